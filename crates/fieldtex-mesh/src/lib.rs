@@ -1,0 +1,29 @@
+//! Triangle mesh core of fieldtex: the [`TriMesh`] type, its [`Topology`] tables,
+//! inspection and repair, and the geometry operators every pipeline uses.
+//!
+//! Architecture invariant: no file I/O, no printing. Parsers and writers live in
+//! `fieldtex-io`; sparse matrices are built here as triplets and handed to
+//! `fieldtex-linalg`, which alone knows the solver library.
+
+pub mod error;
+pub mod mesh;
+pub mod primitives;
+pub mod topology;
+
+pub use error::MeshError;
+pub use mesh::{Aabb, CornerUvs, TriMesh};
+pub use topology::{Csr, Topology, UnionFind};
+
+// Geometry operators.
+pub mod areas;
+pub mod bvh;
+pub mod cotan_laplacian;
+pub mod heat_geodesic;
+pub mod mass_matrix;
+pub mod normals;
+pub mod poisson_disk_sampling;
+pub mod principal_curvature;
+
+// Inspection and repair.
+pub mod inspect;
+pub mod repair;

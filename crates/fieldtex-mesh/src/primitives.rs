@@ -1,0 +1,157 @@
+//! Procedural meshes for demos, tests and benchmarks (no files needed).
+//!
+//! All are consistently oriented (outward normals for closed surfaces, +z for planar
+//! patches) and free of degenerate triangles.
+
+use crate::TriMesh;
+use std::f64::consts::PI;
+
+/// A regular `nx × ny`-cell grid on `[0, w] × [0, h]` in the z = 0 plane, each cell
+/// split into two triangles along alternating diagonals. Disk topology, one boundary
+/// loop. Vertex `(i, j)` has index `j * (nx + 1) + i`.
+pub fn grid(nx: usize, ny: usize, w: f64, h: f64) -> TriMesh {
+    let nx = nx.max(1);
+    let ny = ny.max(1);
+    let mut positions = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            positions.push([w * i as f64 / nx as f64, h * j as f64 / ny as f64, 0.0]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut triangles = Vec::with_capacity(2 * nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            } else {
+                triangles.push([a, b, d]);
+                triangles.push([b, c, d]);
+            }
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+/// A unit-radius sphere made by subdividing an icosahedron `level` times
+/// (`20 · 4^level` triangles), closed, genus 0.
+pub fn icosphere(level: usize) -> TriMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut triangles: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..level {
+        let m = subdivide_midpoint(&TriMesh::new(positions, triangles));
+        positions = m.positions;
+        triangles = m.triangles;
+    }
+    for p in &mut positions {
+        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        *p = [p[0] / n, p[1] / n, p[2] / n];
+    }
+    TriMesh::new(positions, triangles)
+}
+
+/// A torus around the z axis with major radius `major` and minor radius `minor`,
+/// `nu` segments around the axis and `nv` around the tube. Closed, genus 1.
+pub fn torus(major: f64, minor: f64, nu: usize, nv: usize) -> TriMesh {
+    let nu = nu.max(3);
+    let nv = nv.max(3);
+    let mut positions = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        let u = 2.0 * PI * i as f64 / nu as f64;
+        for j in 0..nv {
+            let v = 2.0 * PI * j as f64 / nv as f64;
+            let r = major + minor * v.cos();
+            positions.push([r * u.cos(), r * u.sin(), minor * v.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
+    let mut triangles = Vec::with_capacity(2 * nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+/// Splits every triangle into four through its edge midpoints (1→4 subdivision,
+/// positions only; attributes are dropped). Shared edges get one shared midpoint, so
+/// the result keeps the input's topology.
+pub fn subdivide_midpoint(mesh: &TriMesh) -> TriMesh {
+    let topo = crate::Topology::build(mesh.n_vertices(), &mesh.triangles);
+    let nv = mesh.n_vertices();
+    let mut positions = mesh.positions.clone();
+    positions.reserve(topo.n_edges());
+    for e in &topo.edges {
+        let (a, b) = (mesh.positions[e[0] as usize], mesh.positions[e[1] as usize]);
+        positions.push([(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5, (a[2] + b[2]) * 0.5]);
+    }
+    let mut triangles = Vec::with_capacity(4 * mesh.n_triangles());
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        let m = topo.face_edges[f].map(|e| nv as u32 + e);
+        // m[i] is the midpoint of corners i and i+1.
+        triangles.push([t[0], m[0], m[2]]);
+        triangles.push([t[1], m[1], m[0]]);
+        triangles.push([t[2], m[2], m[1]]);
+        triangles.push([m[0], m[1], m[2]]);
+    }
+    TriMesh::new(positions, triangles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Topology;
+
+    fn euler(m: &TriMesh) -> i64 {
+        let t = Topology::build(m.n_vertices(), &m.triangles);
+        m.n_vertices() as i64 - t.n_edges() as i64 + m.n_triangles() as i64
+    }
+
+    #[test]
+    fn euler_characteristics() {
+        assert_eq!(euler(&icosphere(2)), 2);
+        assert_eq!(icosphere(2).n_triangles(), 320);
+        assert_eq!(euler(&torus(2.0, 0.5, 24, 12)), 0);
+        assert_eq!(euler(&grid(5, 4, 1.0, 1.0)), 1);
+    }
+}
