@@ -1,0 +1,427 @@
+//! Sparse Cholesky `A = P⁻¹ L Lᵀ P` of a symmetric positive definite matrix, on faer.
+//!
+//! - **Ordering**: approximate minimum degree (AMD; Amestoy, Davis & Duff 1996) computed
+//!   by faer, then faer's supernodal (or, for very sparse factors, simplicial) symbolic
+//!   analysis (George & Liu 1981, "Computer Solution of Large Sparse Positive Definite
+//!   Systems"). [`SymbolicCholesky`] holds both and is reused by
+//!   [`Cholesky::factor_with`] for matrices with the same pattern (e.g. the same mesh with
+//!   new weights or a new penalty diagonal).
+//! - **Input**: a full symmetric `n × n` [`SparseMatrix`] (both triangles stored). Only
+//!   the lower triangle is factored; the whole matrix is used for residuals, so the two
+//!   triangles are checked to agree (relative `1e-10`).
+//! - **Residual check**: every solve computes `‖A x − b‖₂ / ‖b‖₂` with the *current*
+//!   matrix (including rank-1 updates). If it exceeds
+//!   [`CholeskyOptions::refine_above`], up to [`CholeskyOptions::max_refinement_steps`]
+//!   steps of iterative refinement (`x += A⁻¹ (b − A x)` with the same factor) are taken;
+//!   if it still exceeds [`CholeskyOptions::residual_tolerance`] the solve fails with
+//!   [`LinalgError::SolveFailed`]. `b = 0` gives `x = 0` with residual 0.
+//! - **Parallelism**: the numeric factorisation uses faer with the current rayon pool.
+//!   Solves run faer's triangular solves with `Par::Seq` per right-hand side (faer's
+//!   multi-RHS supernodal solve under `Par::Rayon` is 6–10× slower, DEPENDENCIES.md);
+//!   [`Cholesky::solve_many`] runs right-hand sides in parallel.
+//! - Not implemented: `LDLᵀ` / indefinite matrices, regularisation of singular matrices
+//!   (a singular or indefinite matrix is a [`LinalgError::FactorizationFailed`]).
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky as fc;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side};
+use rayon::prelude::*;
+
+use crate::cholesky_update::DynamicFactor;
+use crate::{LinalgError, SparseMatrix};
+
+/// Tolerances of the residual check done by every solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CholeskyOptions {
+    /// Largest accepted relative residual `‖A x − b‖ / ‖b‖`. Default `1e-8`: a backward
+    /// stable Cholesky solve of a penalty system (Laplacian + `α = 1e8` diagonal, condition
+    /// number ~1e12) gives ~1e-14…1e-11; `1e-8` leaves room for worse conditioning while
+    /// still catching singular factors and asymmetric input.
+    pub residual_tolerance: f64,
+    /// Iterative refinement is tried when the residual exceeds this. Default `1e-11`.
+    pub refine_above: f64,
+    /// Most refinement steps per solve (each costs one solve and one product). Default 2.
+    pub max_refinement_steps: usize,
+}
+
+impl Default for CholeskyOptions {
+    fn default() -> Self {
+        Self { residual_tolerance: 1e-8, refine_above: 1e-11, max_refinement_steps: 2 }
+    }
+}
+
+struct SymbolicInner {
+    faer: fc::SymbolicCholesky<usize>,
+    /// Pattern of the analysed matrix, to refuse numeric factorisations of another one.
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+}
+
+/// Fill-reducing ordering plus symbolic factorisation of a symmetric sparsity pattern;
+/// cheap to clone (shared), reusable for every matrix with exactly this pattern.
+#[derive(Clone)]
+pub struct SymbolicCholesky {
+    inner: Arc<SymbolicInner>,
+}
+
+impl std::fmt::Debug for SymbolicCholesky {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SymbolicCholesky")
+            .field("size", &self.size())
+            .field("factor_nnz", &self.factor_nnz())
+            .finish()
+    }
+}
+
+impl SymbolicCholesky {
+    /// AMD ordering + symbolic analysis of the pattern of `a` (square; values ignored).
+    pub fn analyze(a: &SparseMatrix) -> Result<Self, LinalgError> {
+        let n = check_square(a)?;
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
+        let faer = fc::factorize_symbolic_cholesky(
+            pattern,
+            Side::Lower,
+            fc::SymmetricOrdering::Amd,
+            fc::CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| LinalgError::FactorizationFailed {
+            size: n,
+            reason: format!("symbolic analysis failed: {e:?}"),
+        })?;
+        Ok(Self {
+            inner: Arc::new(SymbolicInner {
+                faer,
+                col_ptr: a.col_ptr().to_vec(),
+                row_idx: a.row_idx().to_vec(),
+            }),
+        })
+    }
+
+    /// Matrix size `n`.
+    pub fn size(&self) -> usize {
+        self.inner.col_ptr.len() - 1
+    }
+
+    /// Stored entries of the factor `L` (supernodal storage counts whole blocks).
+    pub fn factor_nnz(&self) -> usize {
+        self.inner.faer.len_val()
+    }
+
+    /// `perm[k]` = original index of the `k`-th eliminated unknown (identity if none).
+    pub fn permutation(&self) -> Vec<usize> {
+        match self.inner.faer.perm() {
+            Some(p) => p.arrays().0.to_vec(),
+            None => (0..self.size()).collect(),
+        }
+    }
+
+    fn check_pattern(&self, a: &SparseMatrix) -> Result<(), LinalgError> {
+        let n = check_square(a)?;
+        if n != self.size() {
+            return Err(LinalgError::Dimension {
+                what: "matrix size vs symbolic analysis",
+                expected: self.size(),
+                found: n,
+            });
+        }
+        if a.col_ptr() != self.inner.col_ptr.as_slice() {
+            return Err(LinalgError::PatternMismatch { what: "column counts differ" });
+        }
+        if a.row_idx() != self.inner.row_idx.as_slice() {
+            return Err(LinalgError::PatternMismatch { what: "row indices differ" });
+        }
+        Ok(())
+    }
+}
+
+/// Numeric Cholesky factorisation of a symmetric positive definite matrix; keeps a copy
+/// of the matrix for residual checks. After a rank-1 update the factor lives in an own
+/// simplicial copy (see [`Cholesky::update`]).
+pub struct Cholesky {
+    symbolic: SymbolicCholesky,
+    /// faer's factor values (supernodal or simplicial layout), valid while `dynamic` is None.
+    values: Vec<f64>,
+    /// Own simplicial factor, created by the first rank-1 update.
+    pub(crate) dynamic: Option<DynamicFactor>,
+    /// The factored matrix, kept current under rank-1 updates whose pattern it holds.
+    pub(crate) matrix: SparseMatrix,
+    /// Rank-1 terms `sign · w wᵀ` whose pattern is not in `matrix`.
+    pub(crate) extra_terms: Vec<(Vec<(usize, f64)>, f64)>,
+    options: CholeskyOptions,
+    last_residual: AtomicU64,
+}
+
+impl Clone for Cholesky {
+    fn clone(&self) -> Self {
+        Self {
+            symbolic: self.symbolic.clone(),
+            values: self.values.clone(),
+            dynamic: self.dynamic.clone(),
+            matrix: self.matrix.clone(),
+            extra_terms: self.extra_terms.clone(),
+            options: self.options.clone(),
+            last_residual: AtomicU64::new(self.last_residual.load(Ordering::Relaxed)),
+        }
+    }
+}
+
+impl std::fmt::Debug for Cholesky {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Cholesky")
+            .field("size", &self.size())
+            .field("updated", &self.dynamic.is_some())
+            .field("last_residual", &self.last_residual())
+            .finish()
+    }
+}
+
+impl Cholesky {
+    /// Symbolic analysis + numeric factorisation of `a` (full symmetric, SPD).
+    pub fn factor(a: &SparseMatrix) -> Result<Self, LinalgError> {
+        let symbolic = SymbolicCholesky::analyze(a)?;
+        Self::factor_with(&symbolic, a)
+    }
+
+    /// Numeric factorisation reusing `symbolic`, which must have been made for a matrix
+    /// with exactly the pattern of `a` ([`LinalgError::PatternMismatch`] otherwise).
+    pub fn factor_with(symbolic: &SymbolicCholesky, a: &SparseMatrix) -> Result<Self, LinalgError> {
+        symbolic.check_pattern(a)?;
+        let n = a.nrows();
+        if let Some(index) = a.first_non_finite() {
+            return Err(LinalgError::NonFinite { what: "matrix value", index });
+        }
+        if let Some((row, col, value, mirror)) = a.first_asymmetry(1e-10) {
+            return Err(LinalgError::NotSymmetric { row, col, value, mirror });
+        }
+        let fsym = &symbolic.inner.faer;
+        let mut values = vec![0.0f64; fsym.len_val()];
+        if n > 0 {
+            let par = Par::rayon(0);
+            let mat = SparseColMatRef::new(
+                SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx()),
+                a.values(),
+            );
+            let mut mem = MemBuffer::try_new(
+                fsym.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+            )
+            .map_err(|_| failed(n, "out of memory for the factorisation workspace".into()))?;
+            fsym.factorize_numeric_llt(
+                &mut values,
+                mat,
+                Side::Lower,
+                LltRegularization::default(),
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| {
+                let faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } = e;
+                let original = symbolic.permutation().get(index).copied().unwrap_or(index);
+                failed(
+                    n,
+                    format!(
+                        "pivot {index} (original row {original}) is not positive: the matrix is not positive definite"
+                    ),
+                )
+            })?;
+            if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+                return Err(failed(n, format!("factor entry {k} is not finite (overflow)")));
+            }
+        }
+        Ok(Self {
+            symbolic: symbolic.clone(),
+            values,
+            dynamic: None,
+            matrix: a.clone(),
+            extra_terms: Vec::new(),
+            options: CholeskyOptions::default(),
+            last_residual: AtomicU64::new(0f64.to_bits()),
+        })
+    }
+
+    /// Replaces the residual-check options (see [`CholeskyOptions`]).
+    pub fn with_options(mut self, options: CholeskyOptions) -> Self {
+        self.options = options;
+        self
+    }
+
+    pub fn options(&self) -> &CholeskyOptions {
+        &self.options
+    }
+
+    /// Matrix size `n`.
+    pub fn size(&self) -> usize {
+        self.matrix.nrows()
+    }
+
+    /// The symbolic analysis this factor was built with.
+    pub fn symbolic(&self) -> &SymbolicCholesky {
+        &self.symbolic
+    }
+
+    /// The matrix currently factored, rank-1 updates included (materialised).
+    pub fn current_matrix(&self) -> SparseMatrix {
+        let mut m = self.matrix.clone();
+        for (w, sign) in &self.extra_terms {
+            let t: Vec<_> =
+                w.iter().flat_map(|&(i, a)| w.iter().map(move |&(j, b)| (i, j, a * b))).collect();
+            let outer = SparseMatrix::from_triplets(m.nrows(), m.ncols(), &t)
+                .expect("rank-1 terms were validated when added");
+            m = m.add_scaled(&outer, *sign);
+        }
+        m
+    }
+
+    /// Largest relative residual `‖A x − b‖ / ‖b‖` of the most recent successful solve
+    /// (over all right-hand sides of [`Cholesky::solve_many`]); 0 before any solve.
+    pub fn last_residual(&self) -> f64 {
+        f64::from_bits(self.last_residual.load(Ordering::Relaxed))
+    }
+
+    /// Solves `A x = b`, checking the residual (see the module docs).
+    pub fn solve(&self, b: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        let (x, r) = self.solve_with_residual(b)?;
+        self.last_residual.store(r.to_bits(), Ordering::Relaxed);
+        Ok(x)
+    }
+
+    /// Solves `A x = b` and returns `x` with its relative residual.
+    pub fn solve_with_residual(&self, b: &[f64]) -> Result<(Vec<f64>, f64), LinalgError> {
+        let n = self.size();
+        if b.len() != n {
+            return Err(LinalgError::Dimension {
+                what: "right-hand side",
+                expected: n,
+                found: b.len(),
+            });
+        }
+        if let Some(index) = b.iter().position(|v| !v.is_finite()) {
+            return Err(LinalgError::NonFinite { what: "right-hand side", index });
+        }
+        let b_norm = norm2(b);
+        if b_norm == 0.0 {
+            return Ok((vec![0.0; n], 0.0));
+        }
+        let mut x = b.to_vec();
+        self.raw_solve_in_place(&mut x);
+        let mut r = self.residual(&x, b);
+        let mut rel = norm2(&r) / b_norm;
+        let mut steps = 0;
+        while exceeds(rel, self.options.refine_above) && steps < self.options.max_refinement_steps {
+            if !rel.is_finite() {
+                break;
+            }
+            self.raw_solve_in_place(&mut r);
+            let candidate: Vec<f64> = x.iter().zip(&r).map(|(a, d)| a + d).collect();
+            let r_new = self.residual(&candidate, b);
+            let rel_new = norm2(&r_new) / b_norm;
+            steps += 1;
+            if rel_new.is_nan() || rel_new >= rel {
+                break;
+            }
+            x = candidate;
+            r = r_new;
+            rel = rel_new;
+        }
+        if exceeds(rel, self.options.residual_tolerance) || x.iter().any(|v| !v.is_finite()) {
+            return Err(LinalgError::SolveFailed {
+                size: n,
+                residual: rel,
+                tolerance: self.options.residual_tolerance,
+            });
+        }
+        Ok((x, rel))
+    }
+
+    /// Solves `A X = B` for several right-hand sides (in parallel, each sequential);
+    /// fails if any of them fails. [`Cholesky::last_residual`] gets the largest residual.
+    pub fn solve_many(&self, b: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, LinalgError> {
+        let results: Vec<_> = b.par_iter().map(|bi| self.solve_with_residual(bi)).collect();
+        let mut out = Vec::with_capacity(b.len());
+        let mut worst = 0.0f64;
+        for res in results {
+            let (x, r) = res?;
+            worst = worst.max(r);
+            out.push(x);
+        }
+        self.last_residual.store(worst.to_bits(), Ordering::Relaxed);
+        Ok(out)
+    }
+
+    /// `r = b − A x` with the current matrix (extra rank-1 terms included).
+    fn residual(&self, x: &[f64], b: &[f64]) -> Vec<f64> {
+        // A is symmetric, so Aᵀx (column-parallel, fixed order) equals A x.
+        let mut ax = self.matrix.transpose_mul_vec(x);
+        for (w, sign) in &self.extra_terms {
+            let d: f64 = w.iter().map(|&(i, v)| v * x[i]).sum();
+            for &(i, v) in w {
+                ax[i] += sign * v * d;
+            }
+        }
+        b.iter().zip(ax).map(|(bi, a)| bi - a).collect()
+    }
+
+    /// `x ← A⁻¹ x` with the current factor, no checks.
+    pub(crate) fn raw_solve_in_place(&self, x: &mut [f64]) {
+        let n = self.size();
+        if n == 0 {
+            return;
+        }
+        if let Some(dynamic) = &self.dynamic {
+            dynamic.solve_in_place(x);
+            return;
+        }
+        let fsym = &self.symbolic.inner.faer;
+        let llt = fc::LltRef::new(fsym, &self.values);
+        let mut mem = MemBuffer::new(fsym.solve_in_place_scratch::<f64>(1, Par::Seq));
+        let rhs = MatMut::from_column_major_slice_mut(x, n, 1);
+        llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut mem));
+    }
+
+    /// faer's symbolic structure and values, for building the simplicial copy.
+    #[allow(dead_code)]
+    pub(crate) fn faer_parts(&self) -> (&fc::SymbolicCholesky<usize>, &[f64]) {
+        (&self.symbolic.inner.faer, &self.values)
+    }
+
+    /// Frees faer's values once the simplicial copy has taken over.
+    #[allow(dead_code)]
+    pub(crate) fn release_faer_values(&mut self) {
+        self.values = Vec::new();
+    }
+}
+
+/// `true` when `r` is NaN or above `tol`.
+fn exceeds(r: f64, tol: f64) -> bool {
+    r.is_nan() || r > tol
+}
+
+pub(crate) fn failed(size: usize, reason: String) -> LinalgError {
+    LinalgError::FactorizationFailed { size, reason }
+}
+
+fn check_square(a: &SparseMatrix) -> Result<usize, LinalgError> {
+    if a.nrows() != a.ncols() {
+        return Err(LinalgError::Dimension {
+            what: "Cholesky needs a square matrix (columns)",
+            expected: a.nrows(),
+            found: a.ncols(),
+        });
+    }
+    Ok(a.nrows())
+}
+
+/// Euclidean norm, sequential (deterministic) and scaled against overflow.
+pub(crate) fn norm2(v: &[f64]) -> f64 {
+    let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return scale;
+    }
+    let s: f64 = v.iter().map(|x| (x / scale) * (x / scale)).sum();
+    scale * s.sqrt()
+}
