@@ -1,1 +1,36 @@
-//! placeholder
+//! File formats of fieldtex — the only crate that touches files.
+//!
+//! - Mesh readers: [`read_mesh`] / [`read_mesh_bytes`] for OBJ (+MTL), PLY, STL, glTF/GLB,
+//!   returning a [`LoadedMesh`] (mesh, base-colour texture, warnings, format). The
+//!   format is recognised from content first, extension second ([`sniff_mesh_format`]).
+//! - Images: [`read_image`] (PNG/JPEG, 8/16-bit, gray/alpha/RGB/RGBA), [`write_png`],
+//!   [`write_png_gray16`], [`encode_png`].
+//! - Atomic output: [`atomic_write`] (temporary file, fsync, rename) and
+//!   [`ensure_not_input`].
+//!
+//! Architecture invariants: readers never panic on bad data, never allocate more than a
+//! small multiple of the file size (claimed counts are checked against the file length
+//! first), and never loop beyond the file's content; every error is an [`IoError`]
+//! naming the file, the place and what to do. Writers only ever write through
+//! [`atomic_write`].
+
+mod atomic_write;
+mod error;
+mod gltf_reader;
+mod image_io;
+mod mesh_checks;
+mod mesh_format;
+mod mtl_reader;
+mod obj_reader;
+mod ply_reader;
+mod read_mesh;
+mod stl_reader;
+
+pub use atomic_write::{atomic_write, ensure_not_input};
+pub use error::{IoError, MEMORY_NAME};
+pub use image_io::{
+    MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, encode_png, read_image, read_image_bytes, write_png,
+    write_png_gray16,
+};
+pub use mesh_format::{MeshFormat, sniff_mesh_format};
+pub use read_mesh::{LoadedMesh, read_mesh, read_mesh_bytes};
