@@ -1,0 +1,646 @@
+//! Chart segmentation: cuts a mesh into charts that are topological disks and
+//! flatten with little distortion.
+//!
+//! Method (a variational, proxy-based clustering in the spirit of Cohen-Steiner,
+//! Alliez & Desbrun 2004, "Variational Shape Approximation", with the normal-cone
+//! chart growing of Lévy, Petitjean, Ray & Maillot 2002 §4 and the merging of small
+//! charts of Sander, Snyder, Gortler & Hoppe 2001, "Texture mapping progressive
+//! meshes"):
+//! 1. **Growing.** Every chart has a proxy: a seed triangle, a unit normal `N` and a
+//!    centre `c`. All charts grow at once from their seeds, best triangle first, with
+//!    the cost `(1 − n·N) + w‖x − c‖² / R²` (`n`, `x`: the triangle's normal and
+//!    centroid, `R²` = total area / (π · #charts), `w` =
+//!    [`SegmentationOptions::compactness_weight`]). A triangle may join a chart only
+//!    if its normal lies within [`SegmentationOptions::max_normal_angle_deg`] of `N`.
+//! 2. **Seeding.** Regions left uncovered get a new chart (seeded at their most
+//!    representative triangle) when they are large enough or form a whole component;
+//!    small leftovers are later absorbed by their neighbours without the cone limit.
+//! 3. **Lloyd relaxation.** Proxies move to the area-weighted mean normal and centroid
+//!    of their chart and the seed to the chart's cheapest triangle; grow again.
+//! 4. **Boundary smoothing.** A triangle with two neighbours in another chart (and at
+//!    most one in its own) moves there when that chart's cone allows it (this never
+//!    disconnects a chart).
+//! 5. **Merging.** Charts smaller than [`SegmentationOptions::small_chart_fraction`] of
+//!    the mean chart area, or nearly enclosed by a neighbour, merge into the neighbour
+//!    with the longest shared boundary when the union stays a disk and its normal cone
+//!    stays within the limit (tiny charts: within 80°).
+//! 6. **Disk guarantee.** Every chart whose Euler characteristic is not 1 (see
+//!    [`crate::chart_topology`]) is split in two by a farthest-pair flood, repeatedly.
+//!
+//! Charts follow chart adjacency ([`crate::face_graph`]): they never cross a
+//! non-manifold or inconsistently oriented edge, nor a gap between components.
+//! Not implemented: feature-curve detection (Lévy et al. §3) and texture-seam costs.
+
+use crate::chart_topology::{ChartMesh, split_in_two};
+use crate::face_graph::{FaceGraph, NONE};
+use fieldtex_core::vec3::{self, V3};
+use fieldtex_mesh::UnionFind;
+use serde::Serialize;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Options of [`segment_charts`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SegmentationOptions {
+    /// Largest angle in degrees between a triangle's normal and its chart's normal
+    /// while growing. Default 70.
+    pub max_normal_angle_deg: f64,
+    /// Weight of the compactness term of the growing cost. Default 0.15.
+    pub compactness_weight: f64,
+    /// Lloyd relaxation rounds once every triangle is covered. Default 4.
+    pub lloyd_iterations: usize,
+    /// Charts with less than this fraction of the mean chart area try to merge into a
+    /// neighbour. Default 0.35.
+    pub small_chart_fraction: f64,
+    /// Boundary smoothing passes. Default 2.
+    pub smoothing_passes: usize,
+}
+
+impl Default for SegmentationOptions {
+    fn default() -> Self {
+        Self {
+            max_normal_angle_deg: 70.0,
+            compactness_weight: 0.15,
+            lloyd_iterations: 4,
+            small_chart_fraction: 0.35,
+            smoothing_passes: 2,
+        }
+    }
+}
+
+/// The result of [`segment_charts`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Segmentation {
+    /// `#F` chart of each triangle.
+    pub chart_of_triangle: Vec<u32>,
+    /// Triangles of each chart, sorted; charts ordered by their first triangle.
+    pub charts: Vec<Vec<u32>>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Proxy {
+    seed: u32,
+    normal: V3,
+    center: V3,
+}
+
+/// Segments the mesh behind `graph` into disk-shaped charts (see the module docs).
+/// `triangles` are the mesh's triangles. Every triangle gets a chart.
+pub fn segment_charts(
+    graph: &FaceGraph,
+    triangles: &[[u32; 3]],
+    options: &SegmentationOptions,
+) -> Segmentation {
+    let nf = graph.n_faces();
+    if nf == 0 {
+        return Segmentation { chart_of_triangle: Vec::new(), charts: Vec::new() };
+    }
+    let theta = options.max_normal_angle_deg.clamp(1.0, 89.0).to_radians();
+    let cos_max = theta.cos();
+    let w = options.compactness_weight.max(0.0);
+    let total_area: f64 = graph.areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+
+    let mut proxies: Vec<Proxy> = Vec::new();
+    let mut assign;
+    let mut lloyd_done = 0usize;
+    let mut iter = 0usize;
+    const MAX_ITER: usize = 80;
+    loop {
+        let r2 = total_area / (std::f64::consts::PI * proxies.len().max(1) as f64);
+        assign = grow(graph, &proxies, cos_max, w, r2);
+        iter += 1;
+        let mean_area = total_area / proxies.len().max(1) as f64;
+        let new = seeds_for_uncovered(graph, &assign, w, r2, 0.1 * mean_area);
+        if !new.is_empty() && iter < MAX_ITER {
+            proxies.extend(new);
+            continue;
+        }
+        if lloyd_done >= options.lloyd_iterations || iter >= MAX_ITER {
+            break;
+        }
+        proxies = lloyd_update(graph, &assign, &proxies, w, r2);
+        lloyd_done += 1;
+    }
+    absorb_uncovered(graph, &mut assign, &proxies, w);
+    // Seeds for anything still uncovered (cannot happen unless growth was capped).
+    let mut next = proxies.len() as u32;
+    for a in assign.iter_mut() {
+        if *a == NONE {
+            *a = next;
+            next += 1;
+        }
+    }
+    let mut charts = collect_charts(&assign);
+    for _ in 0..options.smoothing_passes {
+        smooth_boundaries(graph, &mut charts, cos_max);
+    }
+    let mut charts = merge_small_charts(graph, charts, options.small_chart_fraction, theta);
+    ensure_disks(graph, triangles, &mut charts);
+    finish(nf, charts)
+}
+
+/// Best-first growth of all proxies at once under the normal-cone limit.
+fn grow(graph: &FaceGraph, proxies: &[Proxy], cos_max: f64, w: f64, r2: f64) -> Vec<u32> {
+    let nf = graph.n_faces();
+    let mut assign = vec![NONE; nf];
+    let mut heap = BinaryHeap::new();
+    for (c, p) in proxies.iter().enumerate() {
+        heap.push(Reverse((0u64, p.seed, c as u32)));
+    }
+    while let Some(Reverse((_, f, c))) = heap.pop() {
+        if assign[f as usize] != NONE {
+            continue;
+        }
+        assign[f as usize] = c;
+        let p = &proxies[c as usize];
+        for &g in &graph.adj[f as usize] {
+            if g == NONE || assign[g as usize] != NONE {
+                continue;
+            }
+            let d = vec3::dot(graph.normals[g as usize], p.normal);
+            if !graph.degenerate[g as usize] && d < cos_max {
+                continue;
+            }
+            let cost = face_cost(graph, g as usize, p, w, r2);
+            heap.push(Reverse((cost.to_bits(), g, c)));
+        }
+    }
+    assign
+}
+
+#[inline]
+fn face_cost(graph: &FaceGraph, f: usize, p: &Proxy, w: f64, r2: f64) -> f64 {
+    let normal_term = if graph.degenerate[f] {
+        0.0
+    } else {
+        (1.0 - vec3::dot(graph.normals[f], p.normal)).max(0.0)
+    };
+    let d2 = vec3::norm2(vec3::sub(graph.centroids[f], p.center));
+    let c = normal_term + w * d2 / r2;
+    if c.is_finite() { c.max(0.0) } else { f64::MAX }
+}
+
+/// New proxies for the connected uncovered regions that are at least `min_area` large
+/// (or that touch no chart at all, i.e. whole components). The largest region always
+/// qualifies when it is at least a tenth of `min_area`.
+fn seeds_for_uncovered(
+    graph: &FaceGraph,
+    assign: &[u32],
+    w: f64,
+    r2: f64,
+    min_area: f64,
+) -> Vec<Proxy> {
+    let nf = graph.n_faces();
+    let mut seen = vec![false; nf];
+    let mut regions: Vec<(Vec<u32>, f64, bool)> = Vec::new();
+    let mut stack = Vec::new();
+    for s in 0..nf {
+        if seen[s] || assign[s] != NONE {
+            continue;
+        }
+        seen[s] = true;
+        stack.push(s as u32);
+        let mut faces = Vec::new();
+        let mut area = 0.0;
+        let mut touches = false;
+        while let Some(f) = stack.pop() {
+            faces.push(f);
+            area += graph.areas[f as usize];
+            for &g in &graph.adj[f as usize] {
+                if g == NONE {
+                    continue;
+                }
+                if assign[g as usize] != NONE {
+                    touches = true;
+                } else if !seen[g as usize] {
+                    seen[g as usize] = true;
+                    stack.push(g);
+                }
+            }
+        }
+        regions.push((faces, area, touches));
+    }
+    let largest = regions
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.1.total_cmp(&b.1.1).then(b.0.cmp(&a.0)))
+        .map(|(i, _)| i);
+    let mut out = Vec::new();
+    for (k, (faces, area, touches)) in regions.iter().enumerate() {
+        let qualifies =
+            !*touches || *area >= min_area || (Some(k) == largest && *area >= 0.1 * min_area);
+        if qualifies {
+            out.push(proxy_for(graph, faces, w, r2, None));
+        }
+    }
+    out
+}
+
+/// The proxy of a set of faces: mean normal and centroid, seed at the cheapest face.
+/// When the mean normal vanishes (a closed part) the `fallback` normal or the largest
+/// face's normal is used.
+fn proxy_for(graph: &FaceGraph, faces: &[u32], w: f64, r2: f64, fallback: Option<V3>) -> Proxy {
+    let mut nsum = [0.0; 3];
+    let mut csum = [0.0; 3];
+    let mut area = 0.0;
+    for &f in faces {
+        let a = graph.areas[f as usize];
+        nsum = vec3::add(nsum, vec3::scale(graph.normals[f as usize], a));
+        csum = vec3::add(csum, vec3::scale(graph.centroids[f as usize], a));
+        area += a;
+    }
+    let center =
+        if area > 0.0 { vec3::scale(csum, 1.0 / area) } else { graph.centroids[faces[0] as usize] };
+    let normal = match vec3::normalize(nsum) {
+        Some(n) if vec3::norm(nsum) > 0.2 * area => n,
+        _ => fallback.unwrap_or_else(|| {
+            let big = faces
+                .iter()
+                .copied()
+                .max_by(|&a, &b| {
+                    graph.areas[a as usize].total_cmp(&graph.areas[b as usize]).then(b.cmp(&a))
+                })
+                .unwrap_or(faces[0]);
+            graph.normals[big as usize]
+        }),
+    };
+    let mut p = Proxy { seed: faces[0], normal, center };
+    let mut best = f64::INFINITY;
+    for &f in faces {
+        let c = face_cost(graph, f as usize, &p, w, r2);
+        if c < best {
+            best = c;
+            p.seed = f;
+        }
+    }
+    p
+}
+
+fn lloyd_update(
+    graph: &FaceGraph,
+    assign: &[u32],
+    proxies: &[Proxy],
+    w: f64,
+    r2: f64,
+) -> Vec<Proxy> {
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); proxies.len()];
+    for (f, &c) in assign.iter().enumerate() {
+        if c != NONE {
+            members[c as usize].push(f as u32);
+        }
+    }
+    members
+        .iter()
+        .zip(proxies)
+        .filter(|(m, _)| !m.is_empty())
+        .map(|(m, p)| proxy_for(graph, m, w, r2, Some(p.normal)))
+        .collect()
+}
+
+/// Assigns uncovered faces to neighbouring charts, best first, without the cone limit.
+fn absorb_uncovered(graph: &FaceGraph, assign: &mut [u32], proxies: &[Proxy], w: f64) {
+    let total_area: f64 = graph.areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+    let r2 = total_area / (std::f64::consts::PI * proxies.len().max(1) as f64);
+    let mut heap = BinaryHeap::new();
+    for f in 0..graph.n_faces() {
+        if assign[f] == NONE {
+            continue;
+        }
+        for &g in &graph.adj[f] {
+            if g != NONE && assign[g as usize] == NONE {
+                let c = assign[f];
+                let cost = face_cost(graph, g as usize, &proxies[c as usize], w, r2);
+                heap.push(Reverse((cost.to_bits(), g, c)));
+            }
+        }
+    }
+    while let Some(Reverse((_, f, c))) = heap.pop() {
+        if assign[f as usize] != NONE {
+            continue;
+        }
+        assign[f as usize] = c;
+        for &g in &graph.adj[f as usize] {
+            if g != NONE && assign[g as usize] == NONE {
+                let cost = face_cost(graph, g as usize, &proxies[c as usize], w, r2);
+                heap.push(Reverse((cost.to_bits(), g, c)));
+            }
+        }
+    }
+}
+
+fn collect_charts(assign: &[u32]) -> Vec<Vec<u32>> {
+    let n = assign.iter().copied().max().map_or(0, |m| m as usize + 1);
+    let mut charts = vec![Vec::new(); n];
+    for (f, &c) in assign.iter().enumerate() {
+        charts[c as usize].push(f as u32);
+    }
+    charts.retain(|c| !c.is_empty());
+    charts
+}
+
+fn chart_normal(graph: &FaceGraph, faces: &[u32]) -> V3 {
+    let mut s = [0.0; 3];
+    for &f in faces {
+        s = vec3::add(s, vec3::scale(graph.normals[f as usize], graph.areas[f as usize]));
+    }
+    vec3::normalize(s).unwrap_or([0.0; 3])
+}
+
+/// One pass of boundary smoothing (module docs, step 4).
+fn smooth_boundaries(graph: &FaceGraph, charts: &mut Vec<Vec<u32>>, cos_max: f64) {
+    let nf = graph.n_faces();
+    let mut chart_of = vec![NONE; nf];
+    for (c, faces) in charts.iter().enumerate() {
+        for &f in faces {
+            chart_of[f as usize] = c as u32;
+        }
+    }
+    let normals: Vec<V3> = charts.iter().map(|c| chart_normal(graph, c)).collect();
+    let mut changed = false;
+    for f in 0..nf {
+        let own = chart_of[f];
+        let nb = graph.adj[f];
+        let same = nb.iter().filter(|&&g| g != NONE && chart_of[g as usize] == own).count();
+        if same > 1 {
+            continue;
+        }
+        for k in 0..3 {
+            if nb[k] == NONE {
+                continue;
+            }
+            let other = chart_of[nb[k] as usize];
+            if other == own {
+                continue;
+            }
+            let cnt = nb.iter().filter(|&&g| g != NONE && chart_of[g as usize] == other).count();
+            let ok = graph.degenerate[f]
+                || vec3::dot(graph.normals[f], normals[other as usize]) >= cos_max;
+            if cnt >= 2 && ok {
+                chart_of[f] = other;
+                changed = true;
+                break;
+            }
+        }
+    }
+    if changed {
+        let mut out = vec![Vec::new(); charts.len()];
+        for (f, &c) in chart_of.iter().enumerate() {
+            out[c as usize].push(f as u32);
+        }
+        out.retain(|c| !c.is_empty());
+        *charts = out;
+    }
+}
+
+/// Per-chart bookkeeping of the merge step.
+#[derive(Debug, Clone)]
+struct ChartStat {
+    faces: Vec<u32>,
+    area: f64,
+    nsum: V3,
+    axis: V3,
+    half_angle: f64,
+    interior: i64,
+    chi: i64,
+    perimeter: f64,
+}
+
+fn cone_of(graph: &FaceGraph, faces: &[u32], nsum: V3) -> (V3, f64) {
+    let axis = vec3::normalize(nsum).unwrap_or([0.0, 0.0, 1.0]);
+    let mut min_dot: f64 = 1.0;
+    for &f in faces {
+        if !graph.degenerate[f as usize] {
+            min_dot = min_dot.min(vec3::dot(graph.normals[f as usize], axis));
+        }
+    }
+    (axis, min_dot.clamp(-1.0, 1.0).acos())
+}
+
+/// Merging of small or enclosed charts (module docs, step 5).
+fn merge_small_charts(
+    graph: &FaceGraph,
+    charts: Vec<Vec<u32>>,
+    small_fraction: f64,
+    theta: f64,
+) -> Vec<Vec<u32>> {
+    let nf = graph.n_faces();
+    let n0 = charts.len();
+    if n0 < 2 {
+        return charts;
+    }
+    let mut chart_of = vec![0u32; nf];
+    for (c, faces) in charts.iter().enumerate() {
+        for &f in faces {
+            chart_of[f as usize] = c as u32;
+        }
+    }
+    // Global corner union-find: corners joined across interior edges of one chart.
+    let mut uf = UnionFind::new(3 * nf);
+    for f in 0..nf {
+        for i in 0..3 {
+            let g = graph.adj[f][i];
+            if g == NONE || (g as usize) < f || chart_of[g as usize] != chart_of[f] {
+                continue;
+            }
+            let j = graph.adj_edge[f][i] as usize;
+            uf.union(3 * f + i, 3 * g as usize + (j + 1) % 3);
+            uf.union(3 * f + (i + 1) % 3, 3 * g as usize + j);
+        }
+    }
+    let mut stats: Vec<ChartStat> = Vec::with_capacity(n0);
+    let mut root_seen = vec![u32::MAX; 3 * nf];
+    for (c, faces) in charts.into_iter().enumerate() {
+        let mut area = 0.0;
+        let mut nsum = [0.0; 3];
+        let mut interior = 0i64;
+        let mut perimeter = 0.0;
+        let mut nv = 0i64;
+        for &f in &faces {
+            let f = f as usize;
+            area += graph.areas[f];
+            nsum = vec3::add(nsum, vec3::scale(graph.normals[f], graph.areas[f]));
+            for i in 0..3 {
+                let g = graph.adj[f][i];
+                if g != NONE && chart_of[g as usize] == c as u32 {
+                    interior += 1; // counted from both sides
+                } else {
+                    perimeter += graph.edge_len[f][i];
+                }
+                let r = uf.find(3 * f + i);
+                if root_seen[r] != c as u32 {
+                    root_seen[r] = c as u32;
+                    nv += 1;
+                }
+            }
+        }
+        interior /= 2;
+        let (axis, half_angle) = cone_of(graph, &faces, nsum);
+        let chi = nv - 2 * faces.len() as i64 + interior;
+        stats.push(ChartStat { faces, area, nsum, axis, half_angle, interior, chi, perimeter });
+    }
+    let total_area: f64 = stats.iter().map(|s| s.area).sum();
+    let tiny_theta = theta.max(80f64.to_radians());
+    for _pass in 0..12 {
+        let alive: Vec<usize> = (0..stats.len()).filter(|&c| !stats[c].faces.is_empty()).collect();
+        let mean_area = total_area / alive.len().max(1) as f64;
+        // Shared edges between different charts, each edge once: (c_lo, c_hi, f, i).
+        let mut shared: Vec<(u32, u32, u32, u8)> = Vec::new();
+        for f in 0..nf {
+            for i in 0..3 {
+                let g = graph.adj[f][i];
+                if g == NONE || (g as usize) < f {
+                    continue;
+                }
+                let (a, b) = (chart_of[f], chart_of[g as usize]);
+                if a != b {
+                    shared.push((a.min(b), a.max(b), f as u32, i as u8));
+                }
+            }
+        }
+        shared.sort_unstable();
+        // Pair groups: (a, b, start, end, length).
+        let mut pairs: Vec<(u32, u32, usize, usize, f64)> = Vec::new();
+        let mut s = 0;
+        while s < shared.len() {
+            let mut e = s;
+            let mut len = 0.0;
+            while e < shared.len() && shared[e].0 == shared[s].0 && shared[e].1 == shared[s].1 {
+                len += graph.edge_len[shared[e].2 as usize][shared[e].3 as usize];
+                e += 1;
+            }
+            pairs.push((shared[s].0, shared[s].1, s, e, len));
+            s = e;
+        }
+        let mut nbrs: Vec<Vec<usize>> = vec![Vec::new(); stats.len()];
+        for (k, p) in pairs.iter().enumerate() {
+            nbrs[p.0 as usize].push(k);
+            nbrs[p.1 as usize].push(k);
+        }
+        let mut order = alive.clone();
+        order.sort_by(|&a, &b| stats[a].area.total_cmp(&stats[b].area).then(a.cmp(&b)));
+        let mut locked = vec![false; stats.len()];
+        let mut merged_any = false;
+        for &c in &order {
+            if locked[c] {
+                continue;
+            }
+            let mut cand: Vec<usize> = nbrs[c].clone();
+            cand.sort_by(|&x, &y| pairs[y].4.total_cmp(&pairs[x].4).then(x.cmp(&y)));
+            let best_len = cand.first().map_or(0.0, |&k| pairs[k].4);
+            let small = stats[c].area < small_fraction * mean_area;
+            let enclosed = best_len >= 0.5 * stats[c].perimeter;
+            if !small && !enclosed {
+                continue;
+            }
+            let tiny = stats[c].area < 0.05 * mean_area;
+            let limit = if tiny { tiny_theta } else { theta };
+            for &k in &cand {
+                let (a, b, s0, s1, len) = pairs[k];
+                let d = if a as usize == c { b as usize } else { a as usize };
+                if locked[d] {
+                    continue;
+                }
+                // Cone bound of the union.
+                let nsum = vec3::add(stats[c].nsum, stats[d].nsum);
+                let Some(axis) = vec3::normalize(nsum) else { continue };
+                let ang =
+                    |s: &ChartStat| vec3::dot(axis, s.axis).clamp(-1.0, 1.0).acos() + s.half_angle;
+                if ang(&stats[c]).max(ang(&stats[d])) > limit {
+                    continue;
+                }
+                // Euler characteristic of the union.
+                let mut roots: Vec<(usize, usize)> = Vec::new();
+                for &(_, _, f, i) in &shared[s0..s1] {
+                    let (f, i) = (f as usize, i as usize);
+                    let g = graph.adj[f][i] as usize;
+                    let j = graph.adj_edge[f][i] as usize;
+                    roots.push((uf.find(3 * f + i), uf.find(3 * g + (j + 1) % 3)));
+                    roots.push((uf.find(3 * f + (i + 1) % 3), uf.find(3 * g + j)));
+                }
+                let mut ids: Vec<usize> = roots.iter().flat_map(|&(x, y)| [x, y]).collect();
+                ids.sort_unstable();
+                ids.dedup();
+                let mut small_uf = UnionFind::new(ids.len());
+                let mut k_merges = 0i64;
+                for &(x, y) in &roots {
+                    let (lx, ly) =
+                        (ids.binary_search(&x).unwrap_or(0), ids.binary_search(&y).unwrap_or(0));
+                    if small_uf.union(lx, ly) {
+                        k_merges += 1;
+                    }
+                }
+                let i_cd = (s1 - s0) as i64;
+                let chi = stats[c].chi + stats[d].chi + i_cd - k_merges;
+                if chi != 1 {
+                    continue;
+                }
+                // Accept: merge c into d.
+                for &(x, y) in &roots {
+                    uf.union(x, y);
+                }
+                let faces_c = std::mem::take(&mut stats[c].faces);
+                for &f in &faces_c {
+                    chart_of[f as usize] = d as u32;
+                }
+                let sc = stats[c].clone();
+                let sd = &mut stats[d];
+                sd.faces.extend(faces_c);
+                sd.area += sc.area;
+                sd.nsum = nsum;
+                sd.interior += sc.interior + i_cd;
+                sd.chi = chi;
+                sd.perimeter += sc.perimeter - 2.0 * len;
+                let (ax, ha) = cone_of(graph, &sd.faces, sd.nsum);
+                sd.axis = ax;
+                sd.half_angle = ha;
+                stats[c].area = 0.0;
+                locked[c] = true;
+                locked[d] = true;
+                merged_any = true;
+                break;
+            }
+        }
+        if !merged_any {
+            break;
+        }
+    }
+    stats.into_iter().filter(|s| !s.faces.is_empty()).map(|s| s.faces).collect()
+}
+
+/// Splits every chart that is not a disk until all are (module docs, step 6).
+fn ensure_disks(graph: &FaceGraph, triangles: &[[u32; 3]], charts: &mut Vec<Vec<u32>>) {
+    let mut out = Vec::with_capacity(charts.len());
+    let mut work: Vec<Vec<u32>> = std::mem::take(charts);
+    work.reverse();
+    while let Some(faces) = work.pop() {
+        let cm = ChartMesh::build(faces, graph, triangles);
+        if cm.is_disk() {
+            out.push(cm.faces);
+            continue;
+        }
+        match split_in_two(&cm.faces, graph) {
+            Some(parts) => {
+                for p in parts.into_iter().rev() {
+                    work.push(p);
+                }
+            }
+            None => out.push(cm.faces),
+        }
+    }
+    *charts = out;
+}
+
+/// Sorts charts by first triangle and builds the per-triangle table.
+fn finish(nf: usize, mut charts: Vec<Vec<u32>>) -> Segmentation {
+    for c in charts.iter_mut() {
+        c.sort_unstable();
+    }
+    charts.sort_by_key(|c| c[0]);
+    let mut chart_of_triangle = vec![0u32; nf];
+    for (k, c) in charts.iter().enumerate() {
+        for &f in c {
+            chart_of_triangle[f as usize] = k as u32;
+        }
+    }
+    Segmentation { chart_of_triangle, charts }
+}
