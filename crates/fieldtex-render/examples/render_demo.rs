@@ -51,17 +51,6 @@ fn main() {
     let img = render(&Scene::new(&sphere), &RenderOptions::default());
     println!("sphere 800px: {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
     save(&img, &out.join("sphere.png"));
-    for (name, o) in [
-        ("ss1", RenderOptions::default().with_supersample(1)),
-        ("unlit", RenderOptions::default().with_shading(Shading::Unlit)),
-        ("empty-bg", RenderOptions::default()),
-    ] {
-        let empty = fieldtex_mesh::TriMesh::new(vec![[0.0; 3], [1e-9, 0.0, 0.0]], vec![]);
-        let m = if name == "empty-bg" { &empty } else { &sphere };
-        let t0 = std::time::Instant::now();
-        let _ = render(&Scene::new(m), &o);
-        println!("{name}: {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
-    }
     save(
         &render(
             &Scene::new(&sphere),
