@@ -1,1 +1,48 @@
-//! placeholder
+//! Tangent vector fields and orientation (2-RoSy) fields for fieldtex: DEC operators,
+//! field design with the natural boundary term, singularity indices, design files and
+//! the fingerprint presets.
+//!
+//! Papers: Fisher, Schröder, Desbrun & Hoppe 2007 ("Design of tangent vector fields")
+//! and Liu et al., "Orientation field guided texture synthesis" (paper D, §2–3).
+//!
+//! Map:
+//! - [`dec`]: `d0`, `d1`, `⋆0/⋆1/⋆2`, Whitney interpolation and its inverse.
+//! - [`natural_boundary`]: the boundary term that turns div² + curl² into the
+//!   Dirichlet energy (paper D §2.2).
+//! - [`singular_model_field`]: exact 1-forms of poles and saddles.
+//! - [`stroke_constraints`]: polylines → weighted edge constraints.
+//! - [`field_design`]: [`FieldDesign`], the editable design with a kept factorisation.
+//! - [`orientation_field`]: doubled angles, complex roots, sampling to pixels.
+//! - [`singularity_index`]: N-RoSy indices on meshes and pixel grids.
+//! - [`design_file`]: the TOML design format; [`presets`]: fingerprint classes.
+//! - [`domain`]: plane grids, point location, disk meshes.
+//!
+//! Architecture invariant: no file I/O, no printing, no environment; everything is
+//! deterministic for any thread count (parallel loops write disjoint outputs, and the
+//! linear algebra is deterministic).
+
+// Index loops over the 3 corners/edges of a triangle read like the maths.
+#![allow(clippy::needless_range_loop)]
+
+pub mod dec;
+pub mod design_elements;
+pub mod design_file;
+pub mod domain;
+pub mod error;
+pub mod field_design;
+pub mod natural_boundary;
+pub mod orientation_field;
+pub mod presets;
+pub mod singular_model_field;
+pub mod singularity_index;
+pub mod stroke_constraints;
+
+pub use dec::Dec;
+pub use design_elements::{Singularity, SingularityKind, Stroke, Symmetry};
+pub use design_file::DesignFile;
+pub use domain::{PlaneGrid, disk_mesh};
+pub use error::FieldsError;
+pub use field_design::{
+    Domain, FieldDesign, FieldDesignOptions, SingularityId, SingularityModel, SolvedField, StrokeId,
+};
+pub use singularity_index::DetectedSingularity;

@@ -1,0 +1,707 @@
+//! Tangent vector field design with DEC (Fisher, Schröder, Desbrun & Hoppe 2007, "Design
+//! of tangent vector fields") with the natural boundary term of Liu et al. (paper D,
+//! §2.1–2.2), as an editable object for interactive use.
+//!
+//! Unknown: a 1-form `ω` (`#E`). Energy (weighted least squares):
+//!
+//! `E(ω) = w_s [ ‖Dω − S‖²_{⋆0⁻¹} + ‖d1 ω − C‖²_{⋆2} − β ωᵀBω ] + Σ_e w_e (ω_e − t_e)² + ε ωᵀ diag(L) ω`
+//!
+//! - `Dω` is the integrated divergence per vertex *with the boundary flux*
+//!   ([`Dec::divergence_triplets`], Fisher's free boundary), `d1 ω` the curl per face;
+//!   `S` and `C` are the prescribed divergence (sources/sinks) and curl (vortices).
+//! - `ωᵀBω` is the natural boundary term ([`crate::natural_boundary`]); with `β = 1` the
+//!   first bracket is the Dirichlet energy `∫|∇u|²` of the field. `β = 0`
+//!   (`natural_boundary: false`) is Fisher et al.'s energy, kept as an ablation.
+//! - `w_e, t_e` are the stroke constraints ([`crate::stroke_constraints`]).
+//! - `ε diag(L)` (default `ε = 1e-6`) pins the free constant fields (the kernel of the
+//!   Dirichlet energy on a flat patch) to the smallest-norm choice.
+//!
+//! Normal equations: `A ω = b` with
+//! `A = w_s (Dᵀ⋆0⁻¹D + d1ᵀ⋆2 d1 − βB) + ε diag + diag(w_e)` and
+//! `b = w_s (Dᵀ⋆0⁻¹ S + d1ᵀ⋆2 C) + (w_e t_e)` — the paper's `∗dS + ∗δC + ZᵀWU_Z`.
+//!
+//! Singularities enter **only** `S` and `C` (so only `b`): with the default
+//! [`SingularityModel::ModelField`], `S` and `C` are the discrete divergence and curl
+//! of the exact 1-forms of the singularities' model fields
+//! ([`crate::singular_model_field`]): a vortex's curl is exactly a point curl on its
+//! triangle, a source's divergence is concentrated on the vertices around it, and
+//! saddles/trisectors (which have no point divergence or curl) get their smooth
+//! `−2c/(z−p)²` densities. [`SingularityModel::PointDelta`] is the literal point form
+//! (divergence `2π·Re c` split barycentrically over the three vertices of the containing
+//! triangle, curl `2π·Im c` on the triangle; saddles still use their model field).
+//! Deviation from the paper: the paper builds a saddle/trisector from direction
+//! constraints on a vertex one-ring, which changes `A`; here every singularity keeps `A`
+//! fixed, so moving any singularity is one back-substitution.
+//!
+//! Factor once: [`FieldDesign::new`] assembles `A` and factors it (symbolic analysis
+//! kept). Editing singularities only marks `b` dirty. Strokes change the diagonal of
+//! `A`: the current implementation refactors numerically with the kept symbolic
+//! analysis on the next [`FieldDesign::solve`] (TODO: use the rank-1
+//! `Cholesky::update` of `fieldtex-linalg` once it lands — each stroke edge is a rank-1
+//! term `w_e e_e e_eᵀ`).
+
+use std::sync::Arc;
+
+use fieldtex_core::Warnings;
+use fieldtex_core::vec3::{add, scale};
+use fieldtex_linalg::{Cholesky, SparseMatrix, SymbolicCholesky};
+use fieldtex_mesh::TriMesh;
+
+use crate::FieldsError;
+use crate::dec::Dec;
+use crate::design_elements::{Singularity, SingularityKind, Stroke, Symmetry};
+use crate::domain::{Frame, PlaneGrid, locate_in_mesh, projected_frames};
+use crate::natural_boundary::boundary_term_triplets;
+use crate::singular_model_field::{ModelField, ModelKind};
+use crate::stroke_constraints::{EdgeConstraint, stroke_edge_constraints};
+
+/// How singularities become prescribed divergence and curl.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SingularityModel {
+    /// Discrete divergence and curl of the exact model-field 1-forms (default).
+    #[default]
+    ModelField,
+    /// Point divergence/curl at the containing triangle (the paper's literal form;
+    /// saddles and trisectors fall back to their model field).
+    PointDelta,
+}
+
+/// Weights and switches of a field design.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldDesignOptions {
+    /// `w_s`, weight of the smoothness (divergence + curl + boundary) energy. Default 1.
+    pub smoothness_weight: f64,
+    /// Include the natural boundary term (paper D §2.2). Default `true`; `false` is the
+    /// ablation with Fisher et al.'s free boundary only.
+    pub natural_boundary: bool,
+    /// `β`, scale of the natural boundary term, in `[0, 1]` (1 = Dirichlet energy).
+    /// Default 1.
+    pub boundary_weight: f64,
+    /// Global stroke weight, multiplied by each stroke's own weight. Default 4.
+    pub stroke_weight: f64,
+    /// `ε`, relative Tikhonov regularisation (times the diagonal of the smoothness
+    /// matrix). Default `1e-6`.
+    pub regularization: f64,
+    /// How singularities enter. Default [`SingularityModel::ModelField`].
+    pub singularity_model: SingularityModel,
+}
+
+impl Default for FieldDesignOptions {
+    fn default() -> Self {
+        Self {
+            smoothness_weight: 1.0,
+            natural_boundary: true,
+            boundary_weight: 1.0,
+            stroke_weight: 4.0,
+            regularization: 1e-6,
+            singularity_model: SingularityModel::ModelField,
+        }
+    }
+}
+
+impl FieldDesignOptions {
+    fn validate(&self) -> Result<(), FieldsError> {
+        let check = |name: &'static str, v: f64, ok: bool, expected: &'static str| {
+            if ok && v.is_finite() {
+                Ok(())
+            } else {
+                Err(FieldsError::InvalidOption { name, value: v, expected })
+            }
+        };
+        check(
+            "smoothness_weight",
+            self.smoothness_weight,
+            self.smoothness_weight > 0.0,
+            "a number > 0",
+        )?;
+        check(
+            "boundary_weight",
+            self.boundary_weight,
+            (0.0..=1.0).contains(&self.boundary_weight),
+            "a number in [0, 1] (1 = Dirichlet energy)",
+        )?;
+        check("stroke_weight", self.stroke_weight, self.stroke_weight >= 0.0, "a number ≥ 0")?;
+        check(
+            "regularization",
+            self.regularization,
+            self.regularization > 0.0 && self.regularization < 1.0,
+            "a number in (0, 1), e.g. 1e-6",
+        )
+    }
+}
+
+/// The domain of a design.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Domain {
+    /// A `W × H` rectangle in pixel units, triangulated as a grid.
+    Plane(PlaneGrid),
+    /// A disk-like triangle mesh patch.
+    Mesh(TriMesh),
+}
+
+/// Stable handle of a singularity in a [`FieldDesign`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SingularityId(pub u32);
+
+/// Stable handle of a stroke in a [`FieldDesign`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct StrokeId(pub u32);
+
+/// A solved design: the 1-form and its per-triangle vectors (for orientation designs
+/// these are the *doubled-angle* vectors; see [`crate::orientation_field`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolvedField {
+    pub symmetry: Symmetry,
+    /// `#E` 1-form.
+    pub one_form: Vec<f64>,
+    /// `#F` Whitney vectors at the barycentres (3-D, tangent).
+    pub face_vectors: Vec<[f64; 3]>,
+    /// Relative residual of the linear solve.
+    pub residual: f64,
+}
+
+#[derive(Debug, Clone)]
+struct SingularityEntry {
+    singularity: Singularity,
+    /// Containing triangle and barycentric coordinates (`None`: outside the plane).
+    face: Option<(usize, [f64; 3])>,
+    /// Nudged position used for the model field.
+    origin: [f64; 3],
+    one_form: Option<Arc<Vec<f64>>>,
+}
+
+/// An editable field design with a kept factorisation. See the module docs.
+pub struct FieldDesign {
+    dec: Dec,
+    plane: Option<PlaneGrid>,
+    symmetry: Symmetry,
+    options: FieldDesignOptions,
+    frames: Vec<Frame>,
+    reference_radius: f64,
+    div: SparseMatrix,
+    div_t: SparseMatrix,
+    d1: SparseMatrix,
+    d1_t: SparseMatrix,
+    base: SparseMatrix,
+    symbolic: SymbolicCholesky,
+    factor: Cholesky,
+    factored_stroke_diag: Vec<f64>,
+    singularities: Vec<Option<SingularityEntry>>,
+    strokes: Vec<Option<(Stroke, Vec<EdgeConstraint>)>>,
+    warnings: Warnings,
+    refactor_count: usize,
+}
+
+impl std::fmt::Debug for FieldDesign {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FieldDesign")
+            .field("symmetry", &self.symmetry)
+            .field("edges", &self.dec.n_edges())
+            .field("singularities", &self.singularities().len())
+            .field("strokes", &self.strokes().len())
+            .finish()
+    }
+}
+
+impl FieldDesign {
+    /// Builds the operators, assembles and factors the design matrix (the expensive,
+    /// once-per-domain step). On a mesh, also computes the per-triangle reference
+    /// frames as the design solution with one fixed vector (paper D, §3).
+    pub fn new(
+        domain: Domain,
+        symmetry: Symmetry,
+        options: FieldDesignOptions,
+    ) -> Result<Self, FieldsError> {
+        options.validate()?;
+        let (mesh, plane) = match domain {
+            Domain::Plane(g) => {
+                for (name, v) in [("width", g.width), ("height", g.height)] {
+                    if !(v.is_finite() && v > 0.0) {
+                        return Err(FieldsError::InvalidOption {
+                            name,
+                            value: v,
+                            expected: "a positive size",
+                        });
+                    }
+                }
+                (g.mesh(), Some(g))
+            }
+            Domain::Mesh(m) => (m, None),
+        };
+        let (dec, warnings) = Dec::new(&mesh)?;
+        let div = SparseMatrix::from_triplets(
+            dec.n_vertices(),
+            dec.n_edges(),
+            &dec.divergence_triplets(),
+        )?;
+        let div_t = div.transpose();
+        let d1 = dec.d1();
+        let d1_t = d1.transpose();
+        let base = assemble_design_matrix(&dec, &div_t, &options)?;
+        let symbolic = SymbolicCholesky::analyze(&base)?;
+        let factor = Cholesky::factor_with(&symbolic, &base)?;
+        let area: f64 = dec.face_areas.iter().sum();
+        let reference_radius = 0.25 * area.sqrt();
+        let mut design = Self {
+            frames: Vec::new(),
+            plane,
+            symmetry,
+            reference_radius,
+            factored_stroke_diag: vec![0.0; dec.n_edges()],
+            dec,
+            options,
+            div,
+            div_t,
+            d1,
+            d1_t,
+            base,
+            symbolic,
+            factor,
+            singularities: Vec::new(),
+            strokes: Vec::new(),
+            warnings,
+            refactor_count: 0,
+        };
+        design.frames = if design.plane.is_some() {
+            vec![([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]); design.dec.n_faces()]
+        } else {
+            design.reference_frames()?
+        };
+        Ok(design)
+    }
+
+    /// Frames from the smoothest field with one fixed vector (the first edge direction
+    /// of the triangle nearest the patch centre), via three solves with the factor.
+    fn reference_frames(&self) -> Result<Vec<Frame>, FieldsError> {
+        let dec = &self.dec;
+        let centroid = scale(
+            dec.positions.iter().fold([0.0; 3], |a, p| add(a, *p)),
+            1.0 / dec.n_vertices() as f64,
+        );
+        let (f0, _, _) = locate_in_mesh(dec, centroid).expect("validated mesh has triangles");
+        let tri = dec.triangles[f0];
+        let dir = fieldtex_core::vec3::sub(
+            dec.positions[tri[1] as usize],
+            dec.positions[tri[0] as usize],
+        );
+        let edges: Vec<usize> = (0..3).map(|k| dec.topology.face_edges[f0][k] as usize).collect();
+        let targets: Vec<f64> =
+            edges.iter().map(|&e| fieldtex_core::vec3::dot(dir, dec.edge_vector(e))).collect();
+        // Hard constraints on the three edges: ω = Σ_k λ_k A⁻¹ e_k with ω[e_j] = t_j.
+        let basis: Vec<Vec<f64>> = edges
+            .iter()
+            .map(|&e| {
+                let mut b = vec![0.0; dec.n_edges()];
+                b[e] = 1.0;
+                b
+            })
+            .collect();
+        let cols = self.factor.solve_many(&basis)?;
+        let g: Vec<[f64; 3]> = (0..3).map(|j| std::array::from_fn(|k| cols[k][edges[j]])).collect();
+        let lambda = solve3([g[0], g[1], g[2]], [targets[0], targets[1], targets[2]]);
+        let mut omega = vec![0.0; dec.n_edges()];
+        for k in 0..3 {
+            for (o, c) in omega.iter_mut().zip(&cols[k]) {
+                *o += lambda[k] * c;
+            }
+        }
+        let reference = dec.face_vectors(&omega);
+        Ok(projected_frames(dec, &reference))
+    }
+
+    /// The DEC operators of the domain.
+    pub fn dec(&self) -> &Dec {
+        &self.dec
+    }
+    /// The plane grid, for plane domains.
+    pub fn plane(&self) -> Option<&PlaneGrid> {
+        self.plane.as_ref()
+    }
+    pub fn symmetry(&self) -> Symmetry {
+        self.symmetry
+    }
+    pub fn options(&self) -> &FieldDesignOptions {
+        &self.options
+    }
+    /// Per-triangle tangent frames `(e1, e2)` in which angles are measured.
+    pub fn frames(&self) -> &[Frame] {
+        &self.frames
+    }
+    /// Warnings from building the operators (degenerate triangles, clamped stars).
+    pub fn warnings(&self) -> &Warnings {
+        &self.warnings
+    }
+    /// Number of numeric refactorisations done for stroke edits so far.
+    pub fn refactor_count(&self) -> usize {
+        self.refactor_count
+    }
+    /// Magnitude scale of singularity model fields: a quarter of `sqrt(area)`.
+    pub fn reference_radius(&self) -> f64 {
+        self.reference_radius
+    }
+    /// The assembled design matrix without strokes.
+    pub fn base_matrix(&self) -> &SparseMatrix {
+        &self.base
+    }
+
+    /// Live singularities with their ids, in id order.
+    pub fn singularities(&self) -> Vec<(SingularityId, Singularity)> {
+        self.singularities
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.as_ref().map(|s| (SingularityId(i as u32), s.singularity)))
+            .collect()
+    }
+
+    /// Live strokes with their ids, in id order.
+    pub fn strokes(&self) -> Vec<(StrokeId, &Stroke)> {
+        self.strokes
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.as_ref().map(|s| (StrokeId(i as u32), &s.0)))
+            .collect()
+    }
+
+    /// Point location: triangle and barycentric coordinates, `None` outside.
+    pub fn locate(&self, p: [f64; 3]) -> Option<(usize, [f64; 3])> {
+        match &self.plane {
+            Some(g) => g.contains(p[0], p[1]).then(|| g.locate(p[0], p[1])),
+            None => {
+                let (f, b, d) = locate_in_mesh(&self.dec, p)?;
+                (d <= self.dec.mean_edge_length).then_some((f, b))
+            }
+        }
+    }
+
+    fn place(&self, s: Singularity) -> Result<SingularityEntry, FieldsError> {
+        if s.kind.symmetry() != self.symmetry {
+            return Err(FieldsError::WrongSymmetry {
+                kind: s.kind.name(),
+                symmetry: self.symmetry.name(),
+            });
+        }
+        let fields = [
+            ("x", s.position[0]),
+            ("y", s.position[1]),
+            ("z", s.position[2]),
+            ("angle", s.angle),
+            ("strength", s.strength),
+        ];
+        for (field, value) in fields {
+            if !value.is_finite() {
+                return Err(FieldsError::NonFinite { what: "singularity", index: 0, field, value });
+            }
+        }
+        let outside = || FieldsError::OutsideDomain {
+            what: "singularity",
+            x: s.position[0],
+            y: s.position[1],
+            z: s.position[2],
+        };
+        let face = self.locate(s.position);
+        if face.is_none()
+            && (self.plane.is_none()
+                || self.options.singularity_model == SingularityModel::PointDelta)
+        {
+            return Err(outside());
+        }
+        // Keep the model field's pole off vertices and edges (its edge integrals would be
+        // undefined there): nudge the barycentric coordinates towards the centre.
+        let (face, origin) = match face {
+            Some((f, b)) => {
+                let min = b[0].min(b[1]).min(b[2]);
+                let b = if min < 1e-6 {
+                    std::array::from_fn(|k| (1.0 - 1e-4) * b[k] + 1e-4 / 3.0)
+                } else {
+                    b
+                };
+                let t = self.dec.triangles[f];
+                let mut o = [0.0; 3];
+                for k in 0..3 {
+                    o = add(o, scale(self.dec.positions[t[k] as usize], b[k]));
+                }
+                if self.plane.is_some() {
+                    o[2] = 0.0;
+                }
+                (Some((f, b)), o)
+            }
+            None => (None, s.position),
+        };
+        Ok(SingularityEntry { singularity: s, face, origin, one_form: None })
+    }
+
+    /// Adds a singularity (right-hand side only). Errors: wrong kind for the design's
+    /// symmetry, non-finite values, outside a mesh domain (on the plane a singularity may
+    /// lie outside the rectangle; it then shapes the field from there).
+    pub fn add_singularity(&mut self, s: Singularity) -> Result<SingularityId, FieldsError> {
+        let entry = self.place(s)?;
+        self.singularities.push(Some(entry));
+        Ok(SingularityId(self.singularities.len() as u32 - 1))
+    }
+
+    fn entry_mut(
+        &mut self,
+        id: SingularityId,
+    ) -> Result<&mut Option<SingularityEntry>, FieldsError> {
+        match self.singularities.get_mut(id.0 as usize) {
+            Some(e @ Some(_)) => Ok(e),
+            _ => Err(FieldsError::UnknownId { what: "singularity", id: id.0 }),
+        }
+    }
+
+    /// Replaces a singularity (kind, position, angle, strength); right-hand side only.
+    pub fn set_singularity(
+        &mut self,
+        id: SingularityId,
+        s: Singularity,
+    ) -> Result<(), FieldsError> {
+        self.entry_mut(id)?;
+        let entry = self.place(s)?;
+        *self.entry_mut(id)? = Some(entry);
+        Ok(())
+    }
+
+    /// Moves a singularity; right-hand side only.
+    pub fn move_singularity(
+        &mut self,
+        id: SingularityId,
+        position: [f64; 3],
+    ) -> Result<(), FieldsError> {
+        let mut s = self.entry_mut(id)?.as_ref().expect("checked").singularity;
+        s.position = position;
+        self.set_singularity(id, s)
+    }
+
+    /// Removes a singularity; right-hand side only. Its id is not reused.
+    pub fn remove_singularity(&mut self, id: SingularityId) -> Result<(), FieldsError> {
+        *self.entry_mut(id)? = None;
+        Ok(())
+    }
+
+    /// Adds a direction stroke (changes the matrix diagonal; refactored on the next solve).
+    pub fn add_stroke(&mut self, stroke: Stroke) -> Result<StrokeId, FieldsError> {
+        let index = self.strokes.len();
+        let constraints = {
+            let locate = |p: [f64; 3]| self.locate(p);
+            stroke_edge_constraints(
+                &self.dec,
+                &locate,
+                &self.frames,
+                self.symmetry,
+                &stroke,
+                self.options.stroke_weight,
+                index,
+            )?
+        };
+        self.strokes.push(Some((stroke, constraints)));
+        Ok(StrokeId(index as u32))
+    }
+
+    /// Removes a stroke. Its id is not reused.
+    pub fn remove_stroke(&mut self, id: StrokeId) -> Result<(), FieldsError> {
+        match self.strokes.get_mut(id.0 as usize) {
+            Some(s @ Some(_)) => {
+                *s = None;
+                Ok(())
+            }
+            _ => Err(FieldsError::UnknownId { what: "stroke", id: id.0 }),
+        }
+    }
+
+    /// Replaces a stroke's polyline (and weight).
+    pub fn set_stroke(&mut self, id: StrokeId, stroke: Stroke) -> Result<(), FieldsError> {
+        if !matches!(self.strokes.get(id.0 as usize), Some(Some(_))) {
+            return Err(FieldsError::UnknownId { what: "stroke", id: id.0 });
+        }
+        let constraints = {
+            let locate = |p: [f64; 3]| self.locate(p);
+            stroke_edge_constraints(
+                &self.dec,
+                &locate,
+                &self.frames,
+                self.symmetry,
+                &stroke,
+                self.options.stroke_weight,
+                id.0 as usize,
+            )?
+        };
+        self.strokes[id.0 as usize] = Some((stroke, constraints));
+        Ok(())
+    }
+
+    /// Sum of the stroke diagonals, in stroke-id order (deterministic).
+    fn stroke_diagonal(&self) -> Vec<f64> {
+        let mut d = vec![0.0; self.dec.n_edges()];
+        for (_, cs) in self.strokes.iter().flatten() {
+            for &(e, w, _) in cs {
+                d[e] += w;
+            }
+        }
+        d
+    }
+
+    /// Brings the factorisation up to date with the strokes (no-op when unchanged).
+    pub fn refactor_if_needed(&mut self) -> Result<(), FieldsError> {
+        let d = self.stroke_diagonal();
+        if d != self.factored_stroke_diag {
+            let a = self.base.add_diagonal(&d);
+            self.factor = Cholesky::factor_with(&self.symbolic, &a)?;
+            self.factored_stroke_diag = d;
+            self.refactor_count += 1;
+        }
+        Ok(())
+    }
+
+    /// The right-hand side `b` (`#E`) for the current singularities and strokes.
+    pub fn right_hand_side(&mut self) -> Vec<f64> {
+        let ne = self.dec.n_edges();
+        let floor = 1e-3 * self.dec.mean_edge_length;
+        let mut model = vec![0.0; ne];
+        let mut any_model = false;
+        let mut s_point = vec![0.0; self.dec.n_vertices()];
+        let mut c_point = vec![0.0; self.dec.n_faces()];
+        let point = self.options.singularity_model == SingularityModel::PointDelta;
+        for i in 0..self.singularities.len() {
+            let Some(entry) = &self.singularities[i] else { continue };
+            let s = entry.singularity;
+            let (kind, c) = s.kind.model(s.angle, s.strength * self.reference_radius);
+            if point && kind == ModelKind::Pole {
+                let (f, b) = entry.face.expect("point singularities lie inside");
+                let two_pi = 2.0 * std::f64::consts::PI;
+                for k in 0..3 {
+                    s_point[self.dec.triangles[f][k] as usize] += two_pi * c[0] * b[k];
+                }
+                c_point[f] += two_pi * c[1];
+                continue;
+            }
+            let one_form = match &entry.one_form {
+                Some(w) => w.clone(),
+                None => {
+                    let (e1, e2) = match entry.face {
+                        Some((f, _)) => self.frames[f],
+                        None => ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+                    };
+                    let m = ModelField { kind, origin: entry.origin, e1, e2, c };
+                    let mut w = vec![0.0; ne];
+                    m.add_one_form(&self.dec, floor, &mut w);
+                    let w = Arc::new(w);
+                    self.singularities[i].as_mut().expect("live").one_form = Some(w.clone());
+                    w
+                }
+            };
+            any_model = true;
+            for (a, b) in model.iter_mut().zip(one_form.iter()) {
+                *a += b;
+            }
+        }
+        // S = Dω* + S_point, C = d1 ω* + C_point; b = w_s (Dᵀ ⋆0⁻¹ S + d1ᵀ ⋆2 C).
+        let mut s =
+            if any_model { self.div.mul_vec(&model) } else { vec![0.0; self.dec.n_vertices()] };
+        let mut c = if any_model { self.d1.mul_vec(&model) } else { vec![0.0; self.dec.n_faces()] };
+        let ws = self.options.smoothness_weight;
+        for (v, sv) in s.iter_mut().enumerate() {
+            *sv = ws * (*sv + s_point[v]) / self.dec.star0[v];
+        }
+        for (f, cf) in c.iter_mut().enumerate() {
+            *cf = ws * (*cf + c_point[f]) * self.dec.star2[f];
+        }
+        let mut b = self.div_t.mul_vec(&s);
+        for (bi, ci) in b.iter_mut().zip(self.d1_t.mul_vec(&c)) {
+            *bi += ci;
+        }
+        for (_, cs) in self.strokes.iter().flatten() {
+            for &(e, _, wt) in cs {
+                b[e] += wt;
+            }
+        }
+        b
+    }
+
+    /// Solves the design: refactors if strokes changed, rebuilds the right-hand side
+    /// (recomputing only the model fields of edited singularities), back-substitutes.
+    pub fn solve(&mut self) -> Result<SolvedField, FieldsError> {
+        self.refactor_if_needed()?;
+        let b = self.right_hand_side();
+        let (one_form, residual) = self.factor.solve_with_residual(&b)?;
+        let face_vectors = self.dec.face_vectors(&one_form);
+        Ok(SolvedField { symmetry: self.symmetry, one_form, face_vectors, residual })
+    }
+}
+
+/// `A = w_s (Dᵀ⋆0⁻¹D + d1ᵀ⋆2 d1 − βB) + ε diag(·)`, exactly symmetric (every
+/// off-diagonal contribution is pushed with its mirror, so duplicates sum identically).
+fn assemble_design_matrix(
+    dec: &Dec,
+    div_t: &SparseMatrix,
+    options: &FieldDesignOptions,
+) -> Result<SparseMatrix, FieldsError> {
+    let ws = options.smoothness_weight;
+    let ne = dec.n_edges();
+    let mut t: Vec<(usize, usize, f64)> =
+        Vec::with_capacity(40 * dec.n_vertices() + 9 * dec.n_faces());
+    let push_outer = |t: &mut Vec<(usize, usize, f64)>, entries: &[(usize, f64)], w: f64| {
+        for (p, &(ep, vp)) in entries.iter().enumerate() {
+            t.push((ep, ep, w * vp * vp));
+            for &(eq, vq) in &entries[p + 1..] {
+                let v = w * vp * vq;
+                t.push((ep, eq, v));
+                t.push((eq, ep, v));
+            }
+        }
+    };
+    // Divergence: column v of Dᵀ is row v of D (sorted edges, merged duplicates).
+    let (cp, ri, vals) = (div_t.col_ptr(), div_t.row_idx(), div_t.values());
+    let mut row: Vec<(usize, f64)> = Vec::with_capacity(32);
+    for v in 0..dec.n_vertices() {
+        row.clear();
+        row.extend((cp[v]..cp[v + 1]).map(|k| (ri[k], vals[k])));
+        push_outer(&mut t, &row, ws / dec.star0[v]);
+    }
+    for f in 0..dec.n_faces() {
+        let entries: Vec<(usize, f64)> = (0..3)
+            .map(|k| {
+                (dec.topology.face_edges[f][k] as usize, dec.topology.face_edge_signs[f][k] as f64)
+            })
+            .collect();
+        push_outer(&mut t, &entries, ws * dec.star2[f]);
+    }
+    if options.natural_boundary && options.boundary_weight > 0.0 {
+        let beta = ws * options.boundary_weight;
+        for (i, j, v) in boundary_term_triplets(dec) {
+            t.push((i, j, -beta * v));
+        }
+    }
+    let l = SparseMatrix::from_triplets(ne, ne, &t)?;
+    let diag = l.diagonal();
+    let mean = diag.iter().sum::<f64>() / ne.max(1) as f64;
+    let reg: Vec<f64> = diag
+        .iter()
+        .map(|d| options.regularization * d.max(1e-3 * mean).max(f64::MIN_POSITIVE))
+        .collect();
+    Ok(l.add_diagonal(&reg))
+}
+
+/// Solves a 3×3 system by Cramer's rule (zero where singular).
+fn solve3(m: [[f64; 3]; 3], r: [f64; 3]) -> [f64; 3] {
+    let det = |a: [[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let d = det(m);
+    if d.abs() < 1e-300 || !d.is_finite() {
+        return [0.0; 3];
+    }
+    std::array::from_fn(|k| {
+        let mut a = m;
+        for (row, rv) in a.iter_mut().zip(r) {
+            row[k] = rv;
+        }
+        det(a) / d
+    })
+}
+
+/// Kinds valid for a symmetry (for UIs and the design file).
+pub fn kinds_for(symmetry: Symmetry) -> Vec<SingularityKind> {
+    SingularityKind::ALL.into_iter().filter(|k| k.symmetry() == symmetry).collect()
+}
