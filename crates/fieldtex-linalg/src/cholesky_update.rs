@@ -1,4 +1,33 @@
-//! Rank-1 update/downdate of a sparse Cholesky factor (work in progress: phase 2).
+//! Sparse rank-1 update and downdate of a Cholesky factor: `L Lᵀ ± w wᵀ = L̄ L̄ᵀ`.
+//!
+//! Algorithm: Davis & Hager 1999, "Modifying a sparse Cholesky factorization" (SIAM J.
+//! Matrix Anal. Appl. 20(3)), the sparse form of the Carlson/Gill–Golub–Murray–Saunders
+//! rank-1 modification (method C1), as also used by CSparse's up/down-date (Davis 2006,
+//! "Direct Methods for Sparse Linear Systems", §8.5). Only the columns of `L` on the
+//! path from `f = min{i : wᵢ ≠ 0}` to the root of the elimination tree of the *modified*
+//! factor change, so an update costs the sum of the column lengths along that path
+//! (about 1 ms at 200K unknowns) instead of a refactorisation.
+//!
+//! Storage: the first update copies faer's factor (supernodal blocks or simplicial
+//! columns) into [`DynamicFactor`], a simplicial CSC `L` in the fill-reducing (permuted)
+//! order with the diagonal first in every column and per-column capacity, so that fill
+//! created by a `w` with several nonzeros can be inserted (a column that outgrows its
+//! slot moves to the end of the arrays, as CHOLMOD does). Explicit zeros from faer's
+//! relaxed supernodes are kept; they are harmless.
+//!
+//! Pattern change (Davis & Hager 1999, §4): walking the new path, each column `j` takes
+//! the pending indices from its child on the path; its new parent is the smallest
+//! off-diagonal row. A single-entry `w = √α eᵢ` (a penalty) never creates fill.
+//!
+//! Failure: a downdate that would make the matrix indefinite (or cancel a pivot to
+//! within rounding: new pivot² ≤ 4 ε · old pivot²) is refused with
+//! [`LinalgError::UpdateFailed`] and the factor values are restored (structural zeros
+//! inserted for fill stay; they do not change the factored matrix).
+
+use faer::sparse::linalg::cholesky as fc;
+
+use crate::LinalgError;
+use crate::cholesky::Cholesky;
 
 /// Direction of a rank-1 modification `A ± w wᵀ`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -9,12 +38,415 @@ pub enum UpdateSign {
     Down,
 }
 
-/// Simplicial factor in permuted space (filled in by the rank-1 update code).
+const NONE: usize = usize::MAX;
+
+/// Simplicial lower-triangular factor of `P A Pᵀ` (`perm[k]` = original index of the
+/// `k`-th unknown), column `j` stored at `start[j]..start[j] + len[j]` with the diagonal
+/// first; `parent` is the elimination tree (`NONE` for roots).
 #[derive(Clone, Debug)]
-pub(crate) struct DynamicFactor {}
+pub(crate) struct DynamicFactor {
+    perm: Vec<usize>,
+    inv: Vec<usize>,
+    start: Vec<usize>,
+    len: Vec<usize>,
+    cap: Vec<usize>,
+    rows: Vec<u32>,
+    vals: Vec<f64>,
+    parent: Vec<usize>,
+    // scratch
+    work: Vec<f64>,
+    mark: Vec<u64>,
+    stamp: u64,
+    path: Vec<usize>,
+    backup: Vec<f64>,
+}
 
 impl DynamicFactor {
-    pub(crate) fn solve_in_place(&self, _x: &mut [f64]) {
-        unreachable!("no rank-1 updates exist yet")
+    /// Copies faer's numeric factor into simplicial CSC form.
+    pub(crate) fn from_faer(
+        sym: &fc::SymbolicCholesky<usize>,
+        values: &[f64],
+    ) -> Result<Self, LinalgError> {
+        let n = sym.nrows();
+        if n >= u32::MAX as usize {
+            return Err(LinalgError::Dimension {
+                what: "rank-1 updates support n < 2³²",
+                expected: u32::MAX as usize,
+                found: n,
+            });
+        }
+        let (perm, inv) = match sym.perm() {
+            Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
+            None => ((0..n).collect(), (0..n).collect()),
+        };
+        let mut start = Vec::with_capacity(n);
+        let mut len = Vec::with_capacity(n);
+        let mut rows: Vec<u32> = Vec::with_capacity(values.len());
+        let mut vals = Vec::with_capacity(values.len());
+        match sym.raw() {
+            fc::SymbolicCholeskyRaw::Simplicial(s) => {
+                let (cp, ri) = (s.col_ptr(), s.row_idx());
+                for j in 0..n {
+                    let range = cp[j]..cp[j + 1];
+                    let Some(d) = ri[range.clone()].iter().position(|&r| r == j) else {
+                        return Err(crate::cholesky::failed(
+                            n,
+                            format!("factor column {j} has no diagonal"),
+                        ));
+                    };
+                    start.push(rows.len());
+                    rows.push(j as u32);
+                    vals.push(values[cp[j] + d]);
+                    for p in range {
+                        if ri[p] != j {
+                            rows.push(ri[p] as u32);
+                            vals.push(values[p]);
+                        }
+                    }
+                    len.push(rows.len() - start[j]);
+                }
+            }
+            fc::SymbolicCholeskyRaw::Supernodal(s) => {
+                let (begin, end, vptr) =
+                    (s.supernode_begin(), s.supernode_end(), s.col_ptr_for_val());
+                for sn in 0..s.n_supernodes() {
+                    let (b, e) = (begin[sn], end[sn]);
+                    let pattern = s.supernode(sn).pattern();
+                    let nrows = (e - b) + pattern.len();
+                    for k in 0..e - b {
+                        let base = vptr[sn] + k * nrows;
+                        start.push(rows.len());
+                        for r in k..e - b {
+                            rows.push((b + r) as u32);
+                            vals.push(values[base + r]);
+                        }
+                        for (t, &r) in pattern.iter().enumerate() {
+                            rows.push(r as u32);
+                            vals.push(values[base + (e - b) + t]);
+                        }
+                        len.push(rows.len() - start[b + k]);
+                    }
+                }
+            }
+        }
+        let mut parent = vec![NONE; n];
+        for j in 0..n {
+            let col = &rows[start[j] + 1..start[j] + len[j]];
+            parent[j] = col.iter().map(|&r| r as usize).min().unwrap_or(NONE);
+        }
+        Ok(Self {
+            perm,
+            inv,
+            cap: len.clone(),
+            start,
+            len,
+            rows,
+            vals,
+            parent,
+            work: vec![0.0; n],
+            mark: vec![0; n],
+            stamp: 0,
+            path: Vec::new(),
+            backup: Vec::new(),
+        })
     }
+
+    fn n(&self) -> usize {
+        self.perm.len()
+    }
+
+    /// Stored entries of `L` (explicit zeros included).
+    pub(crate) fn nnz(&self) -> usize {
+        self.len.iter().sum()
+    }
+
+    /// `x ← A⁻¹ x`: permute, `L y = P x`, `Lᵀ z = y`, permute back.
+    pub(crate) fn solve_in_place(&self, x: &mut [f64]) {
+        let n = self.n();
+        let mut y: Vec<f64> = self.perm.iter().map(|&p| x[p]).collect();
+        for j in 0..n {
+            let s = self.start[j];
+            let yj = y[j] / self.vals[s];
+            y[j] = yj;
+            if yj != 0.0 {
+                for p in s + 1..s + self.len[j] {
+                    y[self.rows[p] as usize] -= self.vals[p] * yj;
+                }
+            }
+        }
+        for j in (0..n).rev() {
+            let s = self.start[j];
+            let mut t = y[j];
+            for p in s + 1..s + self.len[j] {
+                t -= self.vals[p] * y[self.rows[p] as usize];
+            }
+            y[j] = t / self.vals[s];
+        }
+        for (k, &p) in self.perm.iter().enumerate() {
+            x[p] = y[k];
+        }
+    }
+
+    /// Appends explicit-zero entries `new_rows` to column `j`, moving the column to the
+    /// end of the arrays (with 50 % slack) when it outgrows its slot.
+    fn grow_column(&mut self, j: usize, new_rows: &[usize]) {
+        let need = self.len[j] + new_rows.len();
+        if need > self.cap[j] {
+            let cap = need + need / 2 + 4;
+            let old = self.start[j];
+            let new_start = self.rows.len();
+            self.rows.extend_from_within(old..old + self.len[j]);
+            self.vals.extend_from_within(old..old + self.len[j]);
+            self.rows.resize(new_start + cap, 0);
+            self.vals.resize(new_start + cap, 0.0);
+            self.start[j] = new_start;
+            self.cap[j] = cap;
+        }
+        let at = self.start[j] + self.len[j];
+        for (t, &r) in new_rows.iter().enumerate() {
+            self.rows[at + t] = r as u32;
+            self.vals[at + t] = 0.0;
+        }
+        self.len[j] = need;
+    }
+
+    /// Symbolic phase: walks the path of the modified elimination tree from `f`,
+    /// inserting the fill of `w` (pattern `pending`, all > `f`) and recording the path.
+    fn symbolic_path(&mut self, f: usize, mut pending: Vec<usize>) {
+        self.path.clear();
+        let mut j = f;
+        let mut added = Vec::new();
+        loop {
+            self.path.push(j);
+            if !pending.is_empty() {
+                self.stamp += 1;
+                let st = self.stamp;
+                let s = self.start[j];
+                for p in s..s + self.len[j] {
+                    self.mark[self.rows[p] as usize] = st;
+                }
+                added.clear();
+                for &i in &pending {
+                    if self.mark[i] != st {
+                        self.mark[i] = st;
+                        added.push(i);
+                    }
+                }
+                if !added.is_empty() {
+                    let add = std::mem::take(&mut added);
+                    self.grow_column(j, &add);
+                    added = add;
+                }
+                let old_parent = self.parent[j];
+                let new_parent = added.iter().copied().fold(old_parent, usize::min);
+                self.parent[j] = new_parent;
+                pending.clear();
+                if new_parent != old_parent {
+                    // new parent: the whole column (but the parent itself) must reach it
+                    let s = self.start[j];
+                    pending.extend(self.rows[s + 1..s + self.len[j]].iter().map(|&r| r as usize));
+                } else {
+                    pending.extend_from_slice(&added);
+                }
+            }
+            let p = self.parent[j];
+            if p == NONE {
+                break;
+            }
+            pending.retain(|&i| i != p);
+            j = p;
+        }
+    }
+
+    /// `L L̄ᵀ = L Lᵀ + sigma · w wᵀ` for `w` in *permuted* indices (unique, nonzero).
+    /// On failure returns the permuted column where it failed; values are restored.
+    pub(crate) fn update(&mut self, w: &[(usize, f64)], up: bool) -> Result<(), (usize, String)> {
+        let Some(f) = w.iter().map(|&(i, _)| i).min() else {
+            return Ok(());
+        };
+        let pending: Vec<usize> = w.iter().map(|&(i, _)| i).filter(|&i| i != f).collect();
+        self.symbolic_path(f, pending);
+        for &(i, v) in w {
+            self.work[i] = v;
+        }
+        self.backup.clear();
+        let sigma = if up { 1.0 } else { -1.0 };
+        let mut beta = 1.0f64;
+        let mut failure = None;
+        for step in 0..self.path.len() {
+            let j = self.path[step];
+            let (s, l) = (self.start[j], self.len[j]);
+            self.backup.extend_from_slice(&self.vals[s..s + l]);
+            let d = self.vals[s];
+            let wj = self.work[j];
+            self.work[j] = 0.0;
+            let alpha = wj / d;
+            let beta2_sq = beta * beta + sigma * alpha * alpha;
+            if beta2_sq.is_nan()
+                || beta2_sq <= 4.0 * f64::EPSILON * beta * beta
+                || !beta2_sq.is_finite()
+            {
+                failure = Some((step, j, beta2_sq / (beta * beta)));
+                break;
+            }
+            let beta2 = beta2_sq.sqrt();
+            let (delta, gamma) =
+                (if up { beta / beta2 } else { beta2 / beta }, sigma * alpha / (beta2 * beta));
+            let new_d = delta * d + if up { gamma * wj } else { 0.0 };
+            if !new_d.is_finite() || new_d <= 0.0 {
+                failure = Some((step, j, f64::NAN));
+                break;
+            }
+            self.vals[s] = new_d;
+            beta = beta2;
+            if alpha == 0.0 && delta == 1.0 {
+                // no change in this column; entries of w below stay as they are
+                continue;
+            }
+            for p in s + 1..s + l {
+                let i = self.rows[p] as usize;
+                let w1 = self.work[i];
+                let w2 = w1 - alpha * self.vals[p];
+                self.work[i] = w2;
+                self.vals[p] = delta * self.vals[p] + gamma * if up { w1 } else { w2 };
+            }
+        }
+        if let Some((step, j, ratio)) = failure {
+            // restore processed columns and clear the work vector on the rest of the path
+            let mut off = 0;
+            for &c in &self.path[..=step] {
+                let (s, l) = (self.start[c], self.len[c]);
+                if off + l <= self.backup.len() {
+                    self.vals[s..s + l].copy_from_slice(&self.backup[off..off + l]);
+                }
+                off += l;
+            }
+            for &c in &self.path[step..] {
+                self.work[c] = 0.0;
+            }
+            let reason = if ratio.is_nan() {
+                "the updated pivot is not a positive finite number (overflow?)".to_string()
+            } else {
+                format!(
+                    "the pivot would change by a factor of {ratio:e} in its square: the downdated matrix is not (numerically) positive definite"
+                )
+            };
+            return Err((j, reason));
+        }
+        Ok(())
+    }
+}
+
+impl Cholesky {
+    /// Rank-1 modification of the factorisation: afterwards this factors `A + w wᵀ`
+    /// ([`UpdateSign::Up`]) or `A − w wᵀ` ([`UpdateSign::Down`]). `w` is sparse as
+    /// `(index, value)` pairs (duplicates summed, zeros ignored). Solves and their
+    /// residual checks use the modified matrix. The first call copies the factor into an
+    /// own simplicial form (about the cost of one solve); later solves use it.
+    ///
+    /// Errors: index out of range or non-finite value ([`LinalgError::IndexOutOfRange`],
+    /// [`LinalgError::NonFinite`]); a downdate that leaves the matrix indefinite
+    /// ([`LinalgError::UpdateFailed`], factor and matrix unchanged).
+    pub fn update(&mut self, w: &[(usize, f64)], sign: UpdateSign) -> Result<(), LinalgError> {
+        let n = self.size();
+        for (index, &(i, v)) in w.iter().enumerate() {
+            if i >= n {
+                return Err(LinalgError::IndexOutOfRange { row: i, col: 0, nrows: n, ncols: 1 });
+            }
+            if !v.is_finite() {
+                return Err(LinalgError::NonFinite { what: "rank-1 update vector", index });
+            }
+        }
+        let mut merged: Vec<(usize, f64)> = w.to_vec();
+        merged.sort_by_key(|&(i, _)| i);
+        merged.dedup_by(|b, a| {
+            if a.0 == b.0 {
+                a.1 += b.1;
+                true
+            } else {
+                false
+            }
+        });
+        merged.retain(|&(_, v)| v != 0.0);
+        if merged.is_empty() {
+            return Ok(());
+        }
+        if let Some(index) = merged.iter().position(|&(_, v)| !(v * v).is_finite()) {
+            return Err(LinalgError::NonFinite {
+                what: "rank-1 update vector (square overflows)",
+                index,
+            });
+        }
+        if self.dynamic.is_none() {
+            let (sym, values) = self.faer_parts();
+            let dynamic = DynamicFactor::from_faer(sym, values)?;
+            self.dynamic = Some(dynamic);
+            self.release_faer_values();
+        }
+        let dynamic = self.dynamic.as_mut().expect("created above");
+        let permuted: Vec<(usize, f64)> =
+            merged.iter().map(|&(i, v)| (dynamic.inv[i], v)).collect();
+        let up = sign == UpdateSign::Up;
+        dynamic.update(&permuted, up).map_err(|(j, reason)| LinalgError::UpdateFailed {
+            kind: if up { "update" } else { "downdate" },
+            column: dynamic.perm[j],
+            reason,
+        })?;
+        self.downdated |= !up;
+        // keep the matrix used by residual checks current
+        let s = if up { 1.0 } else { -1.0 };
+        let positions: Option<Vec<usize>> = merged
+            .iter()
+            .flat_map(|&(i, _)| merged.iter().map(move |&(j, _)| (i, j)))
+            .map(|(i, j)| self.matrix.find(i, j))
+            .collect();
+        match positions {
+            Some(pos) => {
+                let vals = self.matrix.values_mut();
+                let mut k = 0;
+                for &(_, a) in &merged {
+                    for &(_, b) in &merged {
+                        vals[pos[k]] += s * a * b;
+                        k += 1;
+                    }
+                }
+            }
+            None => self.extra_terms.push((merged, s)),
+        }
+        Ok(())
+    }
+
+    /// Adds the penalty `α eᵢ eᵢᵀ` (a soft constraint on unknown `i`); `α` finite, > 0.
+    pub fn add_diagonal_penalty(&mut self, i: usize, alpha: f64) -> Result<(), LinalgError> {
+        check_alpha(alpha)?;
+        self.update(&[(i, alpha.sqrt())], UpdateSign::Up)
+    }
+
+    /// Removes a penalty added by [`Cholesky::add_diagonal_penalty`] (a downdate).
+    pub fn remove_diagonal_penalty(&mut self, i: usize, alpha: f64) -> Result<(), LinalgError> {
+        check_alpha(alpha)?;
+        self.update(&[(i, alpha.sqrt())], UpdateSign::Down)
+    }
+
+    /// Whether the factor has been modified by rank-1 updates (and lives in the
+    /// simplicial copy).
+    pub fn is_updated(&self) -> bool {
+        self.dynamic.is_some()
+    }
+
+    /// Stored entries of the simplicial factor after updates (`None` before any).
+    pub fn updated_factor_nnz(&self) -> Option<usize> {
+        self.dynamic.as_ref().map(DynamicFactor::nnz)
+    }
+}
+
+fn check_alpha(alpha: f64) -> Result<(), LinalgError> {
+    if !(alpha.is_finite() && alpha > 0.0) {
+        return Err(LinalgError::InvalidArgument {
+            what: "penalty weight alpha",
+            value: alpha,
+            reason: "must be finite and positive",
+        });
+    }
+    Ok(())
 }

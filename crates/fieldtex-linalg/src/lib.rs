@@ -11,8 +11,8 @@
 //!   symbolic analysis is reusable across numeric factorisations of matrices with the
 //!   same pattern. Every solve checks its relative residual (see [`CholeskyOptions`]).
 //! - Rank-1 update/downdate of a factorisation, `A ± w wᵀ`, for adding and removing
-//!   penalty constraints without refactoring (`Cholesky::update`,
-//!   `Cholesky::add_diagonal_penalty`; Davis & Hager 1999; in progress).
+//!   penalty constraints without refactoring ([`Cholesky::update`],
+//!   [`Cholesky::add_diagonal_penalty`]; Davis & Hager 1999).
 //! - [`least_squares`]: sparse least squares through the normal equations.
 //! - [`symmetric_eigen`] and [`Pca`]: dense symmetric eigendecomposition and PCA.
 //!
@@ -32,7 +32,7 @@ mod dense;
 mod least_squares;
 mod sparse_matrix;
 
-pub use cholesky::{Cholesky, CholeskyOptions, SymbolicCholesky};
+pub use cholesky::{Cholesky, CholeskyOptions, FactorLayout, SymbolicCholesky};
 pub use cholesky_update::UpdateSign;
 pub use dense::{Pca, symmetric_eigen};
 pub use least_squares::least_squares;

@@ -134,6 +134,7 @@ fn tight_tolerance_reports_solve_failed() {
         residual_tolerance: 0.0,
         refine_above: 0.0,
         max_refinement_steps: 1,
+        ..Default::default()
     };
     let chol = Cholesky::factor(&a).unwrap().with_options(opts);
     let b = Lcg(5).vec(900);
