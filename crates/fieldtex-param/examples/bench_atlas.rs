@@ -1,0 +1,136 @@
+//! Atlas benchmark: `cargo run --release -p fieldtex-param --example bench_atlas -- [MESH.obj] [RESOLUTION] [GUTTER] [RUNS]`.
+//!
+//! Loads an OBJ (a tiny `v`/`f` reader: polygons fanned, `a/b/c` and negative indices
+//! accepted), builds the atlas `RUNS` times (default 3) and prints `BENCH` lines: the
+//! median wall time and the quality of the last run. Default mesh: the Stanford bunny
+//! of the shared test data.
+
+use fieldtex_core::Progress;
+use fieldtex_mesh::TriMesh;
+use fieldtex_param::{AtlasOptions, build_atlas};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+fn load_obj(path: &Path) -> Result<TriMesh, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for (ln, line) in text.lines().enumerate() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it
+                    .take(3)
+                    .map(|s| s.parse::<f64>())
+                    .collect::<Result<_, _>>()
+                    .map_err(|e| format!("line {}: {e}", ln + 1))?;
+                if c.len() != 3 {
+                    return Err(format!("line {}: a vertex needs 3 coordinates", ln + 1));
+                }
+                positions.push([c[0], c[1], c[2]]);
+            }
+            Some("f") => {
+                let mut idx = Vec::new();
+                for tok in it {
+                    let v: i64 = tok
+                        .split('/')
+                        .next()
+                        .unwrap_or("")
+                        .parse()
+                        .map_err(|e| format!("line {}: {e}", ln + 1))?;
+                    let i = if v < 0 { positions.len() as i64 + v } else { v - 1 };
+                    if i < 0 || i >= positions.len() as i64 {
+                        return Err(format!("line {}: index {v} out of range", ln + 1));
+                    }
+                    idx.push(i as u32);
+                }
+                for k in 1..idx.len().saturating_sub(1) {
+                    triangles.push([idx[0], idx[k], idx[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(TriMesh::new(positions, triangles))
+}
+
+/// Records when each stage starts and finishes.
+#[derive(Default)]
+struct StageTimer {
+    marks: Mutex<Vec<(String, Instant)>>,
+}
+
+impl Progress for StageTimer {
+    fn stage(&self, name: &str, _total: u64) {
+        self.marks.lock().expect("no poisoning").push((name.to_string(), Instant::now()));
+    }
+    fn advance(&self, _n: u64) {}
+    fn finish_stage(&self) {
+        self.marks.lock().expect("no poisoning").push(("end".to_string(), Instant::now()));
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let default = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/meshes/stanford-bunny.obj");
+    let path = args.first().filter(|s| !s.is_empty()).map(PathBuf::from).unwrap_or(default);
+    let resolution: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1024);
+    let gutter: u32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(4);
+    let runs: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(3).max(1);
+    let mesh = match load_obj(&path) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(2);
+        }
+    };
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh").replace(['-', '.'], "_");
+    let name = if name == "stanford_bunny" { "bunny".to_string() } else { name };
+    let opts = AtlasOptions { resolution, gutter, ..Default::default() };
+    let mut times = Vec::new();
+    let mut last = None;
+    let mut stages = String::new();
+    for _ in 0..runs {
+        let timer = StageTimer::default();
+        let t = Instant::now();
+        let atlas = match build_atlas(&mesh, &opts, &timer) {
+            Ok(a) => a,
+            Err(e) => {
+                eprintln!("error: {e}");
+                std::process::exit(1);
+            }
+        };
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        last = Some(atlas);
+        let marks = timer.marks.into_inner().expect("no poisoning");
+        stages = marks
+            .windows(2)
+            .filter(|w| w[0].0 != "end")
+            .map(|w| format!("{} {:.0} ms", w[0].0, (w[1].1 - w[0].1).as_secs_f64() * 1e3))
+            .collect::<Vec<_>>()
+            .join(", ");
+    }
+    times.sort_by(|a, b| a.total_cmp(b));
+    let atlas = last.expect("at least one run");
+    let s = atlas.stats;
+    println!(
+        "# {} : {} vertices, {} triangles, resolution {resolution}, gutter {gutter}, {} threads",
+        path.display(),
+        mesh.n_vertices(),
+        mesh.n_triangles(),
+        rayon::current_num_threads()
+    );
+    println!("BENCH atlas_{name} median_ms={:.1}", times[times.len() / 2]);
+    println!("BENCH atlas_{name}_charts value={}", s.charts);
+    println!("BENCH atlas_{name}_packing value={:.4}", s.packing_efficiency);
+    println!("BENCH atlas_{name}_angle_mean value={:.4}", s.angle_distortion_mean);
+    println!("BENCH atlas_{name}_angle_p95 value={:.4}", s.angle_distortion_p95);
+    println!("BENCH atlas_{name}_area_distortion value={:.4}", s.area_distortion);
+    println!("BENCH atlas_{name}_flips value={}", s.flipped_triangles);
+    println!("# stages (last run): {stages}");
+    for w in &atlas.warnings {
+        println!("# warning: {w}");
+    }
+}

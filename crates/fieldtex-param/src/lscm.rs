@@ -1,0 +1,413 @@
+//! Least Squares Conformal Maps (Lévy, Petitjean, Ray & Maillot 2002, "Least Squares
+//! Conformal Maps for Automatic Texture Atlas Generation", §3) for one chart.
+//!
+//! A map `U = u + iv` is conformal on a triangle when `∂U/∂z̄ = 0`. With the triangle in
+//! an orthonormal frame of its plane (complex corners `z_k`, area `A`), the linear
+//! interpolant gives `∂U/∂z̄ = i/(4A) Σ_k e_k U_k` with `e_k = z_{k+2} − z_{k+1}` (the
+//! edge opposite corner `k`, counter-clockwise). LSCM minimises
+//! `Σ_T |Σ_k e_k U_k|² / A_T` (the paper's eq. 5 up to a constant), two real rows per
+//! triangle:
+//! `Re: Σ (Re e_k · u_k − Im e_k · v_k)`, `Im: Σ (Im e_k · u_k + Re e_k · v_k)`, each
+//! scaled by `1/√A_T`.
+//!
+//! **Variant:** two pinned vertices (the farthest pair of boundary vertices, pinned at
+//! their 3-D distance apart on the u axis), the rest solved in the least-squares sense
+//! through the normal equations `MᵀM x = −MᵀM_p x_p`, assembled directly as the
+//! `2n × 2n` SPD matrix (unknowns interleaved `u_0, v_0, u_1, …`) and factored with the
+//! sparse Cholesky of `fieldtex-linalg`. The free-boundary spectral variant (Mullen et
+//! al. 2008) is not implemented.
+//!
+//! Zero-area triangles keep their rows with the area clamped to `10⁻⁶` of the chart's
+//! mean triangle area, which asks their corners to stay collinear in UV. The result is
+//! mirrored if its total signed area is negative. [`planar_projection`] is the fallback
+//! when the solve fails. [`flattening_defects`] finds flipped or collapsed triangles and
+//! crossings of the chart's boundary in UV (a locally injective map of a disk with a
+//! simple boundary is injective, so both being absent means the chart does not overlap
+//! itself).
+
+use crate::chart_topology::ChartMesh;
+use crate::face_graph::{FaceGraph, NONE};
+use fieldtex_core::vec3::{self, V3};
+use fieldtex_linalg::{Cholesky, LinalgError, SparseMatrix};
+use fieldtex_mesh::TriMesh;
+
+/// Complex corners `z_k` of a triangle in an orthonormal frame of its plane; the longest
+/// edge is the base so that zero-area (collinear) triangles stay well defined.
+fn local_corners(p: [V3; 3]) -> [[f64; 2]; 3] {
+    let len = |k: usize| vec3::norm(vec3::sub(p[(k + 1) % 3], p[k]));
+    let k = (0..3).max_by(|&a, &b| len(a).total_cmp(&len(b)).then(b.cmp(&a))).unwrap_or(0);
+    let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+    let e1 = vec3::sub(b, a);
+    let l = vec3::norm(e1);
+    let mut z = [[0.0; 2]; 3];
+    if l > 0.0 {
+        let x = vec3::scale(e1, 1.0 / l);
+        let e2 = vec3::sub(c, a);
+        let cx = vec3::dot(e2, x);
+        let cy = vec3::norm(vec3::sub(e2, vec3::scale(x, cx)));
+        z[k] = [0.0, 0.0];
+        z[(k + 1) % 3] = [l, 0.0];
+        z[(k + 2) % 3] = [cx, cy];
+    }
+    z
+}
+
+/// LSCM of `chart` (module docs): one UV per local vertex.
+pub fn lscm(
+    chart: &ChartMesh,
+    mesh: &TriMesh,
+    graph: &FaceGraph,
+) -> Result<Vec<[f64; 2]>, LinalgError> {
+    let n = chart.n_vertices;
+    let pos: Vec<V3> = chart.vertex_global.iter().map(|&v| mesh.positions[v as usize]).collect();
+    if chart.faces.len() == 1 {
+        let z = local_corners(mesh.triangle_positions(chart.faces[0] as usize));
+        let mut uv = vec![[0.0; 2]; n];
+        for k in 0..3 {
+            uv[chart.corners[0][k] as usize] = z[k];
+        }
+        return Ok(uv);
+    }
+    // Pins: farthest pair among boundary vertices (all vertices if there is none).
+    let boundary = chart.boundary_vertices(graph);
+    let cand: Vec<usize> = {
+        let b: Vec<usize> = (0..n).filter(|&v| boundary[v]).collect();
+        if b.len() >= 2 { b } else { (0..n).collect() }
+    };
+    let farthest = |from: usize| -> usize {
+        let mut best = cand[0];
+        let mut bd = -1.0;
+        for &v in &cand {
+            let d = vec3::norm2(vec3::sub(pos[v], pos[from]));
+            if d > bd {
+                bd = d;
+                best = v;
+            }
+        }
+        best
+    };
+    let pa = farthest(cand[0]);
+    let pb = farthest(pa);
+    let dist = vec3::norm(vec3::sub(pos[pa], pos[pb]));
+    if pa == pb || dist.is_nan() || dist <= 0.0 {
+        return Err(LinalgError::InvalidArgument {
+            what: "pin distance",
+            value: dist,
+            reason: "chart has no extent",
+        });
+    }
+    let mut free = vec![u32::MAX; n];
+    let mut nfree = 0u32;
+    for (v, slot) in free.iter_mut().enumerate() {
+        if v != pa && v != pb {
+            *slot = nfree;
+            nfree += 1;
+        }
+    }
+    let pinned = |v: usize| -> Option<[f64; 2]> {
+        if v == pa {
+            Some([0.0, 0.0])
+        } else if v == pb {
+            Some([dist, 0.0])
+        } else {
+            None
+        }
+    };
+    let m = 2 * nfree as usize;
+    let mean_area: f64 = chart.faces.iter().map(|&f| graph.areas[f as usize]).sum::<f64>()
+        / chart.faces.len() as f64;
+    let floor = (1e-6 * mean_area).max(f64::MIN_POSITIVE);
+    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(chart.faces.len() * 72);
+    let mut rhs = vec![0.0; m];
+    for (lf, &f) in chart.faces.iter().enumerate() {
+        let z = local_corners(mesh.triangle_positions(f as usize));
+        let w = 1.0 / graph.areas[f as usize].max(floor).sqrt();
+        for row in 0..2 {
+            // (unknown index or pinned value, coefficient) for the 6 scalar unknowns.
+            let mut coef: [(usize, f64); 6] = [(0, 0.0); 6];
+            for k in 0..3 {
+                let a = z[(k + 2) % 3];
+                let b = z[(k + 1) % 3];
+                let (ex, ey) = (a[0] - b[0], a[1] - b[1]);
+                let v = chart.corners[lf][k] as usize;
+                let (cu, cv) = if row == 0 { (ex, -ey) } else { (ey, ex) };
+                coef[2 * k] = (2 * v, cu * w);
+                coef[2 * k + 1] = (2 * v + 1, cv * w);
+            }
+            // Pinned part of the row: r_p · x_p.
+            let mut rp = 0.0;
+            for &(idx, c) in &coef {
+                if let Some(x) = pinned(idx / 2) {
+                    rp += c * x[idx % 2];
+                }
+            }
+            for &(i, ci) in &coef {
+                let fi = free[i / 2];
+                if fi == u32::MAX {
+                    continue;
+                }
+                let gi = 2 * fi as usize + i % 2;
+                rhs[gi] -= ci * rp;
+                for &(j, cj) in &coef {
+                    let fj = free[j / 2];
+                    if fj == u32::MAX {
+                        continue;
+                    }
+                    trip.push((gi, 2 * fj as usize + j % 2, ci * cj));
+                }
+            }
+        }
+    }
+    let mut uv = vec![[0.0; 2]; n];
+    uv[pa] = [0.0, 0.0];
+    uv[pb] = [dist, 0.0];
+    if m > 0 {
+        let a = SparseMatrix::from_triplets(m, m, &trip)?;
+        let chol = Cholesky::factor(&a)?;
+        let x = chol.solve(&rhs)?;
+        for v in 0..n {
+            if free[v] != u32::MAX {
+                let k = 2 * free[v] as usize;
+                uv[v] = [x[k], x[k + 1]];
+            }
+        }
+    }
+    orient_positive(chart, &mut uv);
+    Ok(uv)
+}
+
+/// Orthographic projection onto the plane orthogonal to the chart's mean normal.
+pub fn planar_projection(chart: &ChartMesh, mesh: &TriMesh, graph: &FaceGraph) -> Vec<[f64; 2]> {
+    let mut s = [0.0; 3];
+    for &f in &chart.faces {
+        s = vec3::add(s, vec3::scale(graph.normals[f as usize], graph.areas[f as usize]));
+    }
+    let n = vec3::normalize(s).unwrap_or([0.0, 0.0, 1.0]);
+    let x = vec3::any_orthonormal(n);
+    let y = vec3::cross(n, x);
+    let mut uv: Vec<[f64; 2]> = chart
+        .vertex_global
+        .iter()
+        .map(|&v| {
+            let p = mesh.positions[v as usize];
+            [vec3::dot(p, x), vec3::dot(p, y)]
+        })
+        .collect();
+    orient_positive(chart, &mut uv);
+    uv
+}
+
+fn signed_area(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+}
+
+fn orient_positive(chart: &ChartMesh, uv: &mut [[f64; 2]]) {
+    let total: f64 = chart
+        .corners
+        .iter()
+        .map(|c| signed_area(uv[c[0] as usize], uv[c[1] as usize], uv[c[2] as usize]))
+        .sum();
+    if total < 0.0 {
+        for p in uv.iter_mut() {
+            p[0] = -p[0];
+        }
+    }
+}
+
+/// What is wrong with a flattening.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FlatteningDefects {
+    /// Non-degenerate triangles with non-positive or collapsed UV area.
+    pub flipped: usize,
+    /// `true` when two boundary edges cross in UV.
+    pub boundary_crossing: bool,
+}
+
+impl FlatteningDefects {
+    pub fn is_clean(&self) -> bool {
+        self.flipped == 0 && !self.boundary_crossing
+    }
+}
+
+/// Flipped/collapsed triangles and boundary crossings of `uv` on `chart` (module docs).
+/// A triangle counts as collapsed when its UV area is below `10⁻⁹` of its 3-D area
+/// after normalising total UV area to total 3-D area.
+pub fn flattening_defects(
+    chart: &ChartMesh,
+    uv: &[[f64; 2]],
+    graph: &FaceGraph,
+) -> FlatteningDefects {
+    let mut d = FlatteningDefects::default();
+    if uv.iter().any(|p| !(p[0].is_finite() && p[1].is_finite())) {
+        d.flipped = chart.faces.len();
+        return d;
+    }
+    let areas: Vec<f64> = chart
+        .corners
+        .iter()
+        .map(|c| signed_area(uv[c[0] as usize], uv[c[1] as usize], uv[c[2] as usize]))
+        .collect();
+    let a3: f64 = chart.faces.iter().map(|&f| graph.areas[f as usize]).sum();
+    let auv: f64 = areas.iter().map(|a| a.abs()).sum();
+    let scale = if auv > 0.0 { a3 / auv } else { 0.0 };
+    for (lf, &f) in chart.faces.iter().enumerate() {
+        if graph.degenerate[f as usize] {
+            continue;
+        }
+        let scaled = areas[lf] * scale;
+        if scaled.is_nan() || scaled <= 1e-9 * graph.areas[f as usize] {
+            d.flipped += 1;
+        }
+    }
+    d.boundary_crossing = boundary_crosses(chart, uv, graph);
+    d
+}
+
+/// `true` when two boundary edges that share no vertex cross or touch.
+fn boundary_crosses(chart: &ChartMesh, uv: &[[f64; 2]], graph: &FaceGraph) -> bool {
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    for (lf, &f) in chart.faces.iter().enumerate() {
+        for i in 0..3 {
+            let g = graph.adj[f as usize][i];
+            if g == NONE || chart.faces.binary_search(&g).is_err() {
+                edges.push([chart.corners[lf][i], chart.corners[lf][(i + 1) % 3]]);
+            }
+        }
+    }
+    if edges.len() < 4 {
+        return false;
+    }
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let mut total_len = 0.0;
+    for e in &edges {
+        let (a, b) = (uv[e[0] as usize], uv[e[1] as usize]);
+        for k in 0..2 {
+            lo[k] = lo[k].min(a[k]).min(b[k]);
+            hi[k] = hi[k].max(a[k]).max(b[k]);
+        }
+        total_len += ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    }
+    let cell = (2.0 * total_len / edges.len() as f64).max(1e-300);
+    let nx = (((hi[0] - lo[0]) / cell).floor() as i64 + 1).clamp(1, 1 << 20);
+    let ny = (((hi[1] - lo[1]) / cell).floor() as i64 + 1).clamp(1, 1 << 20);
+    let cell_of = |x: f64, y: f64| -> (i64, i64) {
+        (
+            (((x - lo[0]) / cell).floor() as i64).clamp(0, nx - 1),
+            (((y - lo[1]) / cell).floor() as i64).clamp(0, ny - 1),
+        )
+    };
+    let mut keyed: Vec<(i64, u32)> = Vec::new();
+    for (k, e) in edges.iter().enumerate() {
+        let (a, b) = (uv[e[0] as usize], uv[e[1] as usize]);
+        let (x0, y0) = cell_of(a[0].min(b[0]), a[1].min(b[1]));
+        let (x1, y1) = cell_of(a[0].max(b[0]), a[1].max(b[1]));
+        if (x1 - x0 + 1) * (y1 - y0 + 1) > 4096 {
+            // A very long edge: test it against everything once, below.
+            keyed.push((-1, k as u32));
+            continue;
+        }
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                keyed.push((y * nx + x, k as u32));
+            }
+        }
+    }
+    keyed.sort_unstable();
+    let crosses = |i: u32, j: u32| -> bool {
+        let (e, f) = (edges[i as usize], edges[j as usize]);
+        if e[0] == f[0] || e[0] == f[1] || e[1] == f[0] || e[1] == f[1] {
+            return false;
+        }
+        segments_intersect(
+            uv[e[0] as usize],
+            uv[e[1] as usize],
+            uv[f[0] as usize],
+            uv[f[1] as usize],
+        )
+    };
+    let long: Vec<u32> = keyed.iter().take_while(|k| k.0 == -1).map(|k| k.1).collect();
+    for &i in &long {
+        for j in 0..edges.len() as u32 {
+            if j != i && crosses(i, j) {
+                return true;
+            }
+        }
+    }
+    let mut s = long.len();
+    while s < keyed.len() {
+        let mut e = s;
+        while e < keyed.len() && keyed[e].0 == keyed[s].0 {
+            e += 1;
+        }
+        for a in s..e {
+            for b in a + 1..e {
+                if crosses(keyed[a].1, keyed[b].1) {
+                    return true;
+                }
+            }
+        }
+        s = e;
+    }
+    false
+}
+
+/// Closed segment intersection with exact orientation signs on `f64` inputs.
+fn segments_intersect(p1: [f64; 2], p2: [f64; 2], q1: [f64; 2], q2: [f64; 2]) -> bool {
+    let orient = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| -> f64 {
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    };
+    let on_seg = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| -> bool {
+        c[0] >= a[0].min(b[0])
+            && c[0] <= a[0].max(b[0])
+            && c[1] >= a[1].min(b[1])
+            && c[1] <= a[1].max(b[1])
+    };
+    let d1 = orient(q1, q2, p1);
+    let d2 = orient(q1, q2, p2);
+    let d3 = orient(p1, p2, q1);
+    let d4 = orient(p1, p2, q2);
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    (d1 == 0.0 && on_seg(q1, q2, p1))
+        || (d2 == 0.0 && on_seg(q1, q2, p2))
+        || (d3 == 0.0 && on_seg(p1, p2, q1))
+        || (d4 == 0.0 && on_seg(p1, p2, q2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segment_tests() {
+        assert!(segments_intersect([0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [1.0, 0.0]));
+        assert!(!segments_intersect([0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]));
+        assert!(segments_intersect([0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [1.0, 1.0]));
+    }
+
+    #[test]
+    fn flat_grid_is_reproduced_up_to_similarity() {
+        let mesh = fieldtex_mesh::primitives::grid(6, 4, 3.0, 2.0);
+        let graph = FaceGraph::build(&mesh);
+        let chart =
+            ChartMesh::build((0..mesh.n_triangles() as u32).collect(), &graph, &mesh.triangles);
+        let uv = lscm(&chart, &mesh, &graph).unwrap();
+        assert!(flattening_defects(&chart, &uv, &graph).is_clean());
+        // A similarity: all pairwise distance ratios equal.
+        let p = |v: usize| mesh.positions[chart.vertex_global[v] as usize];
+        let d3 = |a: usize, b: usize| vec3::norm(vec3::sub(p(a), p(b)));
+        let d2 = |a: usize, b: usize| {
+            ((uv[a][0] - uv[b][0]).powi(2) + (uv[a][1] - uv[b][1]).powi(2)).sqrt()
+        };
+        let r0 = d2(0, 1) / d3(0, 1);
+        for a in 0..chart.n_vertices {
+            for b in (a + 1)..chart.n_vertices {
+                assert!((d2(a, b) / d3(a, b) - r0).abs() < 1e-8 * r0);
+            }
+        }
+    }
+}
