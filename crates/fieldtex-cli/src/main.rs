@@ -1,1 +1,216 @@
-fn main() {}
+//! `fieldtex`: the command-line front end. Glue only: parse flags into options, call
+//! the library, print a summary, map errors to exit codes (0 ok, 1 internal, 2 bad
+//! input or usage).
+
+mod progress_bar;
+
+use clap::{Args, Parser, Subcommand};
+use fieldtex::Error;
+use progress_bar::TerminalProgress;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser, Debug)]
+#[command(name = "fieldtex", version, about = "Texture 3D shapes so the texture follows the shape")]
+struct Cli {
+    #[command(flatten)]
+    global: GlobalArgs,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Args, Debug, Clone)]
+struct GlobalArgs {
+    /// Random seed; the same inputs, options and seed give byte-identical outputs.
+    #[arg(long, global = true, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: all cores). Output does not depend on it.
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    /// No progress bars or summaries (errors are still printed).
+    #[arg(long, global = true)]
+    quiet: bool,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run the main job on built-in inputs (no files needed).
+    Demo {
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Texture resolution of the atlas.
+        #[arg(long, default_value_t = 1024)]
+        size: usize,
+    },
+    /// Print counts, topology and defects of a mesh.
+    Inspect {
+        mesh: PathBuf,
+        /// Print the full report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Weld, drop degenerate and unreferenced elements, fix orientation, split
+    /// non-manifold vertices; lists every change.
+    Repair {
+        mesh: PathBuf,
+        /// Output mesh (.obj, .ply or .glb); never the input file.
+        #[arg(long)]
+        out: PathBuf,
+        /// Weld vertices closer than this fraction of the bounding-box diagonal
+        /// (0 = only identical positions).
+        #[arg(long, default_value_t = 0.0)]
+        weld_epsilon: f64,
+        /// Print the repair report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Segment into charts, flatten, pack; writes model.glb, preview.png, report.json.
+    Atlas {
+        mesh: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// Atlas resolution in texels (square).
+        #[arg(long, default_value_t = 1024)]
+        size: usize,
+        /// Gutter between charts in texels.
+        #[arg(long, default_value_t = 4)]
+        gutter: usize,
+    },
+    /// Render a shaded preview of a mesh (textured when it has a texture).
+    Render {
+        model: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// Image size in pixels (square).
+        #[arg(long, default_value_t = 800)]
+        size: usize,
+        /// View direction as "azimuth,elevation" in degrees.
+        #[arg(long, value_parser = parse_view)]
+        view: Option<(f64, f64)>,
+    },
+    /// Quality metrics of a synthesised image against its exemplar (DESIGN.md §6).
+    Eval {
+        /// The synthesised image.
+        image: PathBuf,
+        /// The exemplar it was made from.
+        #[arg(long)]
+        exemplar: PathBuf,
+        /// Guidance field as .npy (H×W×2 float32 unit (dx, dy), x right, y down).
+        #[arg(long, conflicts_with = "angle")]
+        field: Option<PathBuf>,
+        /// Constant guidance direction in degrees (counter-clockwise from +x on screen).
+        #[arg(long)]
+        angle: Option<f64>,
+        /// Write the metrics JSON here as well as printing it.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+fn parse_view(s: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 2 {
+        return Err(format!("expected \"azimuth,elevation\" in degrees, got {s:?}"));
+    }
+    let a = parts[0].trim().parse::<f64>().map_err(|e| format!("azimuth {:?}: {e}", parts[0]))?;
+    let e = parts[1].trim().parse::<f64>().map_err(|e| format!("elevation {:?}: {e}", parts[1]))?;
+    if !a.is_finite() || !e.is_finite() || e.abs() > 90.0 {
+        return Err("azimuth must be finite and elevation within [-90, 90]".into());
+    }
+    Ok((a, e))
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    if let Some(n) = cli.global.threads {
+        if n == 0 {
+            eprintln!("error: --threads must be at least 1");
+            return ExitCode::from(2);
+        }
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+            eprintln!("error: could not start {n} worker threads: {e}");
+            return ExitCode::from(1);
+        }
+    }
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<(), Error> {
+    let g = cli.global;
+    let progress = TerminalProgress::new(g.quiet);
+    let say = |s: &str| {
+        if !g.quiet {
+            eprintln!("{s}");
+        }
+    };
+    match cli.command {
+        Command::Demo { out, size } => {
+            let opts = fieldtex::DemoOptions { seed: g.seed, size, ..Default::default() };
+            let report = fieldtex::demo(&out, &opts, &progress)?;
+            print_warnings(&report.warnings, g.quiet);
+            say(&format!("wrote {}/model.glb, preview.png, report.json", out.display()));
+        }
+        Command::Inspect { mesh, json } => {
+            let (report, warnings) = fieldtex::inspect_file(&mesh)?;
+            print_warnings(&warnings, g.quiet);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report).unwrap_or_default());
+            } else {
+                for line in report.summary_lines() {
+                    println!("{line}");
+                }
+            }
+        }
+        Command::Repair { mesh, out, weld_epsilon, json } => {
+            let opts = fieldtex::RepairCommandOptions { weld_epsilon };
+            let summary = fieldtex::repair_file(&mesh, &out, &opts)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+            } else {
+                for line in summary.lines() {
+                    println!("{line}");
+                }
+            }
+        }
+        Command::Atlas { mesh, out, size, gutter } => {
+            let opts = fieldtex::AtlasCommandOptions { size, gutter, seed: g.seed };
+            let report = fieldtex::atlas_file(&mesh, &out, &opts, &progress)?;
+            print_warnings(&report.warnings, g.quiet);
+            say(&format!("wrote {}/model.glb, preview.png, report.json", out.display()));
+            if !g.quiet {
+                println!("{}", serde_json::to_string_pretty(&report.metrics).unwrap_or_default());
+            }
+        }
+        Command::Render { model, out, size, view } => {
+            let opts = fieldtex::RenderCommandOptions { size, view };
+            fieldtex::render_file(&model, &out, &opts)?;
+            say(&format!("wrote {}", out.display()));
+        }
+        /*EVAL*/
+        Command::Eval { .. } => return Err(Error::Internal("eval is being wired".into())),
+    }
+    Ok(())
+}
+
+fn print_warnings(w: &[fieldtex::Warning], quiet: bool) {
+    if quiet {
+        return;
+    }
+    for x in w {
+        eprintln!("warning: {x}");
+    }
+}

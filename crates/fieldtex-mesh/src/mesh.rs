@@ -139,23 +139,23 @@ impl TriMesh {
                 }
             }
         }
-        if let Some(c) = &self.vertex_colors {
-            if c.len() != nv {
-                return Err(MeshError::AttributeLength {
-                    attribute: "vertex colours",
-                    expected: nv,
-                    found: c.len(),
-                });
-            }
+        if let Some(c) = &self.vertex_colors
+            && c.len() != nv
+        {
+            return Err(MeshError::AttributeLength {
+                attribute: "vertex colours",
+                expected: nv,
+                found: c.len(),
+            });
         }
-        if let Some(n) = &self.vertex_normals {
-            if n.len() != nv {
-                return Err(MeshError::AttributeLength {
-                    attribute: "vertex normals",
-                    expected: nv,
-                    found: n.len(),
-                });
-            }
+        if let Some(n) = &self.vertex_normals
+            && n.len() != nv
+        {
+            return Err(MeshError::AttributeLength {
+                attribute: "vertex normals",
+                expected: nv,
+                found: n.len(),
+            });
         }
         if self.triangles.is_empty() {
             return Err(MeshError::Empty);

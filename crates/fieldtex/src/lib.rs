@@ -1,1 +1,42 @@
-//! placeholder
+//! fieldtex: texture 3D shapes so the texture follows the shape.
+//!
+//! This facade owns one function per pipeline; each reads its inputs through
+//! `fieldtex-io`, runs the algorithm crates, writes outputs atomically and returns a
+//! [`Report`]. The CLI (`fieldtex-cli`) is a thin layer over these functions.
+//!
+//! | function | command |
+//! |---|---|
+//! | [`demo`] | `fieldtex demo` — built-in inputs, no files needed |
+//! | [`inspect_file`] | `fieldtex inspect` |
+//! | [`repair_file`] | `fieldtex repair` |
+//! | [`atlas_file`] | `fieldtex atlas` |
+//! | [`render_file`] | `fieldtex render` |
+//! | [`eval_files`] | `fieldtex eval` |
+
+mod error;
+mod outputs;
+mod pipelines;
+mod report;
+
+pub use error::{Error, Result};
+pub use fieldtex_core::{Image, NoProgress, Progress, Warning};
+pub use outputs::write_text;
+pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
+pub use pipelines::demo::{DemoOptions, demo};
+// EVAL pub use pipelines::eval::{Guidance, eval_files};
+pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
+pub use pipelines::render::{RenderCommandOptions, render_file};
+pub use report::Report;
+
+/// The algorithm crates, re-exported for library users.
+pub mod crates {
+    pub use fieldtex_core as core;
+    // EVAL pub use fieldtex_eval as eval;
+    pub use fieldtex_fields as fields;
+    pub use fieldtex_io as io;
+    pub use fieldtex_linalg as linalg;
+    pub use fieldtex_mesh as mesh;
+    pub use fieldtex_param as param;
+    pub use fieldtex_render as render;
+    pub use fieldtex_synth as synth;
+}

@@ -1,0 +1,45 @@
+//! One module per pipeline.
+pub mod atlas;
+pub mod demo;
+// EVAL pub mod eval;
+pub mod inspect;
+pub mod render;
+
+use crate::Result;
+use fieldtex_core::Image;
+use fieldtex_mesh::TriMesh;
+use std::path::Path;
+
+/// Writes `model.glb` into `dir`.
+pub(crate) fn write_model(dir: &Path, mesh: &TriMesh, texture: Option<&Image>) -> Result<()> {
+    fieldtex_io::write_glb(
+        &dir.join("model.glb"),
+        mesh,
+        texture,
+        &fieldtex_io::GlbOptions::default(),
+    )?;
+    Ok(())
+}
+
+/// Writes a mesh in the format named by the extension of `path`.
+pub(crate) fn write_mesh_by_extension(
+    path: &Path,
+    mesh: &TriMesh,
+    texture: Option<&Image>,
+) -> Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("glb") => {
+            fieldtex_io::write_glb(path, mesh, texture, &fieldtex_io::GlbOptions::default())?
+        }
+        Some("obj") => fieldtex_io::write_obj(path, mesh, texture)?,
+        Some("ply") => fieldtex_io::write_ply(path, mesh, &[], true)?,
+        _ => {
+            return Err(crate::Error::bad_input(
+                Some(path),
+                "unknown output format: use a .glb, .obj or .ply extension",
+            ));
+        }
+    }
+    Ok(())
+}

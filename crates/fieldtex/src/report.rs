@@ -1,0 +1,64 @@
+//! `report.json`: what was done, with which options, how long it took, and the
+//! quality metrics (DESIGN.md §4, §6).
+//!
+//! Everything in a report is deterministic except the `timings_ms` section, so two
+//! runs with the same inputs and seed differ only there.
+
+use fieldtex_core::Warning;
+use serde::Serialize;
+use serde_json::Value;
+use std::time::Instant;
+
+/// The JSON report every command writes.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    pub tool: &'static str,
+    pub version: &'static str,
+    pub git_hash: &'static str,
+    pub command: String,
+    pub seed: u64,
+    pub options: Value,
+    pub input: Value,
+    pub timings_ms: Vec<(String, f64)>,
+    pub metrics: Value,
+    pub warnings: Vec<Warning>,
+    /// Plain statements of what is a substitute or not implemented in this run.
+    pub notes: Vec<String>,
+}
+
+impl Report {
+    pub fn new(command: &str, seed: u64, options: Value) -> Self {
+        Self {
+            tool: "fieldtex",
+            version: env!("CARGO_PKG_VERSION"),
+            git_hash: env!("FIELDTEX_GIT_HASH"),
+            command: command.to_string(),
+            seed,
+            options,
+            input: Value::Null,
+            timings_ms: Vec::new(),
+            metrics: Value::Object(Default::default()),
+            warnings: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    /// Sets `metrics[key] = value`.
+    pub fn metric(&mut self, key: &str, value: impl Serialize) {
+        if let Value::Object(m) = &mut self.metrics {
+            m.insert(key.to_string(), serde_json::to_value(value).unwrap_or(Value::Null));
+        }
+    }
+
+    /// Runs `f`, recording its wall time under `stage`.
+    pub fn time<T>(&mut self, stage: &str, f: impl FnOnce() -> T) -> T {
+        let t0 = Instant::now();
+        let out = f();
+        self.timings_ms.push((stage.to_string(), t0.elapsed().as_secs_f64() * 1e3));
+        out
+    }
+
+    pub fn to_json_pretty(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|_| "{}".to_string())
+    }
+}
