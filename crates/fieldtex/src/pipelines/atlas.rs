@@ -59,6 +59,7 @@ pub(crate) fn atlas_options(size: usize, gutter: usize) -> Result<AtlasOptions> 
 /// Repairs (when needed) and atlases `mesh`, recording timings and warnings.
 pub(crate) fn repaired_atlas(
     mesh: &fieldtex_mesh::TriMesh,
+    source: Option<&Path>,
     options: &AtlasOptions,
     report: &mut Report,
     progress: &dyn Progress,
@@ -73,11 +74,16 @@ pub(crate) fn repaired_atlas(
     }
     report.warnings.extend(repaired.warnings.iter().cloned());
     if repaired.mesh.triangles.is_empty() {
-        return Err(Error::bad_input(None, "the mesh has no usable triangle after repair"));
+        return Err(Error::bad_input(
+            source,
+            "the mesh has no usable triangle after repair (all were degenerate, non-finite or invalid)",
+        ));
     }
-    let atlas = report
-        .time("atlas", || build_atlas(&repaired.mesh, options, progress))
-        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+    let atlas =
+        report.time("atlas", || build_atlas(&repaired.mesh, options, progress)).map_err(|e| {
+            let what = source.map(|p| format!("{}: ", p.display())).unwrap_or_default();
+            Error::Internal(format!("{what}atlas: {e}"))
+        })?;
     report.warnings.extend(atlas.warnings.iter().cloned());
     Ok(atlas)
 }
@@ -101,7 +107,7 @@ pub fn atlas_file(
         "triangles": loaded.mesh.n_triangles(),
     });
     prepare_out_dir(out_dir)?;
-    let atlas = repaired_atlas(&loaded.mesh, &aopts, &mut report, progress)?;
+    let atlas = repaired_atlas(&loaded.mesh, Some(mesh_path), &aopts, &mut report, progress)?;
     let checker = uv_checker(options.size.min(2048), 32);
     report.time("write", || super::write_model(out_dir, &atlas.mesh, Some(&checker)))?;
     let preview =

@@ -91,7 +91,7 @@ pub fn demo(out_dir: &Path, options: &DemoOptions, progress: &dyn Progress) -> R
         "triangles": mesh.n_triangles(),
         "exemplar": "procedural bricks 128x128",
     });
-    let atlas = repaired_atlas(&mesh, &aopts, &mut report, progress)?;
+    let atlas = repaired_atlas(&mesh, None, &aopts, &mut report, progress)?;
     // UV → exemplar: one atlas unit holds `resolution / texels_per_unit` surface units.
     let texture = report.time("bake", || -> Result<Image> {
         let res = atlas.resolution as usize;

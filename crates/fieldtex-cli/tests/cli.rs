@@ -1,0 +1,269 @@
+//! End-to-end tests of the `fieldtex` binary: determinism across thread counts, exit
+//! codes, the bad-input corpus against every command, every shared mesh through
+//! `atlas`, and the Khronos validator on the GLBs the pipelines write.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_fieldtex")
+}
+
+fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fieldtex-cli").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs the binary with a wall-clock limit (a hang fails the test).
+fn run(args: &[&str], limit: Duration) -> Output {
+    let mut child = Command::new(bin())
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn fieldtex");
+    let t0 = Instant::now();
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            return child.wait_with_output().expect("output");
+        }
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            panic!("fieldtex {args:?} did not finish within {limit:?} (hang?)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn code(o: &Output) -> i32 {
+    o.status.code().unwrap_or(-1)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// `report.json` with the (only nondeterministic) timings removed.
+fn report_without_timings(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("report.json")).expect("report.json");
+    let mut v: serde_json::Value = serde_json::from_str(&text).expect("report is JSON");
+    v.as_object_mut().unwrap().remove("timings_ms");
+    v
+}
+
+#[test]
+fn demo_is_byte_identical_for_one_and_two_threads() {
+    let a = tmp("demo-t1");
+    let b = tmp("demo-t2");
+    let limit = Duration::from_secs(120);
+    let oa = run(&["demo", "--out", a.to_str().unwrap(), "--threads", "1", "--quiet"], limit);
+    assert_eq!(code(&oa), 0, "{}", stderr(&oa));
+    let ob = run(&["demo", "--out", b.to_str().unwrap(), "--threads", "2", "--quiet"], limit);
+    assert_eq!(code(&ob), 0, "{}", stderr(&ob));
+    for f in ["model.glb", "preview.png"] {
+        let x = std::fs::read(a.join(f)).unwrap();
+        let y = std::fs::read(b.join(f)).unwrap();
+        assert!(!x.is_empty());
+        assert!(x == y, "{f} differs between --threads 1 and --threads 2");
+    }
+    assert_eq!(report_without_timings(&a), report_without_timings(&b));
+}
+
+#[test]
+fn different_seeds_change_the_demo_texture() {
+    let a = tmp("demo-s1");
+    let b = tmp("demo-s2");
+    let limit = Duration::from_secs(120);
+    assert_eq!(
+        code(&run(&["demo", "--out", a.to_str().unwrap(), "--quiet", "--seed", "1"], limit)),
+        0
+    );
+    assert_eq!(
+        code(&run(&["demo", "--out", b.to_str().unwrap(), "--quiet", "--seed", "2"], limit)),
+        0
+    );
+    let x = std::fs::read(a.join("model.glb")).unwrap();
+    let y = std::fs::read(b.join("model.glb")).unwrap();
+    assert!(x != y, "the seed should reach the procedural exemplar");
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let limit = Duration::from_secs(10);
+    assert_eq!(code(&run(&["no-such-command"], limit)), 2);
+    assert_eq!(code(&run(&["atlas"], limit)), 2);
+    assert_eq!(code(&run(&["render", "x.obj", "--out", "y.png", "--view", "10"], limit)), 2);
+    assert_eq!(code(&run(&["demo", "--out", "/tmp/x", "--threads", "0"], limit)), 2);
+    let o = run(&["--version"], limit);
+    assert_eq!(code(&o), 0);
+}
+
+#[test]
+fn refuses_to_overwrite_the_input() {
+    let d = tmp("overwrite");
+    let src = shared().join("meshes/torus.obj");
+    let copy = d.join("torus.obj");
+    std::fs::copy(&src, &copy).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    let o = run(
+        &["repair", copy.to_str().unwrap(), "--out", copy.to_str().unwrap()],
+        Duration::from_secs(30),
+    );
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("torus.obj"), "message names the file: {}", stderr(&o));
+    assert_eq!(std::fs::read(&copy).unwrap(), before, "input untouched");
+}
+
+/// Malformed inputs: each command exits 0 (repaired, with warnings) or 2 with a
+/// message naming the file; never a panic (101), a crash or a hang.
+#[test]
+fn bad_input_corpus_never_panics_or_hangs() {
+    let d = tmp("bad");
+    let mut files: Vec<PathBuf> = Vec::new();
+    let mut put = |name: &str, bytes: &[u8]| {
+        let p = d.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        files.push(p);
+    };
+    put("empty.obj", b"");
+    put(
+        "garbage.ply",
+        &(0..4096u32).map(|i| (i.wrapping_mul(2654435761) >> 13) as u8).collect::<Vec<_>>(),
+    );
+    put("truncated.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\x00\x00");
+    put("huge_claim.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1000000000000\nproperty list uchar int vertex_indices\nend_header\n");
+    put("nan.obj", b"v 0 0 0\nv 1 0 0\nv nan 1 0\nv 0 inf 1\nf 1 2 3\nf 1 2 4\n");
+    put("negative_index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -7\n");
+    put("huge_index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4000000000\n");
+    put("no_faces.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    put("degenerate_only.obj", b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 1 2\n");
+    put("truncated.stl", b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0");
+    put("binary_garbage.glb", b"glTF\x02\x00\x00\x00\xff\xff\xff\x7fJSON");
+    put("really_a_ply.obj", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    for f in std::fs::read_dir(shared().join("meshes/defects")).unwrap() {
+        files.push(f.unwrap().path());
+    }
+    let limit = Duration::from_secs(60);
+    for f in &files {
+        let fs = f.to_str().unwrap();
+        let name = f.file_name().unwrap().to_str().unwrap();
+        let out = d.join(format!("out-{name}"));
+        let cases: Vec<Vec<String>> = vec![
+            vec!["inspect".into(), fs.into()],
+            vec![
+                "repair".into(),
+                fs.into(),
+                "--out".into(),
+                out.with_extension("obj").to_str().unwrap().into(),
+            ],
+            vec![
+                "atlas".into(),
+                fs.into(),
+                "--out".into(),
+                out.to_str().unwrap().into(),
+                "--size".into(),
+                "256".into(),
+            ],
+            vec![
+                "render".into(),
+                fs.into(),
+                "--out".into(),
+                out.with_extension("png").to_str().unwrap().into(),
+                "--size".into(),
+                "64".into(),
+            ],
+        ];
+        for args in cases {
+            let a: Vec<&str> = args.iter().map(String::as_str).collect();
+            let o = run(&a, limit);
+            let c = code(&o);
+            assert!(c == 0 || c == 2, "{a:?} exited {c} (expected 0 or 2): {}", stderr(&o));
+            if c == 2 {
+                assert!(
+                    stderr(&o).contains(name),
+                    "{a:?}: the error should name the file: {}",
+                    stderr(&o)
+                );
+            }
+        }
+    }
+}
+
+/// Every mesh shipped in shared/data goes through `atlas` with zero flipped triangles.
+#[test]
+fn atlas_works_on_every_shared_mesh() {
+    let mut meshes: Vec<PathBuf> = std::fs::read_dir(shared().join("meshes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .collect();
+    for t in ["avocado/avocado.obj", "spot/spot_triangulated.obj", "blub/blub.obj"] {
+        meshes.push(shared().join("textured").join(t));
+    }
+    meshes.sort();
+    for m in meshes {
+        let name = m.file_stem().unwrap().to_str().unwrap().to_string();
+        let out = tmp(&format!("atlas-{name}"));
+        let o = run(
+            &["atlas", m.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"],
+            Duration::from_secs(120),
+        );
+        assert_eq!(code(&o), 0, "{name}: {}", stderr(&o));
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        let a = &r["metrics"]["atlas"];
+        assert_eq!(a["flipped_triangles"].as_u64(), Some(0), "{name}: flips");
+        let eff = a["packing_efficiency"].as_f64().unwrap();
+        assert!(eff > 0.3 && eff <= 1.0, "{name}: packing efficiency {eff}");
+        let ang = a["angle_distortion_mean"].as_f64().unwrap();
+        assert!((1.0..1.5).contains(&ang), "{name}: angle distortion {ang}");
+        assert!(out.join("model.glb").is_file() && out.join("preview.png").is_file());
+    }
+}
+
+/// The GLBs the pipelines write pass the Khronos validator with 0 errors.
+#[test]
+fn pipeline_glbs_pass_the_khronos_validator() {
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
+    assert!(
+        validator.join("node_modules/gltf-validator").is_dir(),
+        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
+    );
+    let demo = tmp("validate-demo");
+    assert_eq!(
+        code(&run(&["demo", "--out", demo.to_str().unwrap(), "--quiet"], Duration::from_secs(120))),
+        0
+    );
+    let atlas = tmp("validate-atlas");
+    let fert = shared().join("meshes/fertility.obj");
+    assert_eq!(
+        code(&run(
+            &["atlas", fert.to_str().unwrap(), "--out", atlas.to_str().unwrap(), "--quiet"],
+            Duration::from_secs(120)
+        )),
+        0
+    );
+    for glb in [demo.join("model.glb"), atlas.join("model.glb")] {
+        let o = Command::new("node")
+            .arg(validator.join("validate.js"))
+            .arg(&glb)
+            .output()
+            .expect("node runs");
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+        assert_eq!(
+            report["issues"]["numErrors"].as_u64(),
+            Some(0),
+            "{}: {}",
+            glb.display(),
+            String::from_utf8_lossy(&o.stdout)
+        );
+    }
+}
