@@ -27,3 +27,19 @@ pub mod principal_curvature;
 // Inspection and repair.
 pub mod inspect;
 pub mod repair;
+
+// Geometry operator helpers and re-exports.
+mod checks;
+pub use areas::{
+    VertexAreaKind, barycentric_vertex_areas, face_areas, mixed_voronoi_vertex_areas, total_area,
+    vertex_areas,
+};
+pub use cotan_laplacian::{
+    CotanOptions, CotanStats, cotan_edge_weights, cotan_face_weights, cotan_laplacian,
+    cotan_laplacian_and_mass, cotan_laplacian_triplets, cotan_laplacian_with,
+};
+pub use mass_matrix::{lumped_mass, mass_matrix};
+pub use normals::{NormalWeighting, face_normals, vertex_normals};
+pub use principal_curvature::{CurvatureOptions, PrincipalCurvatures, principal_curvatures};
+#[cfg(test)]
+mod test_meshes;
