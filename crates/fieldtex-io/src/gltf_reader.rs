@@ -11,7 +11,9 @@
 //! glTF splits vertices at UV seams, so vertices with bit-identical positions are welded
 //! after loading (texture coordinates stay per corner, so seams are kept); a `gltf-welded`
 //! warning reports it. Not read: sparse accessors, morph targets, skins, Draco/meshopt
-//! compression (refused with a clear error), textures other than base colour.
+//! compression (refused with a clear error), textures other than base colour. Node
+//! instancing is capped at [`MAX_MERGED_ELEMENTS`] vertices and triangles so a small
+//! file cannot expand into an unbounded mesh.
 //!
 //! The JSON is parsed and its indices validated by the `gltf` crate; the GLB container
 //! and every accessor are bounds-checked here, so a hostile file cannot make the reader
@@ -96,6 +98,9 @@ pub fn read_gltf_bytes(
     Ok((mesh, base_color, warnings))
 }
 
+/// Most vertices (and, separately, triangles) a glTF may expand to after instancing.
+pub const MAX_MERGED_ELEMENTS: usize = 1 << 27;
+
 type Mat4 = [[f64; 4]; 4]; // column-major: m[col][row]
 
 const IDENTITY: Mat4 = [[1., 0., 0., 0.], [0., 1., 0., 0.], [0., 0., 1., 0.], [0., 0., 0., 1.]];
@@ -165,10 +170,24 @@ impl Merger<'_> {
                 "a triangle primitive without positions",
             ));
         };
+        // Instancing (many nodes, one mesh) can multiply a small file into a huge mesh.
+        let first = self.positions.len();
+        let budget = |what: &str, total: usize| {
+            if total > MAX_MERGED_ELEMENTS {
+                return Err(IoError::Unsupported {
+                    file: self.name.to_string(),
+                    what: format!(
+                        "more than {MAX_MERGED_ELEMENTS} {what} after applying node instancing"
+                    ),
+                });
+            }
+            Ok(())
+        };
+        budget("vertices", first.saturating_add(pos_acc.count()))?;
+        let n_idx = prim.indices().map_or(pos_acc.count(), |a| a.count());
+        budget("triangles", self.triangles.len().saturating_add(n_idx))?;
         let pos = read_accessor::<3>(&pos_acc, self.buffers, self.name, &what("POSITION"))?;
         let n = pos.len();
-        let first = self.positions.len();
-        crate::mesh_checks::check_vertex_count(self.name, (first + n) as u64)?;
         self.positions.extend(pos.iter().map(|p| {
             let t = |r: usize| xf[0][r] * p[0] + xf[1][r] * p[1] + xf[2][r] * p[2] + xf[3][r];
             [t(0), t(1), t(2)]

@@ -5,6 +5,9 @@
 //!   format is recognised from content first, extension second ([`sniff_mesh_format`]).
 //! - Images: [`read_image`] (PNG/JPEG, 8/16-bit, gray/alpha/RGB/RGBA), [`write_png`],
 //!   [`write_png_gray16`], [`encode_png`].
+//! - Writers: [`write_glb`] (validator-clean GLB), [`write_obj`] (+MTL+PNG),
+//!   [`write_ply`] (extra vertex properties), [`write_obj_polylines`].
+//! - Arrays: [`write_npy_f32`] / [`read_npy_f32`] (`<f4`, C order).
 //! - Atomic output: [`atomic_write`] (temporary file, fsync, rename) and
 //!   [`ensure_not_input`].
 //!
@@ -16,21 +19,29 @@
 
 mod atomic_write;
 mod error;
+mod glb_writer;
 mod gltf_reader;
 mod image_io;
 mod mesh_checks;
 mod mesh_format;
 mod mtl_reader;
+mod npy;
 mod obj_reader;
+mod obj_writer;
 mod ply_reader;
+mod ply_writer;
 mod read_mesh;
 mod stl_reader;
 
 pub use atomic_write::{atomic_write, ensure_not_input};
 pub use error::{IoError, MEMORY_NAME};
+pub use glb_writer::{GlbOptions, encode_glb, write_glb};
 pub use image_io::{
     MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, encode_png, read_image, read_image_bytes, write_png,
     write_png_gray16,
 };
 pub use mesh_format::{MeshFormat, sniff_mesh_format};
+pub use npy::{decode_npy_f32, encode_npy_f32, read_npy_f32, write_npy_f32};
+pub use obj_writer::{write_obj, write_obj_polylines};
+pub use ply_writer::{encode_ply, write_ply};
 pub use read_mesh::{LoadedMesh, read_mesh, read_mesh_bytes};
