@@ -1,1 +1,48 @@
-//! placeholder
+//! Texture quality metrics of fieldtex (`fieldtex eval`, DESIGN.md §6), on images given
+//! as flat `f32` buffers with a shape ([`ImageView`], [`FieldView`]).
+//!
+//! - [`coherence()`] / [`completeness()`]: exact nearest-patch distances output → exemplar
+//!   and back, per pixel and channel;
+//! - [`color_sliced_wasserstein`]: distance between colour distributions;
+//! - [`orientation_error`]: structure-tensor feature direction vs a guidance field;
+//! - [`singularities()`]: ±1/2 singularities of an orientation map;
+//! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px.
+//!
+//! Every metric returns a `serde::Serialize` report for `report.json`.
+//!
+//! Architecture invariant: no file I/O (reading `.npy`/PNG is `fieldtex-io`'s job), no
+//! printing; results are identical for any number of rayon threads.
+
+pub mod coherence;
+pub mod color_sliced_wasserstein;
+pub mod completeness;
+mod error;
+mod filters;
+pub mod image_view;
+pub mod nearest_patch;
+pub mod orientation;
+mod patch_pca;
+pub mod phase_defects;
+pub mod singularities;
+
+pub use coherence::coherence;
+pub use color_sliced_wasserstein::{
+    SlicedWassersteinOptions, SlicedWassersteinReport, color_sliced_wasserstein,
+};
+pub use completeness::completeness;
+pub use error::EvalError;
+pub use image_view::{FieldView, ImageView, rgb_buffer};
+pub use nearest_patch::{PatchDistanceOptions, PatchDistanceReport, coherence_map};
+pub use orientation::{
+    OrientationErrorOptions, OrientationErrorReport, OrientationMap, OrientationOptions,
+    OrientationReference, dominant_orientation, image_orientation, luminance_orientation,
+    orientation_error,
+};
+pub use phase_defects::{
+    PhaseDefect, PhaseDefectOptions, PhaseDefectReport, count_defects_near, estimate_stripe_period,
+    phase_defects,
+};
+pub use singularities::{
+    ExpectedSingularity, Singularity, SingularityCluster, SingularityMatch, SingularityOptions,
+    SingularityReport, match_singularities, singularities,
+};

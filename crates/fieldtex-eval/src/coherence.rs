@@ -1,0 +1,36 @@
+//! Coherence: how well every output neighbourhood is explained by the exemplar.
+//!
+//! The texture-optimisation energy of Kwatra, Essa, Bobick & Kwatra (2005, "Texture
+//! optimization for example-based synthesis", eq. 1) evaluated on a finished output:
+//! for each `N×N` output patch (every position, stride 1, fully inside the output),
+//! the squared distance to its nearest exemplar patch, divided by `N·N·C`, averaged
+//! over patches. 0 means every output neighbourhood appears verbatim in the exemplar.
+//! The search is exact (see [`crate::nearest_patch`]).
+
+use crate::EvalError;
+use crate::image_view::ImageView;
+use crate::nearest_patch::{
+    PatchDistanceOptions, PatchDistanceReport, PatchGrid, nearest_patch_ssd, summarize,
+};
+
+/// Coherence of `output` with respect to `exemplar` (same channel count; values
+/// usually sRGB in `[0, 1]`). Errors when either image is smaller than the patch.
+pub fn coherence(
+    output: &ImageView,
+    exemplar: &ImageView,
+    options: &PatchDistanceOptions,
+) -> Result<PatchDistanceReport, EvalError> {
+    options.validate()?;
+    if output.channels != exemplar.channels {
+        return Err(EvalError::ChannelMismatch {
+            what: "coherence",
+            a: output.channels,
+            b: exemplar.channels,
+        });
+    }
+    let n = options.patch_size;
+    let query = PatchGrid::new(output, n, false, "coherence output")?;
+    let db = PatchGrid::new(exemplar, n, options.wrap_exemplar, "coherence exemplar")?;
+    let (d, evals) = nearest_patch_ssd(&query, &db, options.pruning_dims);
+    Ok(summarize(&d, query.dim(), db.count(), n, evals))
+}
