@@ -184,13 +184,14 @@ impl SymbolicCholesky {
 }
 
 /// Numeric Cholesky factorisation of a symmetric positive definite matrix; keeps a copy
-/// of the matrix for residual checks. After a rank-1 update the factor lives in an own
-/// simplicial copy (see [`Cholesky::update`]).
+/// of the matrix for residual checks. Rank-1 updates modify the factor in place (see
+/// [`Cholesky::update`]).
 pub struct Cholesky {
     symbolic: SymbolicCholesky,
-    /// faer's factor values (supernodal or simplicial layout), valid while `dynamic` is None.
+    /// faer's factor values (supernodal or simplicial layout); moved into `dynamic` by
+    /// the first rank-1 update.
     values: Vec<f64>,
-    /// Own simplicial factor, created by the first rank-1 update.
+    /// Updatable factor (faer's values taken over), created by the first rank-1 update.
     pub(crate) dynamic: Option<DynamicFactor>,
     /// The factored matrix, kept current under rank-1 updates whose pattern it holds.
     pub(crate) matrix: SparseMatrix,
@@ -427,25 +428,24 @@ impl Cholesky {
         if n == 0 {
             return;
         }
-        if let Some(dynamic) = &self.dynamic {
-            dynamic.solve_in_place(x);
-            return;
-        }
+        let values = match &self.dynamic {
+            Some(d) if !d.faer_layout => {
+                d.solve_in_place(x);
+                return;
+            }
+            Some(d) => &d.values()[..self.symbolic.inner.faer.len_val()],
+            None => &self.values[..],
+        };
         let fsym = &self.symbolic.inner.faer;
-        let llt = fc::LltRef::new(fsym, &self.values);
+        let llt = fc::LltRef::new(fsym, values);
         let mut mem = MemBuffer::new(fsym.solve_in_place_scratch::<f64>(1, Par::Seq));
         let rhs = MatMut::from_column_major_slice_mut(x, n, 1);
         llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut mem));
     }
 
-    /// faer's symbolic structure and values, for building the simplicial copy.
-    pub(crate) fn faer_parts(&self) -> (&fc::SymbolicCholesky<usize>, &[f64]) {
-        (&self.symbolic.inner.faer, &self.values)
-    }
-
-    /// Frees faer's values once the simplicial copy has taken over.
-    pub(crate) fn release_faer_values(&mut self) {
-        self.values = Vec::new();
+    /// faer's symbolic structure and (moved-out) values, for the updatable factor.
+    pub(crate) fn take_faer_values(&mut self) -> (&fc::SymbolicCholesky<usize>, Vec<f64>) {
+        (&self.symbolic.inner.faer, std::mem::take(&mut self.values))
     }
 }
 
