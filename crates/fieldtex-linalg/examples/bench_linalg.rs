@@ -117,6 +117,13 @@ fn main() {
                 .collect()
         })
         .collect();
+    let mut t_one = Vec::new();
+    for _ in 0..runs {
+        let (x, ms) = time_ms(|| chol.solve(&rhs[0]).expect("solve"));
+        std::hint::black_box(x);
+        t_one.push(ms);
+    }
+    report("solve_1rhs", t_one);
     let mut t_solve = Vec::new();
     for _ in 0..runs {
         let (x, ms) = time_ms(|| chol.solve_many(&rhs).expect("solve"));

@@ -389,29 +389,33 @@ impl SparseMatrix {
     /// as `(i, j, a_ij, a_ji)`; `None` for a symmetric matrix. Panics if not square.
     pub fn first_asymmetry(&self, rel_tol: f64) -> Option<(usize, usize, f64, f64)> {
         assert_eq!(self.nrows, self.ncols, "first_asymmetry needs a square matrix");
-        for j in 0..self.ncols {
-            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+        // column-parallel; `find_map_first` keeps the answer independent of threads
+        let lower = (0..self.ncols).into_par_iter().find_map_first(|j| {
+            (self.col_ptr[j]..self.col_ptr[j + 1]).find_map(|k| {
                 let i = self.row_idx[k];
                 if i <= j {
-                    continue;
+                    return None;
                 }
                 let a = self.values[k];
                 let m = self.get(j, i);
-                if (a - m).abs() > rel_tol * a.abs().max(m.abs()) {
-                    return Some((i, j, a, m));
-                }
-            }
+                ((a - m).abs() > rel_tol * a.abs().max(m.abs())).then_some((i, j, a, m))
+            })
+        });
+        if lower.is_some() {
+            return lower;
         }
         // entries stored only in the upper triangle
-        for j in 0..self.ncols {
-            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+        (0..self.ncols).into_par_iter().find_map_first(|j| {
+            (self.col_ptr[j]..self.col_ptr[j + 1]).find_map(|k| {
                 let i = self.row_idx[k];
-                if i < j && self.find(j, i).is_none() && self.values[k] != 0.0 {
-                    return Some((i, j, self.values[k], 0.0));
-                }
-            }
-        }
-        None
+                (i < j && self.values[k] != 0.0 && self.find(j, i).is_none()).then_some((
+                    i,
+                    j,
+                    self.values[k],
+                    0.0,
+                ))
+            })
+        })
     }
 
     /// Index of the first non-finite stored value.

@@ -158,3 +158,13 @@ fn factor_and_solve_are_thread_count_independent() {
     };
     assert_eq!(run(1), run(2));
 }
+
+#[test]
+fn public_types_are_send_and_sync() {
+    fn check<T: Send + Sync>() {}
+    check::<Cholesky>();
+    check::<SymbolicCholesky>();
+    check::<SparseMatrix>();
+    check::<fieldtex_linalg::Pca>();
+    check::<LinalgError>();
+}
