@@ -150,13 +150,21 @@ fn tight_tolerance_reports_solve_failed() {
 fn factor_and_solve_are_thread_count_independent() {
     let a = penalty_system(120, 100, &every(12000, 50), 1e8);
     let b = Lcg(9).vec(12000);
-    let run = |t| {
-        rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap().install(|| {
-            let c = Cholesky::factor(&a).unwrap();
-            c.solve_many(&[b.clone(), b.clone()]).unwrap()
-        })
-    };
-    assert_eq!(run(1), run(2));
+    for layout in
+        [fieldtex_linalg::FactorLayout::Simplicial, fieldtex_linalg::FactorLayout::Supernodal]
+    {
+        let run = |t| {
+            rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap().install(|| {
+                let s = SymbolicCholesky::analyze_with(&a, layout).unwrap();
+                let mut c = Cholesky::factor_with(&s, &a).unwrap();
+                let x = c.solve_many(&[b.clone(), b.clone()]).unwrap();
+                c.add_diagonal_penalty(77, 1e8).unwrap();
+                (x, c.solve(&b).unwrap())
+            })
+        };
+        assert_eq!(run(1), run(2));
+        assert_eq!(run(1), run(3));
+    }
 }
 
 #[test]
