@@ -123,7 +123,9 @@ fn mesh_instances(doc: &gltf::Document) -> Vec<(gltf::Mesh<'_>, Mat4)> {
     };
     let mut out = Vec::new();
     let mut visited = vec![false; doc.nodes().count()];
+    // Depth-first, children in document order (pushed reversed onto the stack).
     let mut stack: Vec<(gltf::Node<'_>, Mat4)> = scene.nodes().map(|n| (n, IDENTITY)).collect();
+    stack.reverse();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut visited[node.index()], true) {
             continue; // a cycle or a shared child: invalid glTF, read once
@@ -133,7 +135,9 @@ fn mesh_instances(doc: &gltf::Document) -> Vec<(gltf::Mesh<'_>, Mat4)> {
         if let Some(mesh) = node.mesh() {
             out.push((mesh, world));
         }
+        let first_child = stack.len();
         stack.extend(node.children().map(|c| (c, world)));
+        stack[first_child..].reverse();
     }
     out
 }
@@ -183,11 +187,9 @@ impl Merger<'_> {
             }
             Ok(())
         };
-        budget("vertices", first.saturating_add(pos_acc.count()))?;
-        let n_idx = prim.indices().map_or(pos_acc.count(), |a| a.count());
-        budget("triangles", self.triangles.len().saturating_add(n_idx))?;
         let pos = read_accessor::<3>(&pos_acc, self.buffers, self.name, &what("POSITION"))?;
         let n = pos.len();
+        budget("vertices", first.saturating_add(n))?;
         self.positions.extend(pos.iter().map(|p| {
             let t = |r: usize| xf[0][r] * p[0] + xf[1][r] * p[1] + xf[2][r] * p[2] + xf[3][r];
             [t(0), t(1), t(2)]
@@ -199,6 +201,7 @@ impl Merger<'_> {
                 .collect(),
             None => (0..n as u32).collect(),
         };
+        budget("triangles", self.triangles.len().saturating_add(idx.len()))?;
         let tri_count = self.triangles.len();
         let mut push = |t: [u32; 3]| -> Result<(), IoError> {
             if let Some(&bad) = t.iter().find(|&&i| i as usize >= n) {
