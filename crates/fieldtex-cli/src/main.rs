@@ -200,8 +200,19 @@ fn run(cli: Cli) -> Result<(), Error> {
             fieldtex::render_file(&model, &out, &opts)?;
             say(&format!("wrote {}", out.display()));
         }
-        /*EVAL*/
-        Command::Eval { .. } => return Err(Error::Internal("eval is being wired".into())),
+        Command::Eval { image, exemplar, field, angle, out } => {
+            let guide = match (field, angle) {
+                (Some(f), _) => Some(fieldtex::Guidance::FieldFile(f)),
+                (None, Some(a)) => Some(fieldtex::Guidance::Angle(a)),
+                (None, None) => None,
+            };
+            let metrics = fieldtex::eval_files(&image, &exemplar, guide.as_ref(), g.seed)?;
+            let text = serde_json::to_string_pretty(&metrics).unwrap_or_default();
+            if let Some(o) = out {
+                fieldtex::write_text(&o, &text)?;
+            }
+            println!("{text}");
+        }
     }
     Ok(())
 }

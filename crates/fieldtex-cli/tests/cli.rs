@@ -267,3 +267,39 @@ fn pipeline_glbs_pass_the_khronos_validator() {
         );
     }
 }
+
+/// `eval` of an exemplar against itself: zero coherence and colour distance, the
+/// stripes' orientation matches 0°, and a field of the wrong shape is refused (exit 2).
+#[test]
+fn eval_known_answers_and_bad_field() {
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let e = ex.to_str().unwrap();
+    let o = run(&["eval", e, "--exemplar", e, "--angle", "0"], Duration::from_secs(60));
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
+    assert_eq!(v["coherence"]["mean"].as_f64(), Some(0.0));
+    assert_eq!(v["color_sliced_wasserstein"]["distance"].as_f64(), Some(0.0));
+    assert!(v["orientation_error"]["mean_error_deg"].as_f64().unwrap() < 2.0);
+    let o = run(&["eval", e, "--exemplar", e, "--angle", "90"], Duration::from_secs(60));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["orientation_error"]["mean_error_deg"].as_f64().unwrap() > 80.0);
+    // A 2×2×2 field does not fit a 116×116 image.
+    let d = tmp("eval-bad-field");
+    let npy = d.join("f.npy");
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    let mut header = "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 2, 2), }".to_string();
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    bytes.extend(std::iter::repeat_n(0u8, 32));
+    std::fs::write(&npy, bytes).unwrap();
+    let o = run(
+        &["eval", e, "--exemplar", e, "--field", npy.to_str().unwrap()],
+        Duration::from_secs(60),
+    );
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("f.npy"), "{}", stderr(&o));
+}

@@ -23,7 +23,7 @@ pub use fieldtex_core::{Image, NoProgress, Progress, Warning};
 pub use outputs::write_text;
 pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
 pub use pipelines::demo::{DemoOptions, demo};
-// EVAL pub use pipelines::eval::{Guidance, eval_files};
+pub use pipelines::eval::{Guidance, ImageMetrics, eval_files};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
 pub use pipelines::render::{RenderCommandOptions, render_file};
 pub use report::Report;
@@ -31,7 +31,7 @@ pub use report::Report;
 /// The algorithm crates, re-exported for library users.
 pub mod crates {
     pub use fieldtex_core as core;
-    // EVAL pub use fieldtex_eval as eval;
+    pub use fieldtex_eval as eval;
     pub use fieldtex_fields as fields;
     pub use fieldtex_io as io;
     pub use fieldtex_linalg as linalg;

@@ -1,7 +1,7 @@
 //! One module per pipeline.
 pub mod atlas;
 pub mod demo;
-// EVAL pub mod eval;
+pub mod eval;
 pub mod inspect;
 pub mod render;
 
