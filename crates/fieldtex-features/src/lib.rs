@@ -1,0 +1,1 @@
+//! Salient curves on meshes (being written).
