@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
-fn load_obj(path: &Path) -> Result<TriMesh, String> {
+pub fn load_obj(path: &Path) -> Result<TriMesh, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut positions = Vec::new();
     let mut triangles = Vec::new();

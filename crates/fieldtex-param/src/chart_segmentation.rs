@@ -7,16 +7,21 @@
 //! charts of Sander, Snyder, Gortler & Hoppe 2001, "Texture mapping progressive
 //! meshes"):
 //! 1. **Growing.** Every chart has a proxy: a seed triangle, a unit normal `N` and a
-//!    centre `c`. All charts grow at once from their seeds, best triangle first, with
-//!    the cost `(1 − n·N) + w‖x − c‖² / R²` (`n`, `x`: the triangle's normal and
-//!    centroid, `R²` = total area / (π · #charts), `w` =
-//!    [`SegmentationOptions::compactness_weight`]). A triangle may join a chart only
-//!    if its normal lies within [`SegmentationOptions::max_normal_angle_deg`] of `N`.
+//!    centre `c`. Charts grow from their seeds, best triangle first, with the cost
+//!    `(1 − n·N) + w‖x − c‖² / R² + w_b·β` (`n`, `x`: the triangle's normal and
+//!    centroid; `R²` = total area / (π · #charts); `w` =
+//!    [`SegmentationOptions::compactness_weight`]; `β` ∈ `[0, 2]` grows with the part
+//!    of the triangle's perimeter not yet shared with the chart, so notches fill first
+//!    and boundaries stay short, `w_b` = [`SegmentationOptions::boundary_weight`]). A
+//!    triangle may join a chart only if its normal lies within
+//!    [`SegmentationOptions::max_normal_angle_deg`] of `N`.
 //! 2. **Seeding.** Regions left uncovered get a new chart (seeded at their most
 //!    representative triangle) when they are large enough or form a whole component;
-//!    small leftovers are later absorbed by their neighbours without the cone limit.
+//!    new charts grow into uncovered triangles only, round after round. Small
+//!    leftovers are finally absorbed by their neighbours without the cone limit.
 //! 3. **Lloyd relaxation.** Proxies move to the area-weighted mean normal and centroid
-//!    of their chart and the seed to the chart's cheapest triangle; grow again.
+//!    of their chart and the seed to the chart's cheapest triangle; all charts grow
+//!    again at once (then step 2 covers what is left).
 //! 4. **Boundary smoothing.** A triangle with two neighbours in another chart (and at
 //!    most one in its own) moves there when that chart's cone allows it (this never
 //!    disconnects a chart).
@@ -54,6 +59,9 @@ pub struct SegmentationOptions {
     pub small_chart_fraction: f64,
     /// Boundary smoothing passes. Default 2.
     pub smoothing_passes: usize,
+    /// Weight of the boundary-length term of the growing cost (0 when every neighbour
+    /// of a triangle is in the chart, 2 when none is). Default 0.3.
+    pub boundary_weight: f64,
 }
 
 impl Default for SegmentationOptions {
@@ -64,6 +72,7 @@ impl Default for SegmentationOptions {
             lloyd_iterations: 4,
             small_chart_fraction: 0.35,
             smoothing_passes: 2,
+            boundary_weight: 0.3,
         }
     }
 }
@@ -100,28 +109,18 @@ pub fn segment_charts(
     let w = options.compactness_weight.max(0.0);
     let total_area: f64 = graph.areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
 
+    let ctx = GrowCtx { graph, cos_max, w, wb: options.boundary_weight.max(0.0), total_area };
     let mut proxies: Vec<Proxy> = Vec::new();
-    let mut assign;
-    let mut lloyd_done = 0usize;
-    let mut iter = 0usize;
-    const MAX_ITER: usize = 80;
-    loop {
-        let r2 = total_area / (std::f64::consts::PI * proxies.len().max(1) as f64);
-        assign = grow(graph, &proxies, cos_max, w, r2);
-        iter += 1;
-        let mean_area = total_area / proxies.len().max(1) as f64;
-        let new = seeds_for_uncovered(graph, &assign, w, r2, 0.1 * mean_area);
-        if !new.is_empty() && iter < MAX_ITER {
-            proxies.extend(new);
-            continue;
-        }
-        if lloyd_done >= options.lloyd_iterations || iter >= MAX_ITER {
-            break;
-        }
-        proxies = lloyd_update(graph, &assign, &proxies, w, r2);
-        lloyd_done += 1;
+    let mut assign = vec![NONE; nf];
+    let mut budget = MAX_SEEDING_ROUNDS;
+    seed_uncovered(&ctx, &mut assign, &mut proxies, &mut budget);
+    for _ in 0..options.lloyd_iterations {
+        proxies = lloyd_update(&ctx, &assign, &proxies);
+        assign.fill(NONE);
+        grow(&ctx, &proxies, 0..proxies.len(), &mut assign);
+        seed_uncovered(&ctx, &mut assign, &mut proxies, &mut budget);
     }
-    absorb_uncovered(graph, &mut assign, &proxies, w);
+    absorb_uncovered(&ctx, &mut assign, &proxies);
     // Seeds for anything still uncovered (cannot happen unless growth was capped).
     let mut next = proxies.len() as u32;
     for a in assign.iter_mut() {
@@ -139,13 +138,52 @@ pub fn segment_charts(
     finish(nf, charts)
 }
 
-/// Best-first growth of all proxies at once under the normal-cone limit.
-fn grow(graph: &FaceGraph, proxies: &[Proxy], cos_max: f64, w: f64, r2: f64) -> Vec<u32> {
-    let nf = graph.n_faces();
-    let mut assign = vec![NONE; nf];
+/// Upper bound on seeding rounds (each adds at least one chart).
+const MAX_SEEDING_ROUNDS: usize = 200;
+
+/// What chart growing needs besides the proxies.
+struct GrowCtx<'a> {
+    graph: &'a FaceGraph,
+    cos_max: f64,
+    w: f64,
+    wb: f64,
+    total_area: f64,
+}
+
+impl GrowCtx<'_> {
+    /// `R²` of the compactness term for `n` charts.
+    fn r2(&self, n: usize) -> f64 {
+        self.total_area / (std::f64::consts::PI * n.max(1) as f64)
+    }
+}
+
+/// Adds charts for uncovered regions and grows them into uncovered triangles only,
+/// until no region qualifies (see [`seeds_for_uncovered`]) or the budget is spent.
+fn seed_uncovered(ctx: &GrowCtx, assign: &mut [u32], proxies: &mut Vec<Proxy>, budget: &mut usize) {
+    while *budget > 0 {
+        let r2 = ctx.r2(proxies.len());
+        let mean_area = ctx.total_area / proxies.len().max(1) as f64;
+        let new = seeds_for_uncovered(ctx.graph, assign, ctx.w, r2, 0.1 * mean_area);
+        if new.is_empty() {
+            break;
+        }
+        *budget -= 1;
+        let start = proxies.len();
+        proxies.extend(new);
+        grow(ctx, proxies, start..proxies.len(), assign);
+    }
+}
+
+/// Best-first growth of the proxies in `active` through uncovered triangles under the
+/// normal-cone limit; triangles already assigned stay where they are.
+fn grow(ctx: &GrowCtx, proxies: &[Proxy], active: std::ops::Range<usize>, assign: &mut [u32]) {
+    let graph = ctx.graph;
+    let r2 = ctx.r2(proxies.len());
     let mut heap = BinaryHeap::new();
-    for (c, p) in proxies.iter().enumerate() {
-        heap.push(Reverse((0u64, p.seed, c as u32)));
+    for c in active {
+        if assign[proxies[c].seed as usize] == NONE {
+            heap.push(Reverse((0u64, proxies[c].seed, c as u32)));
+        }
     }
     while let Some(Reverse((_, f, c))) = heap.pop() {
         if assign[f as usize] != NONE {
@@ -158,14 +196,33 @@ fn grow(graph: &FaceGraph, proxies: &[Proxy], cos_max: f64, w: f64, r2: f64) -> 
                 continue;
             }
             let d = vec3::dot(graph.normals[g as usize], p.normal);
-            if !graph.degenerate[g as usize] && d < cos_max {
+            if !graph.degenerate[g as usize] && d < ctx.cos_max {
                 continue;
             }
-            let cost = face_cost(graph, g as usize, p, w, r2);
+            let cost = face_cost(graph, g as usize, p, ctx.w, r2)
+                + ctx.wb * boundary_term(graph, assign, g as usize, c);
             heap.push(Reverse((cost.to_bits(), g, c)));
         }
     }
-    assign
+}
+
+/// Change of the chart's boundary length if `f` joined chart `c`, relative to `f`'s
+/// perimeter, shifted to `[0, 2]`: 0 when all three neighbours are in `c`.
+#[inline]
+fn boundary_term(graph: &FaceGraph, assign: &[u32], f: usize, c: u32) -> f64 {
+    let l = graph.edge_len[f];
+    let total = l[0] + l[1] + l[2];
+    if total.is_nan() || total <= 0.0 {
+        return 1.0;
+    }
+    let mut inside = 0.0;
+    for (&g, &len) in graph.adj[f].iter().zip(&l) {
+        if g != NONE && assign[g as usize] == c {
+            inside += len;
+        }
+    }
+    // (outside - inside) / total + 1 = 2 (total - inside) / total.
+    2.0 * (total - inside) / total
 }
 
 #[inline]
@@ -276,13 +333,8 @@ fn proxy_for(graph: &FaceGraph, faces: &[u32], w: f64, r2: f64, fallback: Option
     p
 }
 
-fn lloyd_update(
-    graph: &FaceGraph,
-    assign: &[u32],
-    proxies: &[Proxy],
-    w: f64,
-    r2: f64,
-) -> Vec<Proxy> {
+fn lloyd_update(ctx: &GrowCtx, assign: &[u32], proxies: &[Proxy]) -> Vec<Proxy> {
+    let (graph, w, r2) = (ctx.graph, ctx.w, ctx.r2(proxies.len()));
     let mut members: Vec<Vec<u32>> = vec![Vec::new(); proxies.len()];
     for (f, &c) in assign.iter().enumerate() {
         if c != NONE {
@@ -298,9 +350,8 @@ fn lloyd_update(
 }
 
 /// Assigns uncovered faces to neighbouring charts, best first, without the cone limit.
-fn absorb_uncovered(graph: &FaceGraph, assign: &mut [u32], proxies: &[Proxy], w: f64) {
-    let total_area: f64 = graph.areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
-    let r2 = total_area / (std::f64::consts::PI * proxies.len().max(1) as f64);
+fn absorb_uncovered(ctx: &GrowCtx, assign: &mut [u32], proxies: &[Proxy]) {
+    let (graph, w, r2) = (ctx.graph, ctx.w, ctx.r2(proxies.len()));
     let mut heap = BinaryHeap::new();
     for f in 0..graph.n_faces() {
         if assign[f] == NONE {

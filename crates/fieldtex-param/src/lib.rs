@@ -13,6 +13,7 @@
 
 pub mod atlas;
 pub mod bake;
+mod chart_footprint;
 pub mod chart_segmentation;
 pub mod chart_topology;
 pub mod distortion;

@@ -22,7 +22,7 @@
 //! Charts are only rotated, never mirrored (mirroring would flip triangles).
 
 use crate::ParamError;
-use crate::raster::triangle_row_spans;
+use crate::chart_footprint::{Footprint, Grown};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -104,22 +104,6 @@ impl Packing {
     }
 }
 
-/// Row spans of covered texels, rows `0..h`, columns within `0..w`.
-#[derive(Debug, Clone, Default)]
-struct Footprint {
-    w: i64,
-    h: i64,
-    rows: Vec<Vec<(i64, i64)>>,
-}
-
-/// A footprint grown by the gutter: rows start at `y0`; `need` is each row's widest span.
-#[derive(Debug, Clone, Default)]
-struct Grown {
-    y0: i64,
-    rows: Vec<Vec<(i64, i64)>>,
-    need: Vec<i64>,
-}
-
 fn merge_spans(spans: &mut Vec<(i64, i64)>) {
     spans.sort_unstable();
     let mut out: Vec<(i64, i64)> = Vec::with_capacity(spans.len());
@@ -132,84 +116,13 @@ fn merge_spans(spans: &mut Vec<(i64, i64)>) {
     *spans = out;
 }
 
-fn rasterize(chart: &PackChart, origin: [f64; 2], scale: f64) -> Footprint {
-    let pts: Vec<[f64; 2]> = chart
-        .points
-        .iter()
-        .map(|p| [(p[0] - origin[0]) * scale + INSET, (p[1] - origin[1]) * scale + INSET])
-        .collect();
-    let mut rows: Vec<Vec<(i64, i64)>> = Vec::new();
-    let mut emit = |r: i64, a: i64, b: i64| {
-        let r = r.max(0) as usize;
-        if rows.len() <= r {
-            rows.resize(r + 1, Vec::new());
-        }
-        rows[r].push((a.max(0), b.max(0)));
-    };
-    for t in &chart.triangles {
-        let tri = [pts[t[0] as usize], pts[t[1] as usize], pts[t[2] as usize]];
-        triangle_row_spans(tri, PACK_EPS, &mut emit);
-    }
-    if rows.is_empty() {
-        rows.push(vec![(0, 0)]);
-    }
-    let mut w = 1;
-    for r in rows.iter_mut() {
-        merge_spans(r);
-        if let Some(l) = r.last() {
-            w = w.max(l.1 + 1);
-        }
-    }
-    Footprint { w, h: rows.len() as i64, rows }
-}
-
-/// Rotates a footprint by 90° counter-clockwise: texel `(x, y)` → `(h − 1 − y, x)`.
-fn rotate90(f: &Footprint) -> Footprint {
-    let (w, h) = (f.w, f.h);
-    let mut rows: Vec<Vec<(i64, i64)>> = vec![Vec::new(); w as usize];
-    // New row x holds the old column x; the old row y becomes new column h-1-y.
-    for y in (0..h).rev() {
-        let nx = h - 1 - y;
-        for &(a, b) in &f.rows[y as usize] {
-            for x in a..=b {
-                let row = &mut rows[x as usize];
-                match row.last_mut() {
-                    Some(last) if last.1 + 1 == nx => last.1 = nx,
-                    _ => row.push((nx, nx)),
-                }
-            }
-        }
-    }
-    Footprint { w: h, h: w, rows }
-}
-
-fn grow_footprint(f: &Footprint, g: i64) -> Grown {
-    let ext: Vec<i64> =
-        (0..=g).map(|d| (((g * g - d * d) as f64).sqrt() + 1e-9).floor() as i64).collect();
-    let n = f.h + 2 * g;
-    let mut rows = Vec::with_capacity(n as usize);
-    let mut need = Vec::with_capacity(n as usize);
-    for k in 0..n {
-        let y = k - g;
-        let mut spans = Vec::new();
-        for d in -g..=g {
-            let src = y + d;
-            if src < 0 || src >= f.h {
-                continue;
-            }
-            let e = ext[d.unsigned_abs() as usize];
-            spans.extend(f.rows[src as usize].iter().map(|&(a, b)| (a - e, b + e)));
-        }
-        merge_spans(&mut spans);
-        need.push(spans.iter().map(|&(a, b)| b - a + 1).max().unwrap_or(0));
-        rows.push(spans);
-    }
-    Grown { y0: -g, rows, need }
-}
-
 /// Occupied spans per atlas row and the longest free run of each row.
 struct Grid {
+    /// Width in texels (the atlas resolution).
     size: i64,
+    /// Height in texels: twice the atlas, so that a failed fit still measures how
+    /// tall the packing would be.
+    height: i64,
     gutter: i64,
     margin: i64,
     rows: Vec<Vec<(i64, i64)>>,
@@ -217,15 +130,16 @@ struct Grid {
 }
 
 impl Grid {
-    fn new(size: i64, gutter: i64) -> Self {
-        let margin = (gutter + 1) / 2;
+    fn new(size: i64, height: i64, gutter: i64) -> Self {
+        let margin = (gutter as u64).div_ceil(2) as i64;
         let free = size + 2 * gutter;
         Self {
             size,
+            height,
             gutter,
             margin,
-            rows: vec![Vec::new(); size as usize],
-            max_free: vec![free; size as usize],
+            rows: vec![Vec::new(); height as usize],
+            max_free: vec![free; height as usize],
         }
     }
 
@@ -242,10 +156,11 @@ impl Grid {
         self.max_free[y] = best;
     }
 
-    /// Lowest-then-leftmost offset where `grown` (of a `fw × fh` footprint) fits.
-    fn find(&self, grown: &Grown, fw: i64, fh: i64) -> Option<(i64, i64)> {
+    /// Lowest-then-leftmost offset where `grown` (of a `fw × fh` footprint) fits, with
+    /// the offset's row at most `oy_max`.
+    fn find(&self, grown: &Grown, fw: i64, fh: i64, oy_max: i64) -> Option<(i64, i64)> {
         let (ox_lo, ox_hi) = (self.margin, self.size - self.margin - fw);
-        let (oy_lo, oy_hi) = (self.margin, self.size - self.margin - fh);
+        let (oy_lo, oy_hi) = (self.margin, (self.height - self.margin - fh).min(oy_max));
         if ox_lo > ox_hi || oy_lo > oy_hi {
             return None;
         }
@@ -254,21 +169,18 @@ impl Grid {
         let mut scratch: Vec<(i64, i64)> = Vec::new();
         let mut hint = 0i64;
         'oy: for oy in oy_lo..=oy_hi {
-            // Quick reject on the longest free run, starting where the last one failed.
+            feasible.clear();
+            feasible.push((ox_lo, ox_hi));
+            // Rows in any order give the same set; start where the last test failed.
             for k in 0..nrows {
                 let r = (hint + k) % nrows;
                 let y = oy + grown.y0 + r;
-                if y >= 0 && y < self.size && grown.need[r as usize] > self.max_free[y as usize] {
+                if y < 0 || y >= self.height {
+                    continue;
+                }
+                if grown.need[r as usize] > self.max_free[y as usize] {
                     hint = r;
                     continue 'oy;
-                }
-            }
-            feasible.clear();
-            feasible.push((ox_lo, ox_hi));
-            for r in 0..nrows {
-                let y = oy + grown.y0 + r;
-                if y < 0 || y >= self.size {
-                    continue;
                 }
                 let occ = &self.rows[y as usize];
                 if occ.is_empty() {
@@ -310,63 +222,80 @@ impl Grid {
     }
 
     fn place(&mut self, f: &Footprint, ox: i64, oy: i64) {
-        for (r, spans) in f.rows.iter().enumerate() {
-            if spans.is_empty() {
-                continue;
+        for r in 0..f.h {
+            let y = (oy + r) as usize;
+            let before = self.rows[y].len();
+            f.row_spans(r, ox, &mut self.rows[y]);
+            if self.rows[y].len() > before {
+                merge_spans(&mut self.rows[y]);
+                self.update_free(y);
             }
-            let y = (oy + r as i64) as usize;
-            self.rows[y].extend(spans.iter().map(|&(a, b)| (a + ox, b + ox)));
-            merge_spans(&mut self.rows[y]);
-            self.update_free(y);
         }
     }
 }
 
-/// Packs all charts at scale `scale`; `None` when one does not fit.
+/// A packing at one scale: placements and the top row used (exclusive).
+struct Trial {
+    placements: Vec<Placement>,
+    top: i64,
+}
+
+/// Packs all charts at scale `scale` into a grid twice as tall as the atlas; `None`
+/// when a chart is wider than the atlas or the grid overflows.
 fn try_pack(
     charts: &[PackChart],
     origins: &[[f64; 2]],
     order: &[usize],
     scale: f64,
     opts: &PackingOptions,
-) -> Option<Vec<Placement>> {
+) -> Option<Trial> {
     let g = opts.gutter as i64;
     let size = opts.resolution as i64;
     let rots = if opts.rotate { 4 } else { 1 };
-    let mut grid = Grid::new(size, g);
+    let mut grid = Grid::new(size, 2 * size, g);
     let mut out = vec![
         Placement { offset: [0, 0], rotation: 0, origin: [0.0; 2], size: [0, 0] };
         charts.len()
     ];
+    let mut top = 0;
     for &c in order {
-        let base = rasterize(&charts[c], origins[c], scale);
-        if base.w > size || base.h > size {
-            return None;
-        }
+        let ch = &charts[c];
+        let base = Footprint::rasterize(
+            &ch.points,
+            &ch.triangles,
+            origins[c],
+            scale,
+            INSET,
+            PACK_EPS,
+            size,
+        )?;
         let mut best: Option<((i64, i64, i64, u8), Footprint)> = None;
         let mut fp = base.clone();
         for k in 0..rots {
             if k > 0 {
-                fp = rotate90(&fp);
+                fp = fp.rotate90();
             }
-            let grown = grow_footprint(&fp, g);
-            if let Some((ox, oy)) = grid.find(&grown, fp.w, fp.h) {
+            // Only rows that could beat the best top edge so far.
+            let oy_max = best.as_ref().map_or(i64::MAX, |(bk, _)| bk.0 - fp.h);
+            let grown = fp.grow(g);
+            if let Some((ox, oy)) = grid.find(&grown, fp.w, fp.h, oy_max) {
                 let key = (oy + fp.h, oy, ox, k as u8);
                 if best.as_ref().is_none_or(|(bk, _)| key < *bk) {
                     best = Some((key, fp.clone()));
                 }
             }
         }
-        let ((_, oy, ox, k), f) = best?;
+        let ((t, oy, ox, k), f) = best?;
         grid.place(&f, ox, oy);
+        top = top.max(t);
         out[c] =
             Placement { offset: [ox, oy], rotation: k, origin: origins[c], size: [base.w, base.h] };
     }
-    Some(out)
+    Some(Trial { placements: out, top })
 }
 
 /// Packs `charts` into a `resolution²` atlas at the largest scale that fits (module
-/// docs). Charts with no triangles get a placement but occupy nothing.
+/// docs). Charts with no triangles get a placement and reserve one texel.
 pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Packing, ParamError> {
     if options.resolution < 8 || options.resolution > 32768 {
         return Err(ParamError::InvalidOption {
@@ -388,135 +317,117 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
     for ch in charts {
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
+        let mut a = 0.0;
         for t in &ch.triangles {
-            for &i in t {
-                let p = ch.points[i as usize];
-                for k in 0..2 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
-                }
+            let [p, q, r] = t.map(|i| ch.points[i as usize]);
+            for v in [p, q, r] {
+                lo = [lo[0].min(v[0]), lo[1].min(v[1])];
+                hi = [hi[0].max(v[0]), hi[1].max(v[1])];
             }
+            a += 0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs();
         }
-        if !lo[0].is_finite() {
+        if !(lo[0].is_finite() && lo[1].is_finite() && hi[0].is_finite() && hi[1].is_finite()) {
             lo = [0.0; 2];
             hi = [0.0; 2];
         }
         extent = extent.max(hi[0] - lo[0]).max(hi[1] - lo[1]);
         origins.push(lo);
-        let mut a = 0.0;
-        for t in &ch.triangles {
-            let [p, q, r] =
-                [ch.points[t[0] as usize], ch.points[t[1] as usize], ch.points[t[2] as usize]];
-            a += 0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs();
-        }
-        areas.push(a);
+        areas.push(if a.is_finite() { a } else { 0.0 });
     }
     let mut order: Vec<usize> = (0..charts.len()).collect();
     order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]).then(a.cmp(&b)));
     let res = options.resolution as f64;
     let total: f64 = areas.iter().sum();
     // Upper bound: no chart larger than the atlas, no more than full coverage.
-    let mut hi = if total > 0.0 { (res * res / total).sqrt() } else { f64::INFINITY };
+    let mut upper = if total > 0.0 { (res * res / total).sqrt() } else { f64::INFINITY };
     if extent > 0.0 {
-        hi = hi.min(res / extent);
+        upper = upper.min(res / extent);
     }
-    if !hi.is_finite() {
-        hi = 1.0;
+    if !upper.is_finite() {
+        upper = 1.0;
     }
+    let limit = res - options.gutter.div_ceil(2) as f64;
+    let tol = options.tolerance.clamp(1e-6, 0.5);
     let fail = |s: f64| ParamError::PackingFailed {
         charts: charts.len(),
         resolution: options.resolution,
         gutter: options.gutter,
         texels_per_unit: s,
     };
-    // Find a scale that fits, shrinking geometrically.
-    let mut lo_fit: Option<(f64, Vec<Placement>)> = None;
-    let mut s = hi * 0.8;
-    for _ in 0..60 {
-        let trials: Vec<f64> = vec![s, s * 0.85, s * 0.72];
-        let results: Vec<Option<Vec<Placement>>> =
+    // Scale search: `lo` fits, `hi` does not (or is the upper bound). Each trial's
+    // packing height h(s) ∝ s² roughly, so `s·√(limit / h)` estimates the best scale.
+    let mut lo: Option<(f64, Vec<Placement>)> = None;
+    let mut hi = upper * (1.0 + 1e-9);
+    let mut guess = 0.8 * upper;
+    for _round in 0..40 {
+        let lo_s = lo.as_ref().map_or(0.0, |l| l.0);
+        if lo.is_some() && hi <= lo_s * (1.0 + tol) {
+            break;
+        }
+        let trials: Vec<f64> = if lo.is_some() && hi <= lo_s * 1.05 {
+            let r = hi / lo_s;
+            (1..=3).map(|k| lo_s * r.powf(k as f64 / 4.0)).collect()
+        } else {
+            let c = guess.min(hi / (1.0 + 0.25 * tol)).max(lo_s * (1.0 + 0.25 * tol));
+            [c, c * 0.99, c * 0.98].into_iter().filter(|&t| t > lo_s && t < hi).collect()
+        };
+        if trials.is_empty() {
+            break;
+        }
+        let results: Vec<Option<Trial>> =
             trials.par_iter().map(|&t| try_pack(charts, &origins, &order, t, options)).collect();
-        let mut found = false;
-        for (t, r) in trials.iter().zip(results) {
-            if let Some(p) = r {
-                lo_fit = Some((*t, p));
-                found = true;
-                break;
-            }
-            hi = hi.min(*t);
-        }
-        if found {
-            break;
-        }
-        s *= 0.6;
-        if s < 1e-300 {
-            break;
-        }
-    }
-    let Some((mut lo, mut best)) = lo_fit else { return Err(fail(s)) };
-    // Refine between lo (fits) and hi (does not, or the upper bound).
-    let tol = options.tolerance.clamp(1e-6, 0.5);
-    for _ in 0..20 {
-        if hi / lo <= 1.0 + tol {
-            break;
-        }
-        let r = hi / lo;
-        let trials: Vec<f64> = (1..=3).map(|k| lo * r.powf(k as f64 / 4.0)).collect();
-        let results: Vec<Option<Vec<Placement>>> =
-            trials.par_iter().map(|&t| try_pack(charts, &origins, &order, t, options)).collect();
-        let mut new_hi = hi;
-        for (t, r) in trials.iter().zip(results) {
+        let mut estimate: Option<f64> = None;
+        let mut smallest_failed: Option<f64> = None;
+        for (&t, r) in trials.iter().zip(results) {
             match r {
-                Some(p) => {
-                    if *t > lo && *t < new_hi {
-                        lo = *t;
-                        best = p;
+                Some(trial) if trial.top as f64 <= limit => {
+                    if t > lo.as_ref().map_or(0.0, |l| l.0) {
+                        let est = t * (limit / trial.top.max(1) as f64).sqrt();
+                        estimate = Some(estimate.map_or(est, |e: f64| e.max(est)));
+                        lo = Some((t, trial.placements));
+                    }
+                }
+                Some(trial) => {
+                    hi = hi.min(t);
+                    if lo.is_none() {
+                        let est = t * (limit / trial.top as f64).sqrt() * 0.995;
+                        estimate = Some(estimate.map_or(est, |e: f64| e.min(est)));
                     }
                 }
                 None => {
-                    if *t > lo {
-                        new_hi = new_hi.min(*t);
-                    }
+                    hi = hi.min(t);
+                    smallest_failed = Some(smallest_failed.map_or(t, |m: f64| m.min(t)));
                 }
             }
         }
-        hi = new_hi;
+        guess = match (estimate, smallest_failed) {
+            (Some(e), _) => e,
+            (None, Some(m)) => m * 0.6,
+            (None, None) => guess,
+        };
+        if lo.is_none() && guess < upper * 1e-9 {
+            return Err(fail(guess));
+        }
     }
+    let Some((scale, placements)) = lo else { return Err(fail(guess)) };
     Ok(Packing {
         resolution: options.resolution,
         gutter: options.gutter,
-        texels_per_unit: lo,
-        placements: best,
+        texels_per_unit: scale,
+        placements,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::raster::triangle_row_spans;
 
     fn square(side: f64) -> PackChart {
         PackChart {
             points: vec![[0.0, 0.0], [side, 0.0], [side, side], [0.0, side]],
             triangles: vec![[0, 1, 2], [0, 2, 3]],
         }
-    }
-
-    #[test]
-    fn rotation_matches_geometry() {
-        let ch = PackChart {
-            points: vec![[0.0, 0.0], [3.0, 0.0], [0.0, 1.0]],
-            triangles: vec![[0, 1, 2]],
-        };
-        let f = rasterize(&ch, [0.0, 0.0], 2.0);
-        let r = rotate90(&f);
-        assert_eq!((r.w, r.h), (f.h, f.w));
-        // Rasterising the rotated geometry gives the rotated footprint.
-        let rot = PackChart {
-            points: ch.points.iter().map(|p| [-p[1], p[0]]).collect(),
-            triangles: ch.triangles.clone(),
-        };
-        let g = rasterize(&rot, [-1.0, 0.0], 2.0);
-        assert_eq!(g.rows, r.rows);
     }
 
     #[test]
