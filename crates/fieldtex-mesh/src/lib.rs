@@ -43,3 +43,4 @@ pub use normals::{NormalWeighting, face_normals, vertex_normals};
 pub use principal_curvature::{CurvatureOptions, PrincipalCurvatures, principal_curvatures};
 #[cfg(test)]
 mod test_meshes;
+pub use heat_geodesic::{HeatBoundary, HeatGeodesic, HeatGeodesicOptions, SurfacePoint};
