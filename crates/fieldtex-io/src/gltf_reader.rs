@@ -43,6 +43,26 @@ pub fn read_gltf_bytes(
     let root: gltf::json::Root = gltf::json::deserialize::from_slice(json).map_err(|e| {
         IoError::parse(name, format!("JSON line {} column {}", e.line(), e.column()), e.to_string())
     })?;
+    // gltf-json 1.4's validation indexes the POSITION accessor before checking that it
+    // exists (a panic on a dangling index): check that reference here first.
+    let positions_key = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+    for (mi, mesh) in root.meshes.iter().enumerate() {
+        for (pi, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(a) = prim.attributes.get(&positions_key)
+                && a.value() >= root.accessors.len()
+            {
+                return Err(IoError::parse(
+                    name,
+                    format!("mesh {mi} primitive {pi}"),
+                    format!(
+                        "POSITION refers to accessor {} but only {} exist",
+                        a.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
     let doc = gltf::Document::from_json(root)
         .map_err(|e| IoError::parse(name, "glTF JSON", format!("invalid glTF document: {e}")))?;
     if let Some(ext) = doc.extensions_required().next() {
@@ -82,17 +102,14 @@ pub fn read_gltf_bytes(
     let mut warnings = std::mem::take(&mut m.warnings);
     let image_index = m.image;
     let mesh = m.finish(&mut warnings)?;
-    let base_color = image_index.and_then(|i| {
-        let img = doc.images().nth(i)?;
-        match load_image(&img, &buffers, base, name) {
-            Ok(im) => Some(im),
-            Err(e) => {
-                warnings.push(Warning::new(
-                    "texture-not-loaded",
-                    format!("base-colour texture not loaded: {e}"),
-                ));
-                None
-            }
+    let base_color = image_index.and_then(|i| match load_image(&doc, i, &buffers, base, name) {
+        Ok(im) => Some(im),
+        Err(e) => {
+            warnings.push(Warning::new(
+                "texture-not-loaded",
+                format!("base-colour texture not loaded: {e}"),
+            ));
+            None
         }
     });
     Ok((mesh, base_color, warnings))
@@ -530,29 +547,39 @@ fn read_accessor<const N: usize>(
     Ok(out)
 }
 
+/// Decodes image `index`. Reads the JSON directly: `gltf::Image::source` panics on an
+/// image with neither `uri` nor `mimeType`.
 fn load_image(
-    img: &gltf::Image<'_>,
+    doc: &gltf::Document,
+    index: usize,
     buffers: &[Vec<u8>],
     base: Option<&Path>,
     name: &str,
 ) -> Result<Image, IoError> {
-    let label = format!("{name} (image {})", img.index());
-    match img.source() {
-        gltf::image::Source::View { view, .. } => {
-            let data = &buffers[view.buffer().index()];
-            let bytes = data
-                .get(view.offset()..view.offset().saturating_add(view.length()))
-                .ok_or_else(|| IoError::Truncated {
-                    file: name.to_string(),
-                    what: format!("image bufferView {}", view.index()),
-                    needed: (view.offset() as u64).saturating_add(view.length() as u64),
-                    available: data.len() as u64,
-                })?;
-            crate::read_image_bytes(bytes, &label)
-        }
-        gltf::image::Source::Uri { uri, .. } => {
-            let bytes = load_uri(uri, base, name)?;
-            crate::read_image_bytes(&bytes, &label)
-        }
+    let label = format!("{name} (image {index})");
+    let json = doc
+        .as_json()
+        .images
+        .get(index)
+        .ok_or_else(|| IoError::parse(name, format!("image {index}"), "does not exist"))?;
+    if let Some(v) = &json.buffer_view {
+        let view = doc.views().nth(v.value()).ok_or_else(|| {
+            IoError::parse(name, format!("image {index}"), "refers to a missing bufferView")
+        })?;
+        let data = &buffers[view.buffer().index()];
+        let bytes = data
+            .get(view.offset()..view.offset().saturating_add(view.length()))
+            .ok_or_else(|| IoError::Truncated {
+                file: name.to_string(),
+                what: format!("image bufferView {}", view.index()),
+                needed: (view.offset() as u64).saturating_add(view.length() as u64),
+                available: data.len() as u64,
+            })?;
+        crate::read_image_bytes(bytes, &label)
+    } else if let Some(uri) = &json.uri {
+        let bytes = load_uri(uri, base, name)?;
+        crate::read_image_bytes(&bytes, &label)
+    } else {
+        Err(IoError::parse(name, format!("image {index}"), "has neither a uri nor a bufferView"))
     }
 }

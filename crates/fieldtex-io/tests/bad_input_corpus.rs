@@ -89,6 +89,11 @@ fn valid_files() -> Vec<(&'static str, Vec<u8>)> {
         ("ok-ascii.stl", ascii_stl()),
         ("ok-bin.stl", binary_stl(&[[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; 2])),
         ("ok.glb", encode_glb(&uvm, Some(&tex), &GlbOptions::default()).unwrap()),
+        ("ok-colors.glb", {
+            let mut c = uvm.clone();
+            c.vertex_colors = Some(vec![[0.2, 0.4, 0.6, 1.0]; c.n_vertices()]);
+            encode_glb(&c, None, &GlbOptions::default().with_vertex_colors(true)).unwrap()
+        }),
     ]
 }
 
@@ -325,7 +330,7 @@ fn random_mutations_never_panic() {
     let mut outcomes = [0usize; 2];
     for (name, bytes) in valid_files() {
         let hint = MeshFormat::from_extension(Path::new(name));
-        for _ in 0..400 {
+        for _ in 0..2000 {
             let mut b = bytes.clone();
             for _ in 0..1 + rng.below(4) {
                 let i = rng.below(b.len());

@@ -176,4 +176,17 @@ fn hostile_documents_are_clear_errors() {
     doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
     let e = read_mesh_bytes(&serde_json::to_vec(&doc).unwrap(), None).unwrap_err();
     assert!(e.to_string().contains("KHR_draco_mesh_compression"), "{e}");
+
+    // Regression (fuzzing): gltf-json's validation indexed a dangling POSITION accessor
+    // and panicked; it is now an error naming the primitive.
+    let mut doc = document(&uri, None);
+    doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(99);
+    let e = read_mesh_bytes(&serde_json::to_vec(&doc).unwrap(), None).unwrap_err();
+    assert!(e.to_string().contains("mesh 0 primitive 0"), "{e}");
+    // Regression (fuzzing): an image with neither uri nor mimeType made gltf's
+    // `Image::source` panic; it is now a warning and the mesh still loads.
+    let mut doc = document(&uri, Some("x.png"));
+    doc["images"] = json!([{}]);
+    let m = read_mesh_bytes(&serde_json::to_vec(&doc).unwrap(), None).unwrap();
+    assert!(m.warnings.iter().any(|w| w.code == "texture-not-loaded"), "{:?}", m.warnings);
 }
