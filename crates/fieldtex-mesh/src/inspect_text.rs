@@ -1,0 +1,216 @@
+//! Human-readable text and warning list of an [`InspectReport`].
+
+use crate::inspect::{Examples, InspectReport};
+use fieldtex_core::Warning;
+
+fn list<T: std::fmt::Debug>(e: &Examples<T>) -> String {
+    if e.examples.is_empty() {
+        return String::new();
+    }
+    let items: Vec<String> = e.examples.iter().map(|x| format!("{x:?}")).collect();
+    let more = if e.count > e.examples.len() { ", …" } else { "" };
+    format!(" (e.g. {}{more})", items.join(", "))
+}
+
+impl InspectReport {
+    /// The problems found, as warnings with stable codes, most severe first. Several
+    /// components or boundary loops are not problems and are not listed.
+    pub fn problems(&self) -> Vec<Warning> {
+        let mut w = Vec::new();
+        let mut add = |code: &str, count: usize, what: String| {
+            if count > 0 {
+                w.push(Warning::new(code, what));
+            }
+        };
+        add("empty-mesh", usize::from(self.n_triangles == 0), "the mesh has no triangles".into());
+        let e = &self.non_finite_vertices;
+        add(
+            "non-finite-positions",
+            e.count,
+            format!("{} vertices with NaN/Inf coordinates{}", e.count, list(e)),
+        );
+        let e = &self.invalid_index_triangles;
+        add(
+            "invalid-indices",
+            e.count,
+            format!("{} triangles refer to missing vertices{}", e.count, list(e)),
+        );
+        let e = &self.repeated_index_triangles;
+        add(
+            "repeated-index-triangles",
+            e.count,
+            format!("{} triangles repeat a vertex{}", e.count, list(e)),
+        );
+        let e = &self.non_manifold_edges;
+        let ex: Vec<String> =
+            e.examples.iter().map(|x| format!("{:?}→{:?}", x.vertices, x.triangles)).collect();
+        add(
+            "non-manifold-edges",
+            e.count,
+            format!("{} edges shared by more than two triangles ({})", e.count, ex.join(", ")),
+        );
+        let e = &self.non_manifold_vertices;
+        let ex: Vec<String> =
+            e.examples.iter().map(|x| format!("{} ({} fans)", x.vertex, x.fans)).collect();
+        add(
+            "non-manifold-vertices",
+            e.count,
+            format!("{} vertices joining separate fans of triangles ({})", e.count, ex.join(", ")),
+        );
+        let e = &self.orientation.inconsistent_edges;
+        add(
+            "inconsistent-orientation",
+            e.count,
+            format!(
+                "{} edges where neighbouring triangles disagree in orientation{}",
+                e.count,
+                list(e)
+            ),
+        );
+        let n = &self.orientation.non_orientable_components;
+        add(
+            "non-orientable",
+            n.len(),
+            format!("{} non-orientable components (Möbius-like): {:?}", n.len(), n),
+        );
+        let s = &self.shape;
+        add(
+            "zero-area-triangles",
+            s.zero_area.count,
+            format!(
+                "{} triangles with area ≤ {:.3e}{}",
+                s.zero_area.count,
+                s.zero_area_tolerance,
+                list(&s.zero_area)
+            ),
+        );
+        add(
+            "sliver-triangles",
+            s.slivers.count,
+            format!(
+                "{} triangles with an angle below {}°{}",
+                s.slivers.count,
+                s.sliver_threshold_deg,
+                list(&s.slivers)
+            ),
+        );
+        let e = &self.duplicate_triangles;
+        add(
+            "duplicate-triangles",
+            e.count,
+            format!("{} triangles repeat an earlier one{}", e.count, list(e)),
+        );
+        let d = &self.duplicate_vertices;
+        add(
+            "duplicate-vertices",
+            d.near,
+            format!(
+                "{} vertices coincide with another ({} exactly, {} more within {:.3e})",
+                d.near,
+                d.exact,
+                d.near - d.exact.min(d.near),
+                d.epsilon
+            ),
+        );
+        let e = &self.unreferenced_vertices;
+        add(
+            "unreferenced-vertices",
+            e.count,
+            format!("{} vertices are used by no triangle{}", e.count, list(e)),
+        );
+        for a in &self.attribute_problems {
+            add("attribute-length", 1, a.clone());
+        }
+        if let Some(uv) = &self.uv {
+            if let Some(p) = &uv.index_problem {
+                add("uv-indices", 1, p.clone());
+            }
+            add(
+                "uv-non-finite",
+                uv.non_finite_values,
+                format!("{} UV values are NaN/Inf", uv.non_finite_values),
+            );
+            let e = &uv.negative_area;
+            add(
+                "uv-flipped",
+                e.count,
+                format!("{} triangles are clockwise (mirrored) in UV space{}", e.count, list(e)),
+            );
+            let e = &uv.zero_area;
+            add(
+                "uv-zero-area",
+                e.count,
+                format!("{} triangles have zero area in UV space{}", e.count, list(e)),
+            );
+        }
+        w
+    }
+
+    /// `true` when [`problems`](Self::problems) is empty.
+    pub fn is_clean(&self) -> bool {
+        self.problems().is_empty()
+    }
+
+    /// A short human-readable description, one line per fact, for `fieldtex inspect`.
+    pub fn summary_lines(&self) -> Vec<String> {
+        let mut out =
+            vec![format!("vertices: {}, triangles: {}", self.n_vertices, self.n_triangles)];
+        match &self.bounding_box {
+            Some(b) => out.push(format!(
+                "bounding box: [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}], diagonal {:.6}",
+                b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2], self.diagonal
+            )),
+            None => out.push("bounding box: none (no finite vertex)".into()),
+        }
+        out.push(format!(
+            "components: {} ({} when cut at non-manifold edges/vertices), boundary loops: {}{}",
+            self.components.count,
+            self.components.edge_connected,
+            self.boundary_loops.count,
+            if self.boundary_loops.open_chains > 0 {
+                format!(" ({} open chains)", self.boundary_loops.open_chains)
+            } else {
+                String::new()
+            }
+        ));
+        for c in &self.components.listed {
+            let topo = match (c.genus, c.nonorientable_genus) {
+                (Some(g), _) => format!("genus {g}"),
+                (None, Some(k)) => format!("non-orientable, {k} cross-caps"),
+                _ => format!("genus n/a: {}", c.genus_unavailable.as_deref().unwrap_or("?")),
+            };
+            out.push(format!(
+                "  component {}: {} triangles, {} vertices, χ = {}, {} boundary loops, {topo}",
+                c.id, c.triangles, c.vertices, c.euler_characteristic, c.boundary_loops
+            ));
+        }
+        if self.components.listed.len() < self.components.count {
+            out.push(format!(
+                "  … {} smaller components not listed",
+                self.components.count - self.components.listed.len()
+            ));
+        }
+        if let Some(a) = self.shape.min_angle_deg {
+            out.push(format!("smallest angle: {a:.4}°"));
+        }
+        if let Some(uv) = &self.uv {
+            let range = match (uv.min, uv.max) {
+                (Some(a), Some(b)) => {
+                    format!("[{:.4}, {:.4}] – [{:.4}, {:.4}]", a[0], a[1], b[0], b[1])
+                }
+                _ => "none".into(),
+            };
+            out.push(format!("UVs: {} values, range {range}", uv.values));
+        } else {
+            out.push("UVs: none".into());
+        }
+        let problems = self.problems();
+        if problems.is_empty() {
+            out.push("no problems found".into());
+        }
+        for p in problems {
+            out.push(format!("problem {p}"));
+        }
+        out
+    }
+}
