@@ -21,7 +21,8 @@
 //!   zero-area and smallest angle `< sliver_min_angle_deg` (see [`crate::triangle_quality`]).
 //! - *duplicate triangles*: same three vertices as an earlier triangle, in any order.
 //! - *duplicate vertices*: exactly equal positions, and positions within
-//!   `near_duplicate_relative · diagonal` (single linkage, [`crate::coincident_vertices`]).
+//!   `near_duplicate_relative · diagonal` (single linkage, [`crate::coincident_vertices`]);
+//!   only exact duplicates that a weld would stitch together, and near ones, are problems.
 //! - *UV sanity*: index consistency, non-finite values, range, negative (clockwise) and
 //!   zero-area triangles in UV space.
 //!
@@ -172,6 +173,10 @@ pub struct ShapeReport {
 pub struct DuplicateVerticesReport {
     /// Vertices at exactly the position of a lower-index vertex.
     pub exact: usize,
+    /// Those of `exact` that repair's fan-aware weld ([`crate::vertex_welding`]) would
+    /// merge. The others sit in separate fans of triangles (e.g. the copies repair makes
+    /// when it splits a non-manifold vertex) and are kept apart on purpose.
+    pub weldable: usize,
     /// Vertices a weld within `epsilon` would remove (includes `exact`).
     pub near: usize,
     /// Absolute distance used (`near_duplicate_relative · diagonal`).
@@ -381,8 +386,15 @@ pub fn inspect(mesh: &TriMesh, options: &InspectOptions) -> InspectReport {
     let exact = exact_coincident_classes(&mesh.positions);
     let epsilon = options.near_duplicate_relative.max(0.0) * diagonal;
     let near = near_coincident_classes_from(&mesh.positions, exact.clone(), epsilon);
+    let n_exact = count_merged(&exact);
+    let weldable = if n_exact > 0 {
+        count_merged(&crate::vertex_welding::fan_aware_weld(&mesh.positions, &tris, 0.0))
+    } else {
+        0
+    };
     let duplicate_vertices = DuplicateVerticesReport {
-        exact: count_merged(&exact),
+        exact: n_exact,
+        weldable,
         near: count_merged(&near),
         epsilon,
         examples: exact

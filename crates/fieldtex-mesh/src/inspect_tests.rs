@@ -84,6 +84,7 @@ fn cube_soup_fixture() {
     assert_eq!(r.components.count, 6);
     assert_eq!(r.boundary_loops.count, 6);
     assert_eq!(r.duplicate_vertices.exact, 16);
+    assert_eq!(r.duplicate_vertices.weldable, 16);
     assert_eq!(r.duplicate_vertices.near, 16);
     let uv = r.uv.as_ref().unwrap();
     assert_eq!(uv.values, 24);

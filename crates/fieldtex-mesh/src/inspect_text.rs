@@ -101,15 +101,15 @@ impl InspectReport {
             format!("{} triangles repeat an earlier one{}", e.count, list(e)),
         );
         let d = &self.duplicate_vertices;
+        let close = d.near.saturating_sub(d.exact);
         add(
             "duplicate-vertices",
-            d.near,
+            d.weldable + close,
             format!(
-                "{} vertices coincide with another ({} exactly, {} more within {:.3e})",
-                d.near,
-                d.exact,
-                d.near - d.exact.min(d.near),
-                d.epsilon
+                "{} vertices sit exactly on another one that they could be welded to, {close} \
+                 more within {:.3e} of another ({} exact duplicates in all, including copies \
+                 kept apart in separate fans)",
+                d.weldable, d.epsilon, d.exact
             ),
         );
         let e = &self.unreferenced_vertices;

@@ -75,19 +75,30 @@ pub(crate) fn drop_non_finite(w: &mut Work) {
 }
 
 /// Step 3: fan-aware weld within `epsilon` (absolute); returns how many vertices
-/// were welded away.
+/// were welded away. With `epsilon > 0` an exact weld follows: merging more points
+/// can make an edge non-manifold in the tentative mesh and so block stitches that
+/// exactly coincident vertices alone would allow.
 pub(crate) fn weld(w: &mut Work, epsilon: f64, pass: usize) -> usize {
-    let map = fan_aware_weld(&w.positions, &w.triangles, epsilon);
-    let welded: Vec<u32> = (0..map.len() as u32).filter(|&v| map[v as usize] != v).collect();
+    let mut welded: Vec<u32> = Vec::new();
+    let epsilons: &[f64] = if epsilon > 0.0 { &[epsilon, 0.0] } else { &[0.0] };
+    for &eps in epsilons {
+        let map = fan_aware_weld(&w.positions, &w.triangles, eps);
+        let n0 = welded.len();
+        welded.extend((0..map.len() as u32).filter(|&v| map[v as usize] != v));
+        if welded.len() == n0 {
+            continue;
+        }
+        for t in &mut w.triangles {
+            *t = t.map(|v| map[v as usize]);
+        }
+        for &v in &welded[n0..] {
+            w.dead[v as usize] = true;
+        }
+    }
     if welded.is_empty() {
         return 0;
     }
-    for t in &mut w.triangles {
-        *t = t.map(|v| map[v as usize]);
-    }
-    for &v in &welded {
-        w.dead[v as usize] = true;
-    }
+    welded.sort_unstable();
     let how = if epsilon > 0.0 {
         format!("within {epsilon:.3e}")
     } else {
