@@ -1,1 +1,513 @@
-//! (being written)
+//! Bounding volume hierarchy over a triangle mesh: ray casting (closest hit, any hit)
+//! and closest-point queries. One BVH serves occlusion, picking and baking.
+//!
+//! Built with obvhs 0.4: a PLOC binary BVH (Meister & Bittner 2018, "Parallel
+//! Locally-Ordered Clustering for Bounding Volume Hierarchy Construction") refined by
+//! parallel reinsertion and converted to a compressed 8-wide BVH (Ylitie, Karras & Laine
+//! 2017, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs"), whose
+//! SIMD traversal casts the rays. The binary BVH is kept for closest-point queries, which
+//! obvhs does not offer: an own best-first descent with `f64` point–triangle distances
+//! (Ericson 2005, "Real-Time Collision Detection", §5.1.5).
+//!
+//! **Precision.** Traversal is `f32` (obvhs); the mesh is translated so its bounding box
+//! is centred at the origin first, which keeps `f32` relative precision for meshes far
+//! from the origin. Ray–triangle tests use the watertight algorithm of Woop, Benthin &
+//! Wald 2013 ("Watertight Ray/Triangle Intersection", JCGT 2(1)), so a ray through a
+//! shared edge or vertex never slips between triangles; the winning triangle's `t` and
+//! barycentric coordinates are then recomputed in `f64`. Ties (same `t`) go to the lower
+//! triangle index, so results do not depend on the tree layout or the thread count.
+//! Known limit: obvhs's `f32` slab test may miss an exactly axis-parallel ray lying in a
+//! face plane of the mesh's bounding box (grazing the outermost boundary).
+//!
+//! **Conventions.** `t` is the ray parameter: hit point `origin + t · dir` (a distance
+//! when `dir` is unit). Barycentric coordinates `[b0, b1, b2]` weight the triangle's
+//! corners in order. Triangles with a non-finite corner are left out (counted in
+//! [`Bvh::n_skipped`]); zero-area triangles are kept but never hit by rays (closest-point
+//! queries can return them).
+
+use crate::{MeshError, TriMesh};
+use fieldtex_core::vec3::{self, V3};
+use glam::{UVec2, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::bvh2::node::Bvh2Node;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
+use obvhs::ploc::PlocBuilder;
+use obvhs::ray::Ray as ORay;
+use obvhs::triangle::Triangle;
+use rayon::prelude::*;
+
+/// A ray for batch queries: points `origin + t · dir` with `tmin ≤ t ≤ tmax`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    pub origin: V3,
+    pub dir: V3,
+    pub tmin: f64,
+    pub tmax: f64,
+}
+
+impl Ray {
+    /// A ray over `[0, ∞)`.
+    pub fn new(origin: V3, dir: V3) -> Self {
+        Self { origin, dir, tmin: 0.0, tmax: f64::INFINITY }
+    }
+    /// The same ray restricted to `[tmin, tmax]`.
+    pub fn with_range(self, tmin: f64, tmax: f64) -> Self {
+        Self { tmin, tmax, ..self }
+    }
+}
+
+/// A ray hit: triangle, ray parameter and barycentric coordinates of the hit point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub triangle: u32,
+    pub t: f64,
+    pub barycentric: [f64; 3],
+}
+
+/// The closest surface point to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClosestPoint {
+    pub triangle: u32,
+    pub barycentric: [f64; 3],
+    pub point: V3,
+    pub distance: f64,
+}
+
+/// Ray-casting and closest-point acceleration structure (module docs).
+#[derive(Clone)]
+pub struct Bvh {
+    cwbvh: CwBvh,
+    /// `f32` triangles in BVH primitive order (translated by `-centre`).
+    prim_tris: Vec<Triangle>,
+    /// Mesh triangle of each BVH primitive.
+    prim_ids: Vec<u32>,
+    /// Binary BVH for closest-point queries (boxes translated by `-centre`).
+    nodes2: Vec<Bvh2Node>,
+    prim_ids2: Vec<u32>,
+    centre: V3,
+    /// `f64` corners of every mesh triangle (untranslated).
+    corners: Vec<[V3; 3]>,
+    /// Slack added to `f32` boxes in closest-point pruning.
+    box_slack: f64,
+    n_skipped: usize,
+}
+
+impl std::fmt::Debug for Bvh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Bvh")
+            .field("triangles", &self.prim_ids.len())
+            .field("nodes", &self.cwbvh.nodes.len())
+            .field("skipped", &self.n_skipped)
+            .finish()
+    }
+}
+
+#[inline]
+fn to_f32(p: V3, c: V3) -> Vec3A {
+    Vec3A::new((p[0] - c[0]) as f32, (p[1] - c[1]) as f32, (p[2] - c[2]) as f32)
+}
+
+/// Per-ray constants of the watertight test (Woop et al. 2013, §3): the dominant axis
+/// `kz` of the direction, the two others, and the shear.
+#[derive(Clone, Copy)]
+struct Shear {
+    k: [usize; 3],
+    s: [f32; 3],
+    org: Vec3A,
+    tmin: f32,
+    tmax: f32,
+}
+
+impl Shear {
+    fn new(r: &ORay) -> Self {
+        let d = r.direction;
+        let kz = if d.x.abs() >= d.y.abs() && d.x.abs() >= d.z.abs() {
+            0
+        } else if d.y.abs() >= d.z.abs() {
+            1
+        } else {
+            2
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Self {
+            k: [kx, ky, kz],
+            s: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]],
+            org: r.origin,
+            tmin: r.tmin,
+            tmax: r.tmax,
+        }
+    }
+
+    /// Ray parameter of the hit with triangle `tri`, or `f32::INFINITY`.
+    #[inline(always)]
+    fn intersect(&self, tri: &Triangle) -> f32 {
+        let [kx, ky, kz] = self.k;
+        let [sx, sy, sz] = self.s;
+        let a = tri.v0 - self.org;
+        let b = tri.v1 - self.org;
+        let c = tri.v2 - self.org;
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            // Exactly on an edge in f32: decide in f64 (§3.3 of the paper).
+            let f = |x: f32| x as f64;
+            u = (f(cx) * f(by) - f(cy) * f(bx)) as f32;
+            v = (f(ax) * f(cy) - f(ay) * f(cx)) as f32;
+            w = (f(bx) * f(ay) - f(by) * f(ax)) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return f32::INFINITY;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return f32::INFINITY;
+        }
+        let t = (u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz])) / det;
+        if t >= self.tmin && t <= self.tmax { t } else { f32::INFINITY }
+    }
+}
+
+impl Bvh {
+    /// Builds the BVH (parallel). Errors on an index out of range.
+    pub fn build(mesh: &TriMesh) -> Result<Self, MeshError> {
+        crate::checks::check_indices(mesh)?;
+        let centre = mesh.bounding_box().map_or([0.0; 3], |b| b.center());
+        let extent = mesh.bounding_box().map_or(1.0, |b| b.diagonal().max(f64::MIN_POSITIVE));
+        let corners: Vec<[V3; 3]> = mesh
+            .triangles
+            .par_iter()
+            .with_min_len(4096)
+            .map(|t| t.map(|i| mesh.positions[i as usize]))
+            .collect();
+        let keep: Vec<u32> = (0..corners.len() as u32)
+            .filter(|&f| corners[f as usize].iter().all(|p| vec3::is_finite(*p)))
+            .collect();
+        let n_skipped = corners.len() - keep.len();
+        let tris: Vec<Triangle> = keep
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&f| {
+                let c = corners[f as usize];
+                Triangle {
+                    v0: to_f32(c[0], centre),
+                    v1: to_f32(c[1], centre),
+                    v2: to_f32(c[2], centre),
+                }
+            })
+            .collect();
+        let params = BvhBuildParams::medium_build();
+        let (cwbvh, nodes2, prim_ids2, prim_tris, prim_ids) = if tris.is_empty() {
+            (CwBvh::default(), Vec::new(), Vec::new(), Vec::new(), Vec::new())
+        } else {
+            let mut bvh2 = PlocBuilder::with_capacity(tris.len()).build(
+                params.ploc_search_distance,
+                &tris,
+                (0..tris.len() as u32).collect(),
+                params.sort_precision,
+                params.search_depth_threshold,
+            );
+            ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+            let cw = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
+            let prim_tris: Vec<Triangle> =
+                cw.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
+            let prim_ids: Vec<u32> =
+                cw.primitive_indices.iter().map(|&i| keep[i as usize]).collect();
+            let prim_ids2: Vec<u32> =
+                bvh2.primitive_indices.iter().map(|&i| keep[i as usize]).collect();
+            (cw, bvh2.nodes, prim_ids2, prim_tris, prim_ids)
+        };
+        Ok(Self {
+            cwbvh,
+            prim_tris,
+            prim_ids,
+            nodes2,
+            prim_ids2,
+            centre,
+            corners,
+            box_slack: 1e-6 * extent,
+            n_skipped,
+        })
+    }
+
+    /// Triangles left out because a corner is not finite.
+    pub fn n_skipped(&self) -> usize {
+        self.n_skipped
+    }
+
+    /// Closest hit of the ray `origin + t · dir`, `0 ≤ t ≤ tmax`.
+    pub fn closest_hit(&self, origin: V3, dir: V3, tmax: f64) -> Option<Hit> {
+        self.intersect(&Ray { origin, dir, tmin: 0.0, tmax })
+    }
+
+    /// Whether anything is hit with `0 ≤ t ≤ tmax` (stops at the first hit found).
+    pub fn any_hit(&self, origin: V3, dir: V3, tmax: f64) -> bool {
+        self.occluded(&Ray { origin, dir, tmin: 0.0, tmax })
+    }
+
+    /// The `f32` obvhs ray, or `None` for a degenerate query.
+    fn oray(&self, r: &Ray) -> Option<ORay> {
+        let ok = vec3::is_finite(r.origin)
+            && vec3::is_finite(r.dir)
+            && vec3::norm2(r.dir) > 0.0
+            && !r.tmin.is_nan()
+            && !r.tmax.is_nan()
+            && r.tmin <= r.tmax
+            && !self.prim_tris.is_empty();
+        ok.then(|| {
+            let d = Vec3A::new(r.dir[0] as f32, r.dir[1] as f32, r.dir[2] as f32);
+            ORay::new(to_f32(r.origin, self.centre), d, r.tmin.max(0.0) as f32, r.tmax as f32)
+        })
+    }
+
+    /// Closest hit of a ray with a `[tmin, tmax]` range.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let oray = self.oray(ray)?;
+        let mut best_t = f32::INFINITY;
+        let mut best_prim = u32::MAX;
+        let mut shear = Shear::new(&oray);
+        let mut traverse_ray = oray;
+        let mut state = self.cwbvh.new_traversal(oray.direction);
+        let mut node;
+        obvhs::traverse!(
+            self.cwbvh,
+            node,
+            state,
+            node.intersect_ray(&traverse_ray, state.oct_inv4),
+            {
+                let p = state.primitive_id;
+                let t = shear.intersect(&self.prim_tris[p as usize]);
+                if t < best_t
+                    || (t == best_t
+                        && t.is_finite()
+                        && self.prim_ids[p as usize] < self.prim_ids[best_prim as usize])
+                {
+                    best_t = t;
+                    best_prim = p;
+                    traverse_ray.tmax = t;
+                    shear.tmax = t;
+                }
+            }
+        );
+        if best_prim == u32::MAX {
+            return None;
+        }
+        let tri = self.prim_ids[best_prim as usize];
+        let (t, bary) =
+            refine_hit(self.corners[tri as usize], ray.origin, ray.dir).unwrap_or_else(|| {
+                let b = self.prim_tris[best_prim as usize].compute_barycentric(&oray);
+                (best_t as f64, [1.0 - (b.x + b.y) as f64, b.x as f64, b.y as f64])
+            });
+        Some(Hit { triangle: tri, t, barycentric: bary })
+    }
+
+    /// Whether a ray with a `[tmin, tmax]` range hits anything.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let Some(oray) = self.oray(ray) else { return false };
+        let shear = Shear::new(&oray);
+        let mut state = self.cwbvh.new_traversal(oray.direction);
+        let mut node;
+        let mut hit = false;
+        obvhs::traverse!(self.cwbvh, node, state, node.intersect_ray(&oray, state.oct_inv4), {
+            if shear.intersect(&self.prim_tris[state.primitive_id as usize]).is_finite() {
+                hit = true;
+                break;
+            }
+        });
+        hit
+    }
+
+    /// [`Bvh::intersect`] for many rays, in parallel (deterministic).
+    pub fn intersect_many(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
+        rays.par_iter().with_min_len(256).map(|r| self.intersect(r)).collect()
+    }
+
+    /// [`Bvh::occluded`] for many rays, in parallel (deterministic).
+    pub fn occluded_many(&self, rays: &[Ray]) -> Vec<bool> {
+        rays.par_iter().with_min_len(256).map(|r| self.occluded(r)).collect()
+    }
+
+    /// The closest surface point to `p` (ties to the lower triangle index); `None` for an
+    /// empty BVH or a non-finite `p`.
+    pub fn closest_point(&self, p: V3) -> Option<ClosestPoint> {
+        if self.nodes2.is_empty() || !vec3::is_finite(p) {
+            return None;
+        }
+        let q = vec3::sub(p, self.centre);
+        let mut best: Option<ClosestPoint> = None;
+        let mut best_d2 = f64::INFINITY;
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        stack.push((0, self.box_dist2(0, q)));
+        while let Some((ni, d2)) = stack.pop() {
+            if d2 > best_d2 {
+                continue;
+            }
+            let node = &self.nodes2[ni as usize];
+            if node.is_leaf() {
+                let start = node.first_index as usize;
+                for &tri in &self.prim_ids2[start..start + node.prim_count as usize] {
+                    let c = self.corners[tri as usize];
+                    let (cp, bary) = closest_point_on_triangle(p, c);
+                    let dd = vec3::norm2(vec3::sub(cp, p));
+                    let better =
+                        dd < best_d2 || (dd == best_d2 && best.is_some_and(|b| tri < b.triangle));
+                    if better {
+                        best_d2 = dd;
+                        best = Some(ClosestPoint {
+                            triangle: tri,
+                            barycentric: bary,
+                            point: cp,
+                            distance: dd.sqrt(),
+                        });
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.first_index, node.first_index + 1);
+            let (da, db) = (self.box_dist2(a, q), self.box_dist2(b, q));
+            // Push the farther child first so the nearer one is explored first.
+            let (near, far) = if da <= db { ((a, da), (b, db)) } else { ((b, db), (a, da)) };
+            if far.1 <= best_d2 {
+                stack.push(far);
+            }
+            if near.1 <= best_d2 {
+                stack.push(near);
+            }
+        }
+        best
+    }
+
+    /// [`Bvh::closest_point`] for many points, in parallel (deterministic).
+    pub fn closest_points(&self, points: &[V3]) -> Vec<Option<ClosestPoint>> {
+        points.par_iter().with_min_len(64).map(|&p| self.closest_point(p)).collect()
+    }
+
+    /// Squared distance from the translated point `q` to node `ni`'s box, made
+    /// conservative for the `f32` rounding of the box.
+    #[inline]
+    fn box_dist2(&self, ni: u32, q: V3) -> f64 {
+        let bb = self.nodes2[ni as usize].aabb();
+        let (mn, mx) = (bb.min, bb.max);
+        let mut d2 = 0.0;
+        for k in 0..3 {
+            let lo = mn[k] as f64 - self.box_slack;
+            let hi = mx[k] as f64 + self.box_slack;
+            let d = if q[k] < lo {
+                lo - q[k]
+            } else if q[k] > hi {
+                q[k] - hi
+            } else {
+                0.0
+            };
+            d2 += d * d;
+        }
+        d2
+    }
+}
+
+/// `f64` Möller–Trumbore without rejection: `(t, barycentric)` of the ray against the
+/// plane of the triangle, barycentrics clamped into the triangle; `None` when the ray is
+/// parallel to a (near) degenerate triangle.
+fn refine_hit(c: [V3; 3], o: V3, d: V3) -> Option<(f64, [f64; 3])> {
+    let e1 = vec3::sub(c[1], c[0]);
+    let e2 = vec3::sub(c[2], c[0]);
+    let pv = vec3::cross(d, e2);
+    let det = vec3::dot(e1, pv);
+    if det.is_nan() || det.abs() <= 1e-300 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let tv = vec3::sub(o, c[0]);
+    let u = vec3::dot(tv, pv) * inv;
+    let qv = vec3::cross(tv, e1);
+    let v = vec3::dot(d, qv) * inv;
+    let t = vec3::dot(e2, qv) * inv;
+    let mut b = [1.0 - u - v, u, v].map(|x| x.clamp(0.0, 1.0));
+    let s = b[0] + b[1] + b[2];
+    if !(s > 0.0 && t.is_finite()) {
+        return None;
+    }
+    b = b.map(|x| x / s);
+    Some((t, b))
+}
+
+/// Closest point on triangle `c` to `p` and its barycentric coordinates (Ericson 2005,
+/// §5.1.5, by Voronoi regions); degenerate triangles fall back to their edges.
+pub fn closest_point_on_triangle(p: V3, c: [V3; 3]) -> (V3, [f64; 3]) {
+    let [a, b, cc] = c;
+    let ab = vec3::sub(b, a);
+    let ac = vec3::sub(cc, a);
+    let ap = vec3::sub(p, a);
+    let d1 = vec3::dot(ab, ap);
+    let d2 = vec3::dot(ac, ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, [1.0, 0.0, 0.0]);
+    }
+    let bp = vec3::sub(p, b);
+    let d3 = vec3::dot(ab, bp);
+    let d4 = vec3::dot(ac, bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0 {
+        let v = d1 / (d1 - d3);
+        return (vec3::add(a, vec3::scale(ab, v)), [1.0 - v, v, 0.0]);
+    }
+    let cp = vec3::sub(p, cc);
+    let d5 = vec3::dot(ab, cp);
+    let d6 = vec3::dot(ac, cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return (cc, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0 {
+        let w = d2 / (d2 - d6);
+        return (vec3::add(a, vec3::scale(ac, w)), [1.0 - w, 0.0, w]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 && (d4 - d3) + (d5 - d6) > 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (vec3::add(b, vec3::scale(vec3::sub(cc, b), w)), [0.0, 1.0 - w, w]);
+    }
+    let denom = va + vb + vc;
+    if denom > 0.0 && denom.is_finite() {
+        let v = vb / denom;
+        let w = vc / denom;
+        let q = vec3::add(a, vec3::add(vec3::scale(ab, v), vec3::scale(ac, w)));
+        return (q, [1.0 - v - w, v, w]);
+    }
+    // Degenerate triangle: the best of its three edges.
+    let seg = |x: V3, y: V3| {
+        let d = vec3::sub(y, x);
+        let l2 = vec3::norm2(d);
+        let s = if l2 > 0.0 { (vec3::dot(vec3::sub(p, x), d) / l2).clamp(0.0, 1.0) } else { 0.0 };
+        (vec3::add(x, vec3::scale(d, s)), s)
+    };
+    let cands = [(seg(a, b), 0usize), (seg(b, cc), 1), (seg(cc, a), 2)];
+    let mut best = (a, [1.0, 0.0, 0.0]);
+    let mut best_d = f64::INFINITY;
+    for ((q, s), k) in cands {
+        let d = vec3::norm2(vec3::sub(q, p));
+        if d < best_d {
+            best_d = d;
+            let mut bary = [0.0; 3];
+            bary[k] = 1.0 - s;
+            bary[(k + 1) % 3] = s;
+            best = (q, bary);
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+#[path = "bvh_tests.rs"]
+mod tests;

@@ -1,0 +1,132 @@
+//! Geometry benchmarks (procedural by default; no files needed).
+//!
+//! `cargo run --release -p fieldtex-mesh --example bench_geometry -- [MESH.obj] [--refine N]`
+//!
+//! Without a path the workload is a torus refined once by 1→4 subdivision to
+//! 388,128 triangles (the size of the refined horse of the benchmark suite). With a
+//! path, the OBJ's `v`/`f` lines are read (polygons fanned) and refined `N` times
+//! (default 0). Prints `BENCH name key=value` lines.
+
+use fieldtex_core::rng::hash_unit;
+use fieldtex_core::vec3;
+use fieldtex_linalg::SparseMatrix;
+use fieldtex_mesh::primitives::{subdivide_midpoint, torus};
+use fieldtex_mesh::{Bvh, CotanOptions, Ray, TriMesh, VertexAreaKind, cotan_laplacian_and_mass};
+use std::time::Instant;
+
+fn parse_obj(text: &str) -> TriMesh {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.take(3).filter_map(|s| s.parse().ok()).collect();
+                if c.len() == 3 {
+                    positions.push([c[0], c[1], c[2]]);
+                }
+            }
+            Some("f") => {
+                let n = positions.len() as i64;
+                let idx: Vec<u32> = it
+                    .filter_map(|s| s.split('/').next()?.parse::<i64>().ok())
+                    .map(|i| if i < 0 { (n + i) as u32 } else { (i - 1) as u32 })
+                    .collect();
+                for k in 1..idx.len().saturating_sub(1) {
+                    triangles.push([idx[0], idx[k], idx[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
+    f(); // warm-up
+    let mut t: Vec<f64> = (0..runs)
+        .map(|_| {
+            let s = Instant::now();
+            f();
+            s.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[runs / 2]
+}
+
+/// Rays from a sphere of 1.5 bounding-box diagonals around the mesh towards random points
+/// of the inner 30 % of the box (most hit the surface).
+fn random_rays(mesh: &TriMesh, n: u64) -> Vec<Ray> {
+    let bb = mesh.bounding_box().unwrap();
+    let (c, r) = (bb.center(), bb.diagonal());
+    let unit = |stage: &str, i: u64| {
+        let z = 2.0 * hash_unit(7, stage, 2 * i) - 1.0;
+        let a = std::f64::consts::TAU * hash_unit(7, stage, 2 * i + 1);
+        let s = (1.0 - z * z).sqrt();
+        [s * a.cos(), s * a.sin(), z]
+    };
+    (0..n)
+        .map(|i| {
+            let o = vec3::add(c, vec3::scale(unit("origin", i), 1.5 * r));
+            let half = vec3::scale(vec3::sub(bb.max, bb.min), 0.3 * hash_unit(7, "len", i));
+            let u = unit("target", i);
+            let t = vec3::add(c, [u[0] * half[0], u[1] * half[1], u[2] * half[2]]);
+            Ray::new(o, vec3::normalize(vec3::sub(t, o)).unwrap())
+        })
+        .collect()
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut path = None;
+    let mut refine = 0usize;
+    let mut i = 0;
+    while i < args.len() {
+        if args[i] == "--refine" {
+            refine = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(1);
+            i += 2;
+        } else {
+            path = Some(args[i].clone());
+            i += 1;
+        }
+    }
+    let mut mesh = match &path {
+        Some(p) => parse_obj(&std::fs::read_to_string(p).expect("cannot read the OBJ file")),
+        None => subdivide_midpoint(&torus(2.0, 0.7, 311, 156)),
+    };
+    for _ in 0..refine {
+        mesh = subdivide_midpoint(&mesh);
+    }
+    mesh.validate().expect("invalid mesh");
+    println!("mesh: {} vertices, {} triangles", mesh.n_vertices(), mesh.n_triangles());
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    pool.install(|| {
+        let ms = median_ms(11, || {
+            let (l, m, _) = cotan_laplacian_and_mass(
+                &mesh,
+                &CotanOptions::default(),
+                VertexAreaKind::Barycentric,
+            )
+            .unwrap();
+            std::hint::black_box((l, SparseMatrix::from_diagonal(&m)));
+        });
+        println!("BENCH cotan_mass_388k median_ms={ms:.2}");
+        let ms = median_ms(5, || {
+            std::hint::black_box(Bvh::build(&mesh).unwrap());
+        });
+        println!("BENCH bvh_build median_ms={ms:.2}");
+        let bvh = Bvh::build(&mesh).unwrap();
+        let rays = random_rays(&mesh, 1_000_000);
+        let mut hits = 0;
+        let ms = median_ms(3, || {
+            hits = bvh.intersect_many(&rays).iter().filter(|h| h.is_some()).count();
+        });
+        println!("hit fraction {:.3}", hits as f64 / rays.len() as f64);
+        println!("BENCH rays_per_s value={:.0}", rays.len() as f64 / (ms * 1e-3));
+        let ms = median_ms(3, || {
+            std::hint::black_box(bvh.occluded_many(&rays));
+        });
+        println!("BENCH any_hit_rays_per_s value={:.0}", rays.len() as f64 / (ms * 1e-3));
+    });
+}

@@ -1,0 +1,195 @@
+//! BVH tests against brute force.
+
+use super::*;
+use crate::primitives::{icosphere, torus};
+use crate::test_meshes::{categories, load_obj};
+use fieldtex_core::rng::hash_unit;
+
+fn brute_hit(mesh: &TriMesh, o: V3, d: V3, tmax: f64) -> Option<(u32, f64)> {
+    let mut best: Option<(u32, f64)> = None;
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        let c = t.map(|i| mesh.positions[i as usize]);
+        let e1 = vec3::sub(c[1], c[0]);
+        let e2 = vec3::sub(c[2], c[0]);
+        let pv = vec3::cross(d, e2);
+        let det = vec3::dot(e1, pv);
+        if det.abs() < 1e-14 {
+            continue;
+        }
+        let tv = vec3::sub(o, c[0]);
+        let u = vec3::dot(tv, pv) / det;
+        let qv = vec3::cross(tv, e1);
+        let v = vec3::dot(d, qv) / det;
+        let tt = vec3::dot(e2, qv) / det;
+        if u >= 0.0
+            && v >= 0.0
+            && u + v <= 1.0
+            && tt >= 0.0
+            && tt <= tmax
+            && best.is_none_or(|b| tt < b.1)
+        {
+            best = Some((f as u32, tt));
+        }
+    }
+    best
+}
+
+fn random_unit(seed: u64, i: u64) -> V3 {
+    let z = 2.0 * hash_unit(seed, "bvh-test-z", i) - 1.0;
+    let a = 2.0 * std::f64::consts::PI * hash_unit(seed, "bvh-test-a", i);
+    let r = (1.0 - z * z).sqrt();
+    [r * a.cos(), r * a.sin(), z]
+}
+
+/// Rays from a sphere of radius 3 around the mesh towards random inner points.
+fn rays(mesh: &TriMesh, n: u64) -> Vec<Ray> {
+    let bb = mesh.bounding_box().unwrap();
+    let (c, r) = (bb.center(), bb.diagonal());
+    (0..n)
+        .map(|i| {
+            let o = vec3::add(c, vec3::scale(random_unit(1, i), 1.5 * r));
+            let target = vec3::add(c, vec3::scale(random_unit(2, i), 0.3 * r));
+            Ray::new(o, vec3::sub(target, o))
+        })
+        .collect()
+}
+
+#[test]
+fn closest_hits_match_brute_force() {
+    let mut meshes = vec![icosphere(3), torus(2.0, 0.7, 40, 16)];
+    meshes.extend(load_obj("fandisk.obj"));
+    for m in &meshes {
+        let bvh = Bvh::build(m).unwrap();
+        let rs = rays(m, 300);
+        let hits = bvh.intersect_many(&rs);
+        let mut n_hits = 0;
+        for (r, h) in rs.iter().zip(&hits) {
+            let bf = brute_hit(m, r.origin, r.dir, f64::INFINITY);
+            match (h, bf) {
+                (Some(h), Some((_, t))) => {
+                    n_hits += 1;
+                    assert!((h.t - t).abs() < 1e-6 * t.max(1.0), "t {} vs {t}", h.t);
+                    let c = m.triangle_positions(h.triangle as usize);
+                    let p: V3 = (0..3).fold([0.0; 3], |acc, k| {
+                        vec3::add(acc, vec3::scale(c[k], h.barycentric[k]))
+                    });
+                    let q = vec3::add(r.origin, vec3::scale(r.dir, h.t));
+                    assert!(vec3::norm(vec3::sub(p, q)) < 1e-6 * vec3::norm(r.dir) * h.t.max(1.0));
+                }
+                (None, None) => {}
+                (h, bf) => panic!("bvh {h:?} vs brute force {bf:?}"),
+            }
+            assert_eq!(h.is_some(), bvh.occluded(r));
+        }
+        assert!(n_hits > 100);
+    }
+}
+
+#[test]
+fn ranges_inside_rays_and_bad_queries() {
+    let m = icosphere(3);
+    let bvh = Bvh::build(&m).unwrap();
+    // From the centre every direction hits the sphere near t = 1 (back faces count).
+    let h = bvh.closest_hit([0.0; 3], [0.3, -0.2, 0.9], f64::INFINITY).unwrap();
+    let len = vec3::norm([0.3, -0.2, 0.9]);
+    assert!((h.t * len - 1.0).abs() < 0.02);
+    assert!(bvh.closest_hit([0.0; 3], [0.3, -0.2, 0.9], 0.5 / len).is_none());
+    assert!(!bvh.any_hit([0.0; 3], [0.3, -0.2, 0.9], 0.5 / len));
+    assert!(bvh.any_hit([0.0; 3], [0.3, -0.2, 0.9], 2.0 / len));
+    // tmin skips the first surface: from outside, tmin past the near side hits the far side.
+    // Along the z axis, through vertices (0, 0, ±1) of the icosphere: watertight.
+    let r = Ray::new([0.0, 0.0, 5.0], [0.0, 0.0, -1.0]);
+    let near = bvh.intersect(&r).unwrap();
+    let far = bvh.intersect(&r.with_range(near.t + 0.1, f64::INFINITY)).unwrap();
+    assert!((near.t - 4.0).abs() < 0.02 && (far.t - 6.0).abs() < 0.02);
+    // Degenerate queries.
+    assert!(bvh.closest_hit([0.0; 3], [0.0; 3], 1.0).is_none());
+    assert!(bvh.closest_hit([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], 1.0).is_none());
+    assert!(bvh.closest_point([f64::INFINITY, 0.0, 0.0]).is_none());
+    let empty = Bvh::build(&TriMesh::default()).unwrap();
+    assert!(empty.closest_hit([0.0; 3], [1.0, 0.0, 0.0], 1.0).is_none());
+    assert!(empty.closest_point([0.0; 3]).is_none());
+}
+
+#[test]
+fn closest_points_match_brute_force_over_categories() {
+    let mut all = categories();
+    all.extend(load_obj("defects/narrow_triangles.obj").map(|m| ("narrow", m)));
+    for (name, m) in &all {
+        let bvh = Bvh::build(m).unwrap();
+        let bb = m.bounding_box().unwrap();
+        let (c, r) = (bb.center(), bb.diagonal().min(10.0));
+        for i in 0..100u64 {
+            let p = vec3::add(c, vec3::scale(random_unit(3, i), r * hash_unit(4, "len", i)));
+            let got = bvh.closest_point(p).unwrap();
+            let mut best = f64::INFINITY;
+            for f in 0..m.n_triangles() {
+                let (q, _) = closest_point_on_triangle(p, m.triangle_positions(f));
+                best = best.min(vec3::norm(vec3::sub(q, p)));
+            }
+            assert!(
+                (got.distance - best).abs() <= 1e-9 * (1.0 + best),
+                "{name}: {got:?} vs {best}"
+            );
+            let t = m.triangle_positions(got.triangle as usize);
+            let q: V3 =
+                (0..3).fold([0.0; 3], |a, k| vec3::add(a, vec3::scale(t[k], got.barycentric[k])));
+            assert!(vec3::norm(vec3::sub(q, got.point)) < 1e-9 * (1.0 + r), "{name}");
+        }
+    }
+}
+
+#[test]
+fn far_from_origin_and_deterministic() {
+    let mut m = torus(2.0, 0.7, 40, 16);
+    for p in &mut m.positions {
+        *p = vec3::add(*p, [1.0e6, -2.0e6, 3.0e5]);
+    }
+    let bvh = Bvh::build(&m).unwrap();
+    let rs = rays(&m, 200);
+    for r in &rs {
+        let bf = brute_hit(&m, r.origin, r.dir, f64::INFINITY);
+        let h = bvh.intersect(r);
+        assert_eq!(h.is_some(), bf.is_some());
+        if let (Some(h), Some((_, t))) = (h, bf) {
+            assert!((h.t - t).abs() < 1e-9 * vec3::norm(r.dir).recip() + 1e-7);
+        }
+    }
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| Bvh::build(&m).unwrap().intersect_many(&rs))
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn non_finite_triangles_are_skipped() {
+    let mut m = icosphere(2);
+    m.positions[0] = [f64::NAN, 0.0, 0.0];
+    let bvh = Bvh::build(&m).unwrap();
+    assert_eq!(bvh.n_skipped(), m.triangles.iter().filter(|t| t.contains(&0)).count());
+    assert!(bvh.closest_hit([0.0, 0.0, 5.0], [0.0, 0.0, -1.0], f64::INFINITY).is_some());
+    assert!(bvh.closest_point([0.0, 0.0, 5.0]).is_some());
+    let mut bad = m.clone();
+    bad.triangles.push([0, 1, 1000]);
+    assert!(Bvh::build(&bad).is_err());
+}
+
+#[test]
+fn watertight_on_shared_edges_and_vertices() {
+    // A flat grid hit exactly through its inner vertices and edge midpoints: never a
+    // miss (the outermost boundary is excluded: see the module docs).
+    let m = crate::primitives::grid(8, 8, 1.0, 1.0);
+    let bvh = Bvh::build(&m).unwrap();
+    let mut n = 0;
+    for i in 1..16 {
+        for j in 1..16 {
+            let (x, y) = (i as f64 / 16.0, j as f64 / 16.0);
+            let h = bvh.closest_hit([x, y, 1.0], [0.0, 0.0, -1.0], f64::INFINITY);
+            assert!(h.is_some_and(|h| (h.t - 1.0).abs() < 1e-12), "miss at ({x}, {y})");
+            assert!(bvh.any_hit([x, y, 1.0], [0.0, 0.0, -1.0], 2.0));
+            n += 1;
+        }
+    }
+    assert_eq!(n, 225);
+}
