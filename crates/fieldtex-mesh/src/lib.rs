@@ -44,4 +44,25 @@ pub use principal_curvature::{CurvatureOptions, PrincipalCurvatures, principal_c
 #[cfg(test)]
 mod test_meshes;
 pub use heat_geodesic::{HeatBoundary, HeatGeodesic, HeatGeodesicOptions, SurfacePoint};
+
+// Inspection and repair building blocks (one algorithm per file).
+pub mod boundary_cycles;
+pub mod coincident_vertices;
+mod inspect_text;
+pub mod non_manifold_split;
+pub mod orientation;
+mod repair_steps;
+pub mod triangle_quality;
+pub mod vertex_fans;
+pub mod vertex_welding;
+
+pub use inspect::{InspectOptions, InspectReport, inspect};
+pub use repair::{RepairChange, RepairOptions, RepairResult, repair};
+
+#[cfg(test)]
+mod inspect_tests;
+#[cfg(test)]
+mod repair_tests;
+#[cfg(test)]
+mod test_fixtures;
 pub use bvh::{Bvh, ClosestPoint, Hit, Ray};
