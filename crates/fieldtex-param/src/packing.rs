@@ -167,19 +167,35 @@ impl Grid {
         let nrows = grown.rows.len() as i64;
         let mut feasible: Vec<(i64, i64)> = Vec::new();
         let mut scratch: Vec<(i64, i64)> = Vec::new();
-        let mut hint = 0i64;
-        'oy: for oy in oy_lo..=oy_hi {
+        // Atlas row where the last test failed: the obstacle there usually blocks the
+        // next offset too, one chart row lower.
+        let mut hint_y = i64::MIN;
+        let mut oy = oy_lo - 1;
+        'oy: loop {
+            oy += 1;
+            if oy > oy_hi {
+                break;
+            }
             feasible.clear();
             feasible.push((ox_lo, ox_hi));
-            // Rows in any order give the same set; start where the last test failed.
+            // Rows in any order give the same set; start at the last obstacle.
+            let r0 = hint_y - (oy + grown.y0);
+            let hint = if (0..nrows).contains(&r0) { r0 } else { 0 };
             for k in 0..nrows {
                 let r = (hint + k) % nrows;
                 let y = oy + grown.y0 + r;
                 if y < 0 || y >= self.height {
                     continue;
                 }
-                if grown.need[r as usize] > self.max_free[y as usize] {
-                    hint = r;
+                let need = grown.need[r as usize];
+                if need > self.max_free[y as usize] {
+                    // Skip to the next offset where this row has a long enough run.
+                    let mut y2 = y + 1;
+                    while y2 < self.height && need > self.max_free[y2 as usize] {
+                        y2 += 1;
+                    }
+                    oy += y2 - y - 1;
+                    hint_y = y2;
                     continue 'oy;
                 }
                 let occ = &self.rows[y as usize];
@@ -211,7 +227,7 @@ impl Grid {
                     }
                     std::mem::swap(&mut feasible, &mut scratch);
                     if feasible.is_empty() {
-                        hint = r;
+                        hint_y = y;
                         continue 'oy;
                     }
                 }
