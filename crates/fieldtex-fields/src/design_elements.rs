@@ -168,3 +168,37 @@ impl Stroke {
         self
     }
 }
+
+/// Rotation angles (radians) that make each wedge/trisector agree, near itself, with the
+/// zero-pole model of fingerprint orientation (Sherlock & Monro 1993):
+/// `2θ(z) = 2θ₀ + Σ_wedges arg(z − c) − Σ_trisectors arg(z − d)`, `θ₀ = background`.
+/// For a wedge `α_k = θ₀ + ½ Σ_{j≠k} s_j arg(p_k − p_j)`, for a trisector the negative
+/// (`s = +1` wedge, `−1` trisector); other kinds get 0. Uses the `x, y` of positions
+/// (plane designs). Rotations chosen this way avoid the extra singularities that
+/// mutually inconsistent rotations can force (paper D, §5 "Limitations").
+pub fn zero_pole_angles(singularities: &[Singularity], background: f64) -> Vec<f64> {
+    let sign = |k: SingularityKind| match k {
+        SingularityKind::Wedge => 1.0,
+        SingularityKind::Trisector => -1.0,
+        _ => 0.0,
+    };
+    singularities
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let sk = sign(s.kind);
+            if sk == 0.0 {
+                return 0.0;
+            }
+            let mut a = background;
+            for (j, o) in singularities.iter().enumerate() {
+                if j != k {
+                    a += 0.5
+                        * sign(o.kind)
+                        * (s.position[1] - o.position[1]).atan2(s.position[0] - o.position[0]);
+                }
+            }
+            sk * a
+        })
+        .collect()
+}

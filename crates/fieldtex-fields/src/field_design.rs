@@ -2,43 +2,49 @@
 //! of tangent vector fields") with the natural boundary term of Liu et al. (paper D,
 //! §2.1–2.2), as an editable object for interactive use.
 //!
-//! Unknown: a 1-form `ω` (`#E`). Energy (weighted least squares):
+//! Unknown: a 1-form `ω` (`#E`). Notation: `Dω` is the integrated divergence per vertex
+//! *with the boundary flux* ([`Dec::divergence_triplets`], Fisher's free boundary),
+//! `d1 ω` the curl per face, `ωᵀBω` the natural boundary term
+//! ([`crate::natural_boundary`]), so that
+//! `Q_β(ω) = ‖Dω‖²_{⋆0⁻¹} + ‖d1 ω‖²_{⋆2} − β ωᵀBω` is the Dirichlet energy `∫|∇u|²` for
+//! `β = 1` and Fisher et al.'s div² + curl² energy for `β = 0` (the ablation,
+//! `natural_boundary: false`). Strokes give edge constraints `w_e (ω_e − t_e)²`
+//! ([`crate::stroke_constraints`]). `ε ‖·‖²_diag` (default `ε = 1e-6`, relative to the
+//! matrix diagonal) removes the kernel of constant fields.
 //!
-//! `E(ω) = w_s [ ‖Dω − S‖²_{⋆0⁻¹} + ‖d1 ω − C‖²_{⋆2} − β ωᵀBω ] + Σ_e w_e (ω_e − t_e)² + ε ωᵀ diag(L) ω`
+//! Singularities, two models ([`SingularityModel`]):
+//! - **`ModelField` (default).** Every singularity has an exact model 1-form
+//!   ([`crate::singular_model_field`]); `ω*` is their sum. The energy is
+//!   `E(ω) = w_s Q_β(ω − ω*) + ε‖ω − ω*‖² + Σ_e w_e (ω_e − t_e)²`, i.e. the paper's least
+//!   squares with prescribed divergence `S = Dω*` and curl `C = d1 ω*`, the natural
+//!   boundary term and the regularisation measured on the deviation from `ω*`. Without
+//!   strokes the solution is exactly `ω*` (the singularities, no constant added); strokes
+//!   add the Dirichlet-smoothest correction that follows them — this is where the
+//!   natural boundary matters (with `β = 0` the correction is free in all harmonic
+//!   directions). A source's `S` is concentrated at it, a vortex's `C` is exactly a point
+//!   curl on its triangle, and saddles/trisectors, which have no point divergence or
+//!   curl, get their smooth `−2c/(z−p)²` densities.
+//! - **`PointDelta`** (the paper's literal form, kept for paper D Fig. 2):
+//!   `E(ω) = w_s (‖Dω − S‖² + ‖d1ω − C‖² − β ωᵀBω) + ε‖ω‖² + strokes` with point
+//!   divergence `S = 2π·Re c` split barycentrically over the three vertices of the
+//!   containing triangle and point curl `C = 2π·Im c` on the triangle. Saddles and
+//!   trisectors still use their model field.
 //!
-//! - `Dω` is the integrated divergence per vertex *with the boundary flux*
-//!   ([`Dec::divergence_triplets`], Fisher's free boundary), `d1 ω` the curl per face;
-//!   `S` and `C` are the prescribed divergence (sources/sinks) and curl (vortices).
-//! - `ωᵀBω` is the natural boundary term ([`crate::natural_boundary`]); with `β = 1` the
-//!   first bracket is the Dirichlet energy `∫|∇u|²` of the field. `β = 0`
-//!   (`natural_boundary: false`) is Fisher et al.'s energy, kept as an ablation.
-//! - `w_e, t_e` are the stroke constraints ([`crate::stroke_constraints`]).
-//! - `ε diag(L)` (default `ε = 1e-6`) pins the free constant fields (the kernel of the
-//!   Dirichlet energy on a flat patch) to the smallest-norm choice.
+//! Normal equations `A ω = b`:
+//! `A = w_s (Dᵀ⋆0⁻¹D + d1ᵀ⋆2 d1 − βB) + ε diag + diag(w_e)` ([`crate::design_matrix`]),
+//! `b = w_s (Dᵀ⋆0⁻¹ S + d1ᵀ⋆2 C) − w_s β B ω* + ε diag ω* + (w_e t_e)` — the paper's
+//! `∗dS + ∗δC + ZᵀWU_Z` plus the two deviation terms (`ω* = 0` for `PointDelta` poles).
 //!
-//! Normal equations: `A ω = b` with
-//! `A = w_s (Dᵀ⋆0⁻¹D + d1ᵀ⋆2 d1 − βB) + ε diag + diag(w_e)` and
-//! `b = w_s (Dᵀ⋆0⁻¹ S + d1ᵀ⋆2 C) + (w_e t_e)` — the paper's `∗dS + ∗δC + ZᵀWU_Z`.
-//!
-//! Singularities enter **only** `S` and `C` (so only `b`): with the default
-//! [`SingularityModel::ModelField`], `S` and `C` are the discrete divergence and curl
-//! of the exact 1-forms of the singularities' model fields
-//! ([`crate::singular_model_field`]): a vortex's curl is exactly a point curl on its
-//! triangle, a source's divergence is concentrated on the vertices around it, and
-//! saddles/trisectors (which have no point divergence or curl) get their smooth
-//! `−2c/(z−p)²` densities. [`SingularityModel::PointDelta`] is the literal point form
-//! (divergence `2π·Re c` split barycentrically over the three vertices of the containing
-//! triangle, curl `2π·Im c` on the triangle; saddles still use their model field).
-//! Deviation from the paper: the paper builds a saddle/trisector from direction
-//! constraints on a vertex one-ring, which changes `A`; here every singularity keeps `A`
-//! fixed, so moving any singularity is one back-substitution.
+//! Singularities enter only `b`. Deviation from the paper: there, a trisector is built
+//! from direction constraints on a vertex one-ring, which changes `A`; here every
+//! singularity keeps `A` fixed, so moving any singularity is one back-substitution (its
+//! model 1-form is recomputed, the others are cached).
 //!
 //! Factor once: [`FieldDesign::new`] assembles `A` and factors it (symbolic analysis
-//! kept). Editing singularities only marks `b` dirty. Strokes change the diagonal of
-//! `A`: the current implementation refactors numerically with the kept symbolic
-//! analysis on the next [`FieldDesign::solve`] (TODO: use the rank-1
-//! `Cholesky::update` of `fieldtex-linalg` once it lands — each stroke edge is a rank-1
-//! term `w_e e_e e_eᵀ`).
+//! kept). Strokes change the diagonal of `A`: the next [`FieldDesign::solve`] refactors
+//! numerically with the kept symbolic analysis (TODO: switch to the rank-1
+//! `Cholesky::update` of `fieldtex-linalg` once it lands and measure — each stroke edge
+//! is a rank-1 term `w_e e_e e_eᵀ`, a typical stroke touches a few hundred edges).
 
 use std::sync::Arc;
 
@@ -50,6 +56,7 @@ use fieldtex_mesh::TriMesh;
 use crate::FieldsError;
 use crate::dec::Dec;
 use crate::design_elements::{Singularity, SingularityKind, Stroke, Symmetry};
+use crate::design_matrix::assemble_design_matrix;
 use crate::domain::{Frame, PlaneGrid, locate_in_mesh, projected_frames};
 use crate::natural_boundary::boundary_term_triplets;
 use crate::singular_model_field::{ModelField, ModelKind};
@@ -80,7 +87,7 @@ pub struct FieldDesignOptions {
     /// Global stroke weight, multiplied by each stroke's own weight. Default 4.
     pub stroke_weight: f64,
     /// `ε`, relative Tikhonov regularisation (times the diagonal of the smoothness
-    /// matrix). Default `1e-6`.
+    /// matrix; on the deviation from the model fields). Default `1e-6`.
     pub regularization: f64,
     /// How singularities enter. Default [`SingularityModel::ModelField`].
     pub singularity_model: SingularityModel,
@@ -183,8 +190,13 @@ pub struct FieldDesign {
     d1: SparseMatrix,
     d1_t: SparseMatrix,
     base: SparseMatrix,
+    /// `B` of the natural boundary term (`None` when it is off).
+    boundary: Option<SparseMatrix>,
+    /// `ε diag` of the regularisation (`#E`).
+    regularization_diag: Vec<f64>,
     symbolic: SymbolicCholesky,
-    factor: Cholesky,
+    /// Numeric factor of `A` with `factored_stroke_diag` (made lazily on the first solve).
+    factor: Option<Cholesky>,
     factored_stroke_diag: Vec<f64>,
     singularities: Vec<Option<SingularityEntry>>,
     strokes: Vec<Option<(Stroke, Vec<EdgeConstraint>)>>,
@@ -204,9 +216,11 @@ impl std::fmt::Debug for FieldDesign {
 }
 
 impl FieldDesign {
-    /// Builds the operators, assembles and factors the design matrix (the expensive,
-    /// once-per-domain step). On a mesh, also computes the per-triangle reference
-    /// frames as the design solution with one fixed vector (paper D, §3).
+    /// Builds the operators, assembles the design matrix and analyses its sparsity
+    /// pattern (the expensive, once-per-domain step); the numeric factorisation follows
+    /// on the first solve, with the strokes added by then. On a mesh, the matrix is
+    /// factored now to compute the per-triangle reference frames as the design solution
+    /// with one fixed vector (paper D, §3).
     pub fn new(
         domain: Domain,
         symmetry: Symmetry,
@@ -237,9 +251,18 @@ impl FieldDesign {
         let div_t = div.transpose();
         let d1 = dec.d1();
         let d1_t = d1.transpose();
-        let base = assemble_design_matrix(&dec, &div_t, &options)?;
+        let boundary = if options.natural_boundary && options.boundary_weight > 0.0 {
+            Some(SparseMatrix::from_triplets(
+                dec.n_edges(),
+                dec.n_edges(),
+                &boundary_term_triplets(&dec),
+            )?)
+        } else {
+            None
+        };
+        let (base, regularization_diag) =
+            assemble_design_matrix(&dec, &div_t, boundary.as_ref(), &options)?;
         let symbolic = SymbolicCholesky::analyze(&base)?;
-        let factor = Cholesky::factor_with(&symbolic, &base)?;
         let area: f64 = dec.face_areas.iter().sum();
         let reference_radius = 0.25 * area.sqrt();
         let mut design = Self {
@@ -255,8 +278,10 @@ impl FieldDesign {
             d1,
             d1_t,
             base,
+            boundary,
+            regularization_diag,
             symbolic,
-            factor,
+            factor: None,
             singularities: Vec::new(),
             strokes: Vec::new(),
             warnings,
@@ -265,6 +290,7 @@ impl FieldDesign {
         design.frames = if design.plane.is_some() {
             vec![([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]); design.dec.n_faces()]
         } else {
+            design.refactor_if_needed()?;
             design.reference_frames()?
         };
         Ok(design)
@@ -296,7 +322,7 @@ impl FieldDesign {
                 b
             })
             .collect();
-        let cols = self.factor.solve_many(&basis)?;
+        let cols = self.factor.as_ref().expect("factored by the caller").solve_many(&basis)?;
         let g: Vec<[f64; 3]> = (0..3).map(|j| std::array::from_fn(|k| cols[k][edges[j]])).collect();
         let lambda = solve3([g[0], g[1], g[2]], [targets[0], targets[1], targets[2]]);
         let mut omega = vec![0.0; dec.n_edges()];
@@ -331,7 +357,7 @@ impl FieldDesign {
     pub fn warnings(&self) -> &Warnings {
         &self.warnings
     }
-    /// Number of numeric refactorisations done for stroke edits so far.
+    /// Number of numeric factorisations done so far (the first one included).
     pub fn refactor_count(&self) -> usize {
         self.refactor_count
     }
@@ -540,12 +566,13 @@ impl FieldDesign {
         d
     }
 
-    /// Brings the factorisation up to date with the strokes (no-op when unchanged).
+    /// Brings the numeric factorisation up to date with the strokes (no-op when it is;
+    /// the first call makes it). Reuses the symbolic analysis.
     pub fn refactor_if_needed(&mut self) -> Result<(), FieldsError> {
         let d = self.stroke_diagonal();
-        if d != self.factored_stroke_diag {
+        if self.factor.is_none() || d != self.factored_stroke_diag {
             let a = self.base.add_diagonal(&d);
-            self.factor = Cholesky::factor_with(&self.symbolic, &a)?;
+            self.factor = Some(Cholesky::factor_with(&self.symbolic, &a)?);
             self.factored_stroke_diag = d;
             self.refactor_count += 1;
         }
@@ -606,6 +633,19 @@ impl FieldDesign {
             *cf = ws * (*cf + c_point[f]) * self.dec.star2[f];
         }
         let mut b = self.div_t.mul_vec(&s);
+        // The boundary term and the regularisation act on the deviation ω − ω* too:
+        // b += −w_s β B ω* + ε diag ω*.
+        if any_model {
+            if let Some(bm) = &self.boundary {
+                let beta = ws * self.options.boundary_weight;
+                for (bi, v) in b.iter_mut().zip(bm.mul_vec(&model)) {
+                    *bi -= beta * v;
+                }
+            }
+            for ((bi, r), m) in b.iter_mut().zip(&self.regularization_diag).zip(&model) {
+                *bi += r * m;
+            }
+        }
         for (bi, ci) in b.iter_mut().zip(self.d1_t.mul_vec(&c)) {
             *bi += ci;
         }
@@ -622,63 +662,11 @@ impl FieldDesign {
     pub fn solve(&mut self) -> Result<SolvedField, FieldsError> {
         self.refactor_if_needed()?;
         let b = self.right_hand_side();
-        let (one_form, residual) = self.factor.solve_with_residual(&b)?;
+        let factor = self.factor.as_ref().expect("refactor_if_needed made the factor");
+        let (one_form, residual) = factor.solve_with_residual(&b)?;
         let face_vectors = self.dec.face_vectors(&one_form);
         Ok(SolvedField { symmetry: self.symmetry, one_form, face_vectors, residual })
     }
-}
-
-/// `A = w_s (Dᵀ⋆0⁻¹D + d1ᵀ⋆2 d1 − βB) + ε diag(·)`, exactly symmetric (every
-/// off-diagonal contribution is pushed with its mirror, so duplicates sum identically).
-fn assemble_design_matrix(
-    dec: &Dec,
-    div_t: &SparseMatrix,
-    options: &FieldDesignOptions,
-) -> Result<SparseMatrix, FieldsError> {
-    let ws = options.smoothness_weight;
-    let ne = dec.n_edges();
-    let mut t: Vec<(usize, usize, f64)> =
-        Vec::with_capacity(40 * dec.n_vertices() + 9 * dec.n_faces());
-    let push_outer = |t: &mut Vec<(usize, usize, f64)>, entries: &[(usize, f64)], w: f64| {
-        for (p, &(ep, vp)) in entries.iter().enumerate() {
-            t.push((ep, ep, w * vp * vp));
-            for &(eq, vq) in &entries[p + 1..] {
-                let v = w * vp * vq;
-                t.push((ep, eq, v));
-                t.push((eq, ep, v));
-            }
-        }
-    };
-    // Divergence: column v of Dᵀ is row v of D (sorted edges, merged duplicates).
-    let (cp, ri, vals) = (div_t.col_ptr(), div_t.row_idx(), div_t.values());
-    let mut row: Vec<(usize, f64)> = Vec::with_capacity(32);
-    for v in 0..dec.n_vertices() {
-        row.clear();
-        row.extend((cp[v]..cp[v + 1]).map(|k| (ri[k], vals[k])));
-        push_outer(&mut t, &row, ws / dec.star0[v]);
-    }
-    for f in 0..dec.n_faces() {
-        let entries: Vec<(usize, f64)> = (0..3)
-            .map(|k| {
-                (dec.topology.face_edges[f][k] as usize, dec.topology.face_edge_signs[f][k] as f64)
-            })
-            .collect();
-        push_outer(&mut t, &entries, ws * dec.star2[f]);
-    }
-    if options.natural_boundary && options.boundary_weight > 0.0 {
-        let beta = ws * options.boundary_weight;
-        for (i, j, v) in boundary_term_triplets(dec) {
-            t.push((i, j, -beta * v));
-        }
-    }
-    let l = SparseMatrix::from_triplets(ne, ne, &t)?;
-    let diag = l.diagonal();
-    let mean = diag.iter().sum::<f64>() / ne.max(1) as f64;
-    let reg: Vec<f64> = diag
-        .iter()
-        .map(|d| options.regularization * d.max(1e-3 * mean).max(f64::MIN_POSITIVE))
-        .collect();
-    Ok(l.add_diagonal(&reg))
 }
 
 /// Solves a 3×3 system by Cramer's rule (zero where singular).

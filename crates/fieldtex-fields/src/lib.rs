@@ -27,6 +27,7 @@
 pub mod dec;
 pub mod design_elements;
 pub mod design_file;
+pub mod design_matrix;
 pub mod domain;
 pub mod error;
 pub mod field_design;
@@ -38,7 +39,7 @@ pub mod singularity_index;
 pub mod stroke_constraints;
 
 pub use dec::Dec;
-pub use design_elements::{Singularity, SingularityKind, Stroke, Symmetry};
+pub use design_elements::{Singularity, SingularityKind, Stroke, Symmetry, zero_pole_angles};
 pub use design_file::DesignFile;
 pub use domain::{PlaneGrid, disk_mesh};
 pub use error::FieldsError;

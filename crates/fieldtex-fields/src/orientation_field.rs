@@ -47,6 +47,23 @@ pub fn nrosy_root(z: [f64; 2], symmetry: Symmetry) -> [f64; 2] {
     }
 }
 
+/// [`nrosy_root`] in `f32` for pixel output: for `n = 2` the half-angle vector
+/// `z + |z|` normalised (`(0, 1)` on the negative real axis, where the principal root is
+/// `i`). `(1, 0)` for `z = 0`.
+#[inline]
+pub fn nrosy_root_f32(z: [f32; 2], symmetry: Symmetry) -> [f32; 2] {
+    let r = (z[0] * z[0] + z[1] * z[1]).sqrt();
+    if !(r > 0.0 && r.is_finite()) {
+        return [1.0, 0.0];
+    }
+    let w = match symmetry {
+        Symmetry::Vector => z,
+        Symmetry::Orientation => [z[0] + r, z[1]],
+    };
+    let m = (w[0] * w[0] + w[1] * w[1]).sqrt();
+    if m > 1e-6 * r { [w[0] / m, w[1] / m] } else { [0.0, 1.0] }
+}
+
 /// The design-space value of an N-RoSy direction at angle `theta` (`e^{iNθ}`).
 #[inline]
 pub fn nrosy_power(theta: f64, symmetry: Symmetry) -> [f64; 2] {
@@ -139,23 +156,39 @@ pub fn sample_plane(
         return Err(FieldsError::FieldSize { width, height, expected: 1, found: 0 });
     }
     let zv = vertex_complex(design, field);
-    let tris = &design.dec().triangles;
-    let (sx, sy) = (grid.width / width as f64, grid.height / height as f64);
     let symmetry = field.symmetry;
+    let (nx, ny) = (grid.nx, grid.ny);
+    // Pixel → grid coordinates: g = (pixel + ½) · (cells / pixels).
+    let (kx, ky) = (nx as f64 / width as f64, ny as f64 / height as f64);
     let mut out = vec![[0.0f32; 2]; width * height];
     out.par_chunks_mut(width).enumerate().for_each(|(r, row)| {
-        let y = (r as f64 + 0.5) * sy;
+        let gy = (r as f64 + 0.5) * ky;
+        let j = (gy as usize).min(ny - 1);
+        let v = (gy - j as f64).clamp(0.0, 1.0);
         for (c, px) in row.iter_mut().enumerate() {
-            let (f, b) = grid.locate((c as f64 + 0.5) * sx, y);
-            let t = tris[f];
-            let mut z = [0.0, 0.0];
-            for k in 0..3 {
-                let zk = zv[t[k] as usize];
-                z[0] += b[k] * zk[0];
-                z[1] += b[k] * zk[1];
-            }
-            let u = nrosy_root(z, symmetry);
-            *px = [u[0] as f32, u[1] as f32];
+            let gx = (c as f64 + 0.5) * kx;
+            let i = (gx as usize).min(nx - 1);
+            let u = (gx - i as f64).clamp(0.0, 1.0);
+            // Cell corners a=(i,j) b=(i+1,j) c=(i+1,j+1) d=(i,j+1); triangles as in
+            // PlaneGrid::locate.
+            let a = j * (nx + 1) + i;
+            let (za, zb, zc, zd) = (zv[a], zv[a + 1], zv[a + nx + 2], zv[a + nx + 1]);
+            let (w, p, q) = if (i + j).is_multiple_of(2) {
+                if u >= v {
+                    ([1.0 - u, u - v, v], za, [zb, zc])
+                } else {
+                    ([1.0 - v, u, v - u], za, [zc, zd])
+                }
+            } else if u + v <= 1.0 {
+                ([1.0 - u - v, u, v], za, [zb, zd])
+            } else {
+                ([1.0 - v, u + v - 1.0, 1.0 - u], zb, [zc, zd])
+            };
+            let z = [
+                (w[0] * p[0] + w[1] * q[0][0] + w[2] * q[1][0]) as f32,
+                (w[0] * p[1] + w[1] * q[0][1] + w[2] * q[1][1]) as f32,
+            ];
+            *px = nrosy_root_f32(z, symmetry);
         }
     });
     Ok(out)

@@ -25,7 +25,7 @@
 //! that they agree with these built-in versions).
 
 use crate::FieldsError;
-use crate::design_elements::{SingularityKind, Symmetry};
+use crate::design_elements::{Singularity, SingularityKind, Symmetry, zero_pole_angles};
 use crate::design_file::{DesignFile, SingularitySpec, StrokeSpec};
 
 /// Names of the presets, in the classification's usual order.
@@ -34,35 +34,20 @@ pub const PRESET_NAMES: [&str; 5] = ["arch", "tented-arch", "left-loop", "right-
 /// Reference size of the preset layouts.
 pub const REFERENCE_SIZE: f64 = 512.0;
 
-/// Sets the angle (degrees) of every wedge/trisector so that near it the design agrees
-/// with the zero-pole model with background orientation `background` (degrees):
-/// for a wedge `α = θ₀ + ½ Σ_{j≠k} s_j arg(p_k − p_j)`, for a trisector the negative,
-/// with `s = +1` for wedges and `−1` for trisectors. Rounded to 0.1°, in `(−90, 90]`.
+/// Sets the angle (degrees) of every wedge/trisector from
+/// [`zero_pole_angles`] with background orientation `background` (degrees), rounded to
+/// 0.1°, in `(−90, 90]` (a wedge's or trisector's α is defined modulo 180°).
 pub fn consistent_angles(singularities: &mut [SingularitySpec], background: f64) {
-    let pos: Vec<(f64, f64, f64)> = singularities
+    let list: Vec<Singularity> = singularities
         .iter()
-        .map(|s| {
-            let sign = match s.kind {
-                SingularityKind::Wedge => 1.0,
-                SingularityKind::Trisector => -1.0,
-                _ => 0.0,
-            };
-            (s.x.unwrap_or(0.0), s.y.unwrap_or(0.0), sign)
-        })
+        .map(|s| Singularity::at_pixel(s.kind, s.x.unwrap_or(0.0), s.y.unwrap_or(0.0)))
         .collect();
-    for (k, s) in singularities.iter_mut().enumerate() {
-        let (xk, yk, sk) = pos[k];
-        if sk == 0.0 {
+    let angles = zero_pole_angles(&list, background.to_radians());
+    for (s, a) in singularities.iter_mut().zip(angles) {
+        if s.kind.symmetry() != Symmetry::Orientation {
             continue;
         }
-        let mut a = background.to_radians();
-        for (j, &(xj, yj, sj)) in pos.iter().enumerate() {
-            if j != k {
-                a += 0.5 * sj * (yk - yj).atan2(xk - xj);
-            }
-        }
-        let mut deg = (sk * a).to_degrees();
-        deg = deg.rem_euclid(180.0);
+        let mut deg = a.to_degrees().rem_euclid(180.0);
         if deg > 90.0 {
             deg -= 180.0;
         }

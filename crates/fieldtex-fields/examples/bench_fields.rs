@@ -1,0 +1,112 @@
+//! Field design benchmark: 128×128 grid, whorl preset, 512² pixel field.
+//!
+//! `cargo run --release -p fieldtex-fields --example bench_fields [-- REPEATS]`
+//!
+//! Prints medians as `BENCH <name> median_ms=<value>` lines:
+//! - `field_factor`: from nothing to a factored design: DEC operators, assembly, symbolic
+//!   analysis, the preset's strokes, numeric factorisation (once per domain/stroke set);
+//! - `field_full_solve`: design → pixel field on the factored design: every singularity
+//!   re-placed (all model fields recomputed), right-hand side, solve, sample 512²;
+//! - `field_move_singularity`: move one wedge, re-solve (right-hand side only), sample 512²;
+//! - `field_add_stroke`: add one stroke, numeric refactorisation with the kept symbolic
+//!   analysis, solve, sample 512² (the stroke is removed again untimed);
+//! - `field_numeric_refactor`: the numeric factorisation alone.
+//!
+//! Targets (issue 3): move < 20 ms, full < 50 ms. Timings depend on machine load; the
+//! first line reports the load average where /proc/loadavg exists.
+
+use std::time::Instant;
+
+use fieldtex_fields::orientation_field::sample_plane;
+use fieldtex_fields::presets::preset;
+use fieldtex_fields::{Domain, FieldDesign, Stroke};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+fn main() {
+    let repeats: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(15);
+    if let Ok(load) = std::fs::read_to_string("/proc/loadavg") {
+        println!("info: load average {}", load.trim());
+    }
+    println!("info: rayon threads {}", rayon::current_num_threads());
+    let size = 512usize;
+    let file = preset("whorl", size as f64, size as f64, 128).unwrap();
+    let grid = file.plane_grid().unwrap();
+    let (symmetry, options) = (file.symmetry().unwrap(), file.options());
+
+    let mut t_factor = Vec::new();
+    let mut design = None;
+    for _ in 0..repeats.clamp(1, 7) {
+        let t = Instant::now();
+        let mut d = FieldDesign::new(Domain::Plane(grid), symmetry, options.clone()).unwrap();
+        for s in file.stroke_list() {
+            d.add_stroke(s).unwrap();
+        }
+        d.refactor_if_needed().unwrap();
+        t_factor.push(ms(t));
+        design = Some(d);
+    }
+    let mut d = design.unwrap();
+    println!("info: {} unknowns (edges), matrix nnz {}", d.dec().n_edges(), d.base_matrix().nnz());
+    let singularities = file.singularity_list().unwrap();
+    let ids: Vec<_> = singularities.iter().map(|s| d.add_singularity(*s).unwrap()).collect();
+
+    let mut t_full = Vec::new();
+    for _ in 0..repeats {
+        let t = Instant::now();
+        for (id, s) in ids.iter().zip(&singularities) {
+            d.set_singularity(*id, *s).unwrap();
+        }
+        let f = d.solve().unwrap();
+        let px = sample_plane(&d, &f, size, size).unwrap();
+        t_full.push(ms(t));
+        assert_eq!(px.len(), size * size);
+    }
+
+    let mut t_move = Vec::new();
+    let p0 = singularities[0].position;
+    for k in 0..repeats {
+        let p = [
+            p0[0] + 3.0 * ((k % 5) as f64 - 2.0) + 0.31,
+            p0[1] + 2.0 * ((k % 3) as f64 - 1.0) + 0.37,
+            0.0,
+        ];
+        let t = Instant::now();
+        d.move_singularity(ids[0], p).unwrap();
+        let f = d.solve().unwrap();
+        let px = sample_plane(&d, &f, size, size).unwrap();
+        t_move.push(ms(t));
+        assert_eq!(px.len(), size * size);
+    }
+
+    let mut t_stroke = Vec::new();
+    let mut t_refactor = Vec::new();
+    for k in 0..repeats {
+        let y = 150.0 + 10.0 * k as f64;
+        let t = Instant::now();
+        let sid = d
+            .add_stroke(Stroke::from_pixels(&[[60.0, y], [200.0, y - 20.0], [300.0, y + 10.0]]))
+            .unwrap();
+        let f = d.solve().unwrap();
+        let px = sample_plane(&d, &f, size, size).unwrap();
+        t_stroke.push(ms(t));
+        assert_eq!(px.len(), size * size);
+        d.remove_stroke(sid).unwrap();
+        let t = Instant::now();
+        d.refactor_if_needed().unwrap();
+        t_refactor.push(ms(t));
+    }
+
+    println!("BENCH field_factor median_ms={:.2}", median(t_factor));
+    println!("BENCH field_full_solve median_ms={:.2}", median(t_full));
+    println!("BENCH field_move_singularity median_ms={:.2}", median(t_move));
+    println!("BENCH field_add_stroke median_ms={:.2}", median(t_stroke));
+    println!("BENCH field_numeric_refactor median_ms={:.2}", median(t_refactor));
+}
