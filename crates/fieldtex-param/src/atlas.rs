@@ -156,11 +156,11 @@ pub fn build_atlas(
         rotate: options.rotate_charts,
         ..Default::default()
     };
-    if options.resolution < 8 || options.resolution > 32768 {
+    if options.resolution < 8 || options.resolution > 16384 {
         return Err(ParamError::InvalidOption {
             name: "resolution",
             value: options.resolution.to_string(),
-            reason: "the atlas resolution must be between 8 and 32768 texels",
+            reason: "the atlas resolution must be between 8 and 16384 texels",
         });
     }
     let a = options.segmentation.max_normal_angle_deg;
@@ -170,6 +170,18 @@ pub fn build_atlas(
             value: a.to_string(),
             reason: "the chart normal cone must be between 0 and 90 degrees (exclusive)",
         });
+    }
+    let seg = &options.segmentation;
+    for (name, value) in
+        [("lloyd_iterations", seg.lloyd_iterations), ("smoothing_passes", seg.smoothing_passes)]
+    {
+        if value > 1000 {
+            return Err(ParamError::InvalidOption {
+                name,
+                value: value.to_string(),
+                reason: "at most 1000 rounds are allowed (the defaults are 4 and 2)",
+            });
+        }
     }
     let mut warnings = Warnings::new();
     progress.stage("atlas: segmenting charts", 0);

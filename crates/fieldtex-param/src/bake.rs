@@ -44,6 +44,9 @@ where
             });
         }
     }
+    if n == 0 {
+        return Ok(Image { width: map.width, height: map.height, pixels: Vec::new() });
+    }
     let mut pixels = vec![background; n];
     pixels.par_chunks_mut(map.width).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {

@@ -77,13 +77,24 @@ pub fn singular_values_2x2(m: [[f64; 2]; 2]) -> (f64, f64) {
     (q + r, (q - r).abs())
 }
 
-/// Distortion of per-corner `uvs` on `mesh` (module docs). Fails only when the UV
-/// table does not match the mesh.
+/// Distortion of per-corner `uvs` on `mesh` (module docs). Fails when the UV table
+/// does not match the mesh or a triangle index is out of range.
 pub fn parameterization_distortion(
     mesh: &TriMesh,
     uvs: &fieldtex_mesh::CornerUvs,
 ) -> Result<DistortionStats, ParamError> {
     let nf = mesh.n_triangles();
+    let nv = mesh.n_vertices();
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        if let Some(&i) = t.iter().find(|&&i| i as usize >= nv) {
+            return Err(fieldtex_mesh::MeshError::IndexOutOfRange {
+                triangle: f,
+                index: i as u64,
+                n_vertices: nv,
+            }
+            .into());
+        }
+    }
     if uvs.indices.len() != nf {
         return Err(ParamError::AttributeLength {
             what: "uv indices",

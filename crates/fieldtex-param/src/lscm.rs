@@ -117,44 +117,52 @@ pub fn lscm(
     let mean_area: f64 = chart.faces.iter().map(|&f| graph.areas[f as usize]).sum::<f64>()
         / chart.faces.len() as f64;
     let floor = (1e-6 * mean_area).max(f64::MIN_POSITIVE);
-    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(chart.faces.len() * 72);
+    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(chart.faces.len() * 36);
     let mut rhs = vec![0.0; m];
     for (lf, &f) in chart.faces.iter().enumerate() {
         let z = local_corners(mesh.triangle_positions(f as usize));
         let w = 1.0 / graph.areas[f as usize].max(floor).sqrt();
-        for row in 0..2 {
-            // (unknown index or pinned value, coefficient) for the 6 scalar unknowns.
-            let mut coef: [(usize, f64); 6] = [(0, 0.0); 6];
-            for k in 0..3 {
-                let a = z[(k + 2) % 3];
-                let b = z[(k + 1) % 3];
-                let (ex, ey) = (a[0] - b[0], a[1] - b[1]);
-                let v = chart.corners[lf][k] as usize;
-                let (cu, cv) = if row == 0 { (ex, -ey) } else { (ey, ex) };
-                coef[2 * k] = (2 * v, cu * w);
-                coef[2 * k + 1] = (2 * v + 1, cv * w);
-            }
-            // Pinned part of the row: r_p · x_p.
-            let mut rp = 0.0;
-            for &(idx, c) in &coef {
-                if let Some(x) = pinned(idx / 2) {
-                    rp += c * x[idx % 2];
+        // Both rows over the 6 scalar unknowns (u_k at 2k, v_k at 2k + 1).
+        let mut rows = [[0.0f64; 6]; 2];
+        for k in 0..3 {
+            let a = z[(k + 2) % 3];
+            let b = z[(k + 1) % 3];
+            let (ex, ey) = (a[0] - b[0], a[1] - b[1]);
+            rows[0][2 * k] = ex * w;
+            rows[0][2 * k + 1] = -ey * w;
+            rows[1][2 * k] = ey * w;
+            rows[1][2 * k + 1] = ex * w;
+        }
+        // Global unknown of each local scalar (None when pinned) and pinned values.
+        let mut gidx = [None; 6];
+        let mut xp = [0.0; 6];
+        for k in 0..3 {
+            let v = chart.corners[lf][k] as usize;
+            match pinned(v) {
+                Some(x) => {
+                    xp[2 * k] = x[0];
+                    xp[2 * k + 1] = x[1];
+                }
+                None => {
+                    gidx[2 * k] = Some(2 * free[v] as usize);
+                    gidx[2 * k + 1] = Some(2 * free[v] as usize + 1);
                 }
             }
-            for &(i, ci) in &coef {
-                let fi = free[i / 2];
-                if fi == u32::MAX {
-                    continue;
+        }
+        // Normal-equation block Σ_rows r rᵀ and right-hand side −Σ_rows r (r · x_p).
+        for r in &rows {
+            let rp: f64 = r.iter().zip(&xp).map(|(c, x)| c * x).sum();
+            for i in 0..6 {
+                if let Some(gi) = gidx[i] {
+                    rhs[gi] -= r[i] * rp;
                 }
-                let gi = 2 * fi as usize + i % 2;
-                rhs[gi] -= ci * rp;
-                for &(j, cj) in &coef {
-                    let fj = free[j / 2];
-                    if fj == u32::MAX {
-                        continue;
-                    }
-                    trip.push((gi, 2 * fj as usize + j % 2, ci * cj));
-                }
+            }
+        }
+        for i in 0..6 {
+            let Some(gi) = gidx[i] else { continue };
+            for j in 0..6 {
+                let Some(gj) = gidx[j] else { continue };
+                trip.push((gi, gj, rows[0][i] * rows[0][j] + rows[1][i] * rows[1][j]));
             }
         }
     }

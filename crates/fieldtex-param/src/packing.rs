@@ -313,11 +313,11 @@ fn try_pack(
 /// Packs `charts` into a `resolution²` atlas at the largest scale that fits (module
 /// docs). Charts with no triangles get a placement and reserve one texel.
 pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Packing, ParamError> {
-    if options.resolution < 8 || options.resolution > 32768 {
+    if options.resolution < 8 || options.resolution > 16384 {
         return Err(ParamError::InvalidOption {
             name: "resolution",
             value: options.resolution.to_string(),
-            reason: "the atlas resolution must be between 8 and 32768 texels",
+            reason: "the atlas resolution must be between 8 and 16384 texels",
         });
     }
     if options.gutter as u64 * 4 >= options.resolution as u64 {

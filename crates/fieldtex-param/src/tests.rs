@@ -410,3 +410,28 @@ fn texel_map_and_bake_round_trip() {
         }
     }
 }
+
+#[test]
+fn texel_map_and_bake_bad_input() {
+    let mesh = primitives::grid(2, 2, 1.0, 1.0);
+    assert!(matches!(build_texel_map(&mesh, 16, 16, 2), Err(ParamError::MissingUvs { .. })));
+    let atlas = build_atlas(&mesh, &small_opts(), &NoProgress).unwrap();
+    assert!(build_texel_map(&atlas.mesh, 0, 16, 2).is_err());
+    assert!(build_texel_map(&atlas.mesh, 1 << 20, 16, 2).is_err());
+    let map = build_texel_map(&atlas.mesh, 16, 16, 2).unwrap();
+    // Colours for another mesh, a map for a bigger mesh, an empty map.
+    assert!(bake_vertex_colors(&atlas.mesh, &map, &[[1.0; 4]; 3], [0.0; 4]).is_err());
+    let tiny = TriMesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]]);
+    assert!(matches!(
+        bake_surface(&tiny, &map, [0.0; 4], |_, _, _| [1.0; 4]),
+        Err(ParamError::TriangleOutOfRange { .. })
+    ));
+    let empty = TexelMap { width: 0, height: 0, entries: Vec::new(), source: Vec::new() };
+    assert_eq!(bake_surface(&mesh, &empty, [0.0; 4], |_, _, _| [1.0; 4]).unwrap().pixels.len(), 0);
+    // Distortion of UVs that do not match the mesh.
+    let mut broken = atlas.mesh.clone();
+    broken.triangles[0][0] = 99;
+    assert!(parameterization_distortion(&broken, atlas.mesh.uvs.as_ref().unwrap()).is_err());
+    let short = fieldtex_mesh::CornerUvs { values: vec![], indices: vec![[0, 0, 0]] };
+    assert!(parameterization_distortion(&mesh, &short).is_err());
+}

@@ -97,11 +97,11 @@ pub fn build_texel_map(
             found: uvs.indices.len(),
         });
     }
-    if width == 0 || height == 0 || width > 65536 || height > 65536 {
+    if width == 0 || height == 0 || width > 16384 || height > 16384 {
         return Err(ParamError::InvalidOption {
             name: "texel map size",
             value: format!("{width}×{height}"),
-            reason: "width and height must be between 1 and 65536",
+            reason: "width and height must be between 1 and 16384",
         });
     }
     let (w, h) = (width as f64, height as f64);
