@@ -31,7 +31,7 @@
 //!   trisectors still use their model field.
 //!
 //! Normal equations `A ω = b`:
-//! `A = w_s (Dᵀ⋆0⁻¹D + d1ᵀ⋆2 d1 − βB) + ε diag + diag(w_e)` ([`crate::design_matrix`]),
+//! `A = w_s (Dᵀ⋆0⁻¹D + d1ᵀ⋆2 d1 − βB) + ε diag + diag(w_e)` ([`crate::normal_equations`]),
 //! `b = w_s (Dᵀ⋆0⁻¹ S + d1ᵀ⋆2 C) − w_s β B ω* + ε diag ω* + (w_e t_e)` — the paper's
 //! `∗dS + ∗δC + ZᵀWU_Z` plus the two deviation terms (`ω* = 0` for `PointDelta` poles).
 //!
@@ -56,9 +56,9 @@ use fieldtex_mesh::TriMesh;
 use crate::FieldsError;
 use crate::dec::Dec;
 use crate::design_elements::{Singularity, SingularityKind, Stroke, Symmetry};
-use crate::design_matrix::assemble_design_matrix;
-use crate::domain::{Frame, PlaneGrid, locate_in_mesh, projected_frames};
-use crate::natural_boundary::boundary_term_triplets;
+use crate::domain::{Frame, PlaneGrid, locate_in_mesh};
+use crate::normal_equations::NormalEquations;
+use crate::reference_frames::reference_frames;
 use crate::singular_model_field::{ModelField, ModelKind};
 use crate::stroke_constraints::{EdgeConstraint, stroke_edge_constraints};
 
@@ -185,15 +185,7 @@ pub struct FieldDesign {
     options: FieldDesignOptions,
     frames: Vec<Frame>,
     reference_radius: f64,
-    div: SparseMatrix,
-    div_t: SparseMatrix,
-    d1: SparseMatrix,
-    d1_t: SparseMatrix,
-    base: SparseMatrix,
-    /// `B` of the natural boundary term (`None` when it is off).
-    boundary: Option<SparseMatrix>,
-    /// `ε diag` of the regularisation (`#E`).
-    regularization_diag: Vec<f64>,
+    equations: NormalEquations,
     symbolic: SymbolicCholesky,
     /// Numeric factor of `A` with `factored_stroke_diag` (made lazily on the first solve).
     factor: Option<Cholesky>,
@@ -243,26 +235,8 @@ impl FieldDesign {
             Domain::Mesh(m) => (m, None),
         };
         let (dec, warnings) = Dec::new(&mesh)?;
-        let div = SparseMatrix::from_triplets(
-            dec.n_vertices(),
-            dec.n_edges(),
-            &dec.divergence_triplets(),
-        )?;
-        let div_t = div.transpose();
-        let d1 = dec.d1();
-        let d1_t = d1.transpose();
-        let boundary = if options.natural_boundary && options.boundary_weight > 0.0 {
-            Some(SparseMatrix::from_triplets(
-                dec.n_edges(),
-                dec.n_edges(),
-                &boundary_term_triplets(&dec),
-            )?)
-        } else {
-            None
-        };
-        let (base, regularization_diag) =
-            assemble_design_matrix(&dec, &div_t, boundary.as_ref(), &options)?;
-        let symbolic = SymbolicCholesky::analyze(&base)?;
+        let equations = NormalEquations::new(&dec, &options)?;
+        let symbolic = SymbolicCholesky::analyze(&equations.matrix)?;
         let area: f64 = dec.face_areas.iter().sum();
         let reference_radius = 0.25 * area.sqrt();
         let mut design = Self {
@@ -273,13 +247,7 @@ impl FieldDesign {
             factored_stroke_diag: vec![0.0; dec.n_edges()],
             dec,
             options,
-            div,
-            div_t,
-            d1,
-            d1_t,
-            base,
-            boundary,
-            regularization_diag,
+            equations,
             symbolic,
             factor: None,
             singularities: Vec::new(),
@@ -291,48 +259,9 @@ impl FieldDesign {
             vec![([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]); design.dec.n_faces()]
         } else {
             design.refactor_if_needed()?;
-            design.reference_frames()?
+            reference_frames(&design.dec, design.factor.as_ref().expect("just factored"))?
         };
         Ok(design)
-    }
-
-    /// Frames from the smoothest field with one fixed vector (the first edge direction
-    /// of the triangle nearest the patch centre), via three solves with the factor.
-    fn reference_frames(&self) -> Result<Vec<Frame>, FieldsError> {
-        let dec = &self.dec;
-        let centroid = scale(
-            dec.positions.iter().fold([0.0; 3], |a, p| add(a, *p)),
-            1.0 / dec.n_vertices() as f64,
-        );
-        let (f0, _, _) = locate_in_mesh(dec, centroid).expect("validated mesh has triangles");
-        let tri = dec.triangles[f0];
-        let dir = fieldtex_core::vec3::sub(
-            dec.positions[tri[1] as usize],
-            dec.positions[tri[0] as usize],
-        );
-        let edges: Vec<usize> = (0..3).map(|k| dec.topology.face_edges[f0][k] as usize).collect();
-        let targets: Vec<f64> =
-            edges.iter().map(|&e| fieldtex_core::vec3::dot(dir, dec.edge_vector(e))).collect();
-        // Hard constraints on the three edges: ω = Σ_k λ_k A⁻¹ e_k with ω[e_j] = t_j.
-        let basis: Vec<Vec<f64>> = edges
-            .iter()
-            .map(|&e| {
-                let mut b = vec![0.0; dec.n_edges()];
-                b[e] = 1.0;
-                b
-            })
-            .collect();
-        let cols = self.factor.as_ref().expect("factored by the caller").solve_many(&basis)?;
-        let g: Vec<[f64; 3]> = (0..3).map(|j| std::array::from_fn(|k| cols[k][edges[j]])).collect();
-        let lambda = solve3([g[0], g[1], g[2]], [targets[0], targets[1], targets[2]]);
-        let mut omega = vec![0.0; dec.n_edges()];
-        for k in 0..3 {
-            for (o, c) in omega.iter_mut().zip(&cols[k]) {
-                *o += lambda[k] * c;
-            }
-        }
-        let reference = dec.face_vectors(&omega);
-        Ok(projected_frames(dec, &reference))
     }
 
     /// The DEC operators of the domain.
@@ -367,7 +296,7 @@ impl FieldDesign {
     }
     /// The assembled design matrix without strokes.
     pub fn base_matrix(&self) -> &SparseMatrix {
-        &self.base
+        &self.equations.matrix
     }
 
     /// Live singularities with their ids, in id order.
@@ -571,7 +500,7 @@ impl FieldDesign {
     pub fn refactor_if_needed(&mut self) -> Result<(), FieldsError> {
         let d = self.stroke_diagonal();
         if self.factor.is_none() || d != self.factored_stroke_diag {
-            let a = self.base.add_diagonal(&d);
+            let a = self.equations.matrix.add_diagonal(&d);
             self.factor = Some(Cholesky::factor_with(&self.symbolic, &a)?);
             self.factored_stroke_diag = d;
             self.refactor_count += 1;
@@ -621,40 +550,13 @@ impl FieldDesign {
                 *a += b;
             }
         }
-        // S = Dω* + S_point, C = d1 ω* + C_point; b = w_s (Dᵀ ⋆0⁻¹ S + d1ᵀ ⋆2 C).
-        let mut s =
-            if any_model { self.div.mul_vec(&model) } else { vec![0.0; self.dec.n_vertices()] };
-        let mut c = if any_model { self.d1.mul_vec(&model) } else { vec![0.0; self.dec.n_faces()] };
-        let ws = self.options.smoothness_weight;
-        for (v, sv) in s.iter_mut().enumerate() {
-            *sv = ws * (*sv + s_point[v]) / self.dec.star0[v];
-        }
-        for (f, cf) in c.iter_mut().enumerate() {
-            *cf = ws * (*cf + c_point[f]) * self.dec.star2[f];
-        }
-        let mut b = self.div_t.mul_vec(&s);
-        // The boundary term and the regularisation act on the deviation ω − ω* too:
-        // b += −w_s β B ω* + ε diag ω*.
-        if any_model {
-            if let Some(bm) = &self.boundary {
-                let beta = ws * self.options.boundary_weight;
-                for (bi, v) in b.iter_mut().zip(bm.mul_vec(&model)) {
-                    *bi -= beta * v;
-                }
-            }
-            for ((bi, r), m) in b.iter_mut().zip(&self.regularization_diag).zip(&model) {
-                *bi += r * m;
-            }
-        }
-        for (bi, ci) in b.iter_mut().zip(self.d1_t.mul_vec(&c)) {
-            *bi += ci;
-        }
-        for (_, cs) in self.strokes.iter().flatten() {
-            for &(e, _, wt) in cs {
-                b[e] += wt;
-            }
-        }
-        b
+        self.equations.right_hand_side(
+            &self.dec,
+            any_model.then_some(&model[..]),
+            &s_point,
+            &c_point,
+            self.strokes.iter().flatten().map(|(_, cs)| &cs[..]),
+        )
     }
 
     /// Solves the design: refactors if strokes changed, rebuilds the right-hand side
@@ -667,26 +569,6 @@ impl FieldDesign {
         let face_vectors = self.dec.face_vectors(&one_form);
         Ok(SolvedField { symmetry: self.symmetry, one_form, face_vectors, residual })
     }
-}
-
-/// Solves a 3×3 system by Cramer's rule (zero where singular).
-fn solve3(m: [[f64; 3]; 3], r: [f64; 3]) -> [f64; 3] {
-    let det = |a: [[f64; 3]; 3]| {
-        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
-    };
-    let d = det(m);
-    if d.abs() < 1e-300 || !d.is_finite() {
-        return [0.0; 3];
-    }
-    std::array::from_fn(|k| {
-        let mut a = m;
-        for (row, rv) in a.iter_mut().zip(r) {
-            row[k] = rv;
-        }
-        det(a) / d
-    })
 }
 
 /// Kinds valid for a symmetry (for UIs and the design file).

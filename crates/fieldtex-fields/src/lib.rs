@@ -11,7 +11,9 @@
 //!   Dirichlet energy (paper D §2.2).
 //! - [`singular_model_field`]: exact 1-forms of poles and saddles.
 //! - [`stroke_constraints`]: polylines → weighted edge constraints.
-//! - [`field_design`]: [`FieldDesign`], the editable design with a kept factorisation.
+//! - [`field_design`]: [`FieldDesign`], the editable design with a kept factorisation;
+//!   [`normal_equations`]: its matrix and right-hand side; [`reference_frames`]: frames
+//!   on curved patches.
 //! - [`orientation_field`]: doubled angles, complex roots, sampling to pixels.
 //! - [`singularity_index`]: N-RoSy indices on meshes and pixel grids.
 //! - [`design_file`]: the TOML design format; [`presets`]: fingerprint classes.
@@ -27,13 +29,14 @@
 pub mod dec;
 pub mod design_elements;
 pub mod design_file;
-pub mod design_matrix;
 pub mod domain;
 pub mod error;
 pub mod field_design;
 pub mod natural_boundary;
+pub mod normal_equations;
 pub mod orientation_field;
 pub mod presets;
+pub mod reference_frames;
 pub mod singular_model_field;
 pub mod singularity_index;
 pub mod stroke_constraints;
