@@ -1,1 +1,41 @@
-//! placeholder
+//! Exemplar analysis and texture synthesis engines for fieldtex.
+//!
+//! # Parallel controllable synthesis (Lefebvre & Hoppe 2005, 2006; paper D §4)
+//! - [`ExemplarAnalysis`] (`exemplar_analysis.rs`): computed once per exemplar and
+//!   [`AnalysisOptions`]: toroidal Gaussian stack ([`gaussian_stack`]), an 8-D PCA
+//!   appearance space of 5×5 neighbourhoods per level for the exemplar and its 180°
+//!   rotation ([`appearance_space`]), k-coherence candidate sets ([`k_coherence`]).
+//! - [`SynthesisDomain`] (`domain.rs`): what the engine runs over: a hierarchy of 2-D
+//!   sample grids with neighbours, parents and a per-sample Jacobian (domain offsets →
+//!   exemplar offsets). [`ImageDomain`] is the plane (image output) built from an
+//!   `H × W × 2` direction field; atlas charts and other domains implement the trait.
+//! - [`synthesize`] (`parallel_synthesis.rs`): coarse-to-fine upsampling with the
+//!   Jacobian, seeded jitter, correction passes with 2×2 subpasses over four-corner
+//!   neighbourhoods, and the 2-RoSy flip indicator of paper D §4
+//!   ([`SynthesisOptions::rosy_fix`]).
+//!
+//! # Conventions
+//! - Colours are sRGB-encoded `f32` as stored in [`fieldtex_core::Image`]; the engine
+//!   compares neighbourhoods in that (perceptual) encoding, it never linearises.
+//! - Exemplar coordinates are continuous pixel units: `u ∈ [0, W) × [0, H)`, x right,
+//!   y down; coordinate `u` shows exemplar pixel `(⌊u.x⌋, ⌊u.y⌋)`. The exemplar is
+//!   treated as toroidal (coordinates wrap).
+//! - Jacobians are row-major `[j00, j01, j10, j11]` 2×2 matrices mapping a domain
+//!   offset (in samples of the level) to an exemplar offset (in exemplar pixels of
+//!   the finest level, before the level spacing `2^level` is applied).
+//! - Determinism: randomness only from `fieldtex_core::rng::hash_unit(seed, …)`; all
+//!   parallel work writes disjoint outputs, so results are bit-identical for any
+//!   rayon thread count.
+
+pub mod appearance_space;
+pub mod domain;
+mod error;
+pub mod exemplar_analysis;
+pub mod gaussian_stack;
+pub mod k_coherence;
+pub mod parallel_synthesis;
+
+pub use domain::{ImageDomain, SynthesisDomain};
+pub use error::SynthError;
+pub use exemplar_analysis::{APPEARANCE_DIMS, AnalysisLevel, AnalysisOptions, ExemplarAnalysis};
+pub use parallel_synthesis::{SynthesisOptions, SynthesisResult, synthesize};

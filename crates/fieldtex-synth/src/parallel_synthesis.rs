@@ -1,0 +1,472 @@
+//! Parallel controllable texture synthesis over a [`SynthesisDomain`]
+//! (Lefebvre & Hoppe 2005 "Parallel controllable texture synthesis"; 2006
+//! "Appearance-space texture synthesis", anisometric synthesis §6; the 2-RoSy
+//! modifications of paper D §4 "Handling orientation").
+//!
+//! The output is a map `S` from samples to continuous exemplar coordinates plus a flip
+//! bit `I` per sample. With `F(p) = (−1)^I(p) J(p)` the *effective* frame of sample
+//! `p`, one level `c` (spacing `h = 2^c`) runs:
+//! 1. **Upsampling**: a child at offset `o ∈ {±½}²` from its parent `p` gets
+//!    `S = S[p] + h F(p) o` and `I = I[p] ⊕ c(p, child)`, where the consistency
+//!    `c(a, b)` is true when the representative frames of `a` and `b` point in opposite
+//!    directions (Frobenius product `⟨J(a), J(b)⟩ < 0`, i.e. `u(a)·u(b) < 0` for
+//!    rotations).
+//! 2. **Jitter**: `S += a h ξ`, `ξ ∈ [−1, 1]²` from
+//!    `hash_unit(seed, "synthesis-jitter", …)`, `a` = [`SynthesisOptions::jitter`].
+//! 3. **Correction** (`passes × subpasses`, 2×2 interleaved): each neighbour `q = p + δ`
+//!    predicts `P = S[q] − h F(q) δ` with flip `α = I[q] ⊕ c(q, p)` — the corrected
+//!    prediction `P̃` of paper D, which uses the neighbour's Jacobian and flip. The
+//!    four-corner neighbourhood of `p` averages, for each corner `Δ ∈ {±1}²`, the
+//!    appearance `Ẽ_α[P + (−1)^α h Δ]` over the three neighbours whose directions are
+//!    closest to the warped offset `J(p)⁻¹ Δ` (Lefebvre & Hoppe 2006 §6 use the same
+//!    three predictions chosen by rounding the warped offset; choosing the three
+//!    angularly nearest of the eight neighbours is our simplification, identical for
+//!    `J = I`). Candidates are every prediction `(P, α)`, the k-coherence jumps
+//!    `S[q] + C′ᵢ(S[q]) − h F(q) δ` with flip `α`, and `p`'s current value; the one whose
+//!    exemplar neighbourhood `Ẽ_β[u + (−1)^β h Δ]` (4 × 8 = 32-D) is closest wins and sets
+//!    `S[p]`, `I[p]`.
+//!
+//! With [`SynthesisOptions::rosy_fix`] off, the engine is plain anisometric synthesis:
+//! predictions use `J(p)`, no flips, only `Ẽ₀` (the ablation of paper D Fig. 5).
+//!
+//! Not implemented: the second PCA of the neighbourhood vectors (a GPU memory
+//! optimisation), feature-distance channels, per-level jitter control, scale-dependent
+//! stack levels (with `scale ≠ 1` level `c` still uses stack level `c`).
+
+use std::time::Instant;
+
+use fieldtex_core::rng::hash_unit;
+use fieldtex_core::{Image, Progress};
+use rayon::prelude::*;
+
+use crate::domain::check_jacobian;
+use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
+use crate::{SynthError, SynthesisDomain};
+
+/// Options of [`synthesize`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SynthesisOptions {
+    /// Seed of the initialisation and jitter streams. Default 0.
+    pub seed: u64,
+    /// Correction passes per level. Default 2.
+    pub correction_passes: usize,
+    /// Subpasses per correction pass: 4 (2×2 interleaving, Lefebvre & Hoppe 2005 §3.4)
+    /// or 1 (all samples at once from the previous state). Default 4.
+    pub subpasses: usize,
+    /// Jitter amplitude as a fraction of the level spacing. Default 0.4.
+    pub jitter: f32,
+    /// k-coherence candidates used per neighbour (at most the analysis' k). Default 2.
+    pub k: usize,
+    /// Multiplier of every domain Jacobian (exemplar pixels per domain sample on top
+    /// of the domain's own scale). Default 1.
+    pub scale: f32,
+    /// Paper D §4 2-RoSy handling (flip indicator, rotated appearance space). Default
+    /// true; false is the ablation `--no-rosy-fix`.
+    pub rosy_fix: bool,
+}
+
+impl Default for SynthesisOptions {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            correction_passes: 2,
+            subpasses: 4,
+            jitter: 0.4,
+            k: 2,
+            scale: 1.0,
+            rosy_fix: true,
+        }
+    }
+}
+
+/// Result of [`synthesize`]: per finest-level sample (row-major over
+/// [`SynthesisDomain::output_size`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthesisResult {
+    /// Exemplar colour at each sample's coordinate.
+    pub colors: Image,
+    /// Exemplar coordinate of each sample, in `[0, W) × [0, H)`.
+    pub coords: Vec<[f32; 2]>,
+    /// Flip indicator of each sample (the sample shows the exemplar turned by 180°).
+    pub flips: Vec<bool>,
+    /// Wall time per synthesis level, coarsest first, milliseconds.
+    pub level_timings_ms: Vec<f64>,
+}
+
+const NONE: u32 = u32::MAX;
+/// Neighbour offsets in angular order (angle `k · 45°` from +x, y down).
+const OFFS8: [[i32; 2]; 8] = [[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1]];
+const CORNERS: [[f32; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [-1.0, 1.0], [1.0, 1.0]];
+
+/// One domain level, tabulated.
+struct LevelTables {
+    nbr: Vec<[u32; 8]>,
+    jac: Vec<[f32; 4]>,
+    classes: Vec<Vec<u32>>,
+    parent: Vec<(u32, [f32; 2])>,
+}
+
+fn tabulate(
+    domain: &dyn SynthesisDomain,
+    level: usize,
+    scale: f32,
+    subpasses: usize,
+    with_parent: bool,
+) -> Result<LevelTables, SynthError> {
+    let n = domain.sample_count(level);
+    let coarse_n = if with_parent { domain.sample_count(level + 1) } else { 0 };
+    type Row = ([u32; 8], [f32; 4], u8, (u32, [f32; 2]));
+    let rows: Vec<Result<Row, SynthError>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let mut nb = [NONE; 8];
+            for (k, o) in OFFS8.iter().enumerate() {
+                if let Some(q) = domain.neighbor(level, i, *o) {
+                    if q >= n {
+                        return Err(SynthError::InvalidDomain {
+                            reason: format!(
+                                "level {level} sample {i}: neighbour {q} ≥ sample count {n}"
+                            ),
+                        });
+                    }
+                    nb[k] = q as u32;
+                }
+            }
+            let j = domain.jacobian(level, i);
+            check_jacobian(level, i, &j)?;
+            let j = j.map(|v| v * scale);
+            let class = if subpasses == 1 { 0 } else { domain.subpass_class(level, i) };
+            if class >= 4 {
+                return Err(SynthError::InvalidDomain {
+                    reason: format!("level {level} sample {i}: subpass class {class} ≥ 4"),
+                });
+            }
+            let parent = if with_parent {
+                let (pi, off) = domain.parent(level, i);
+                if pi >= coarse_n || !off.iter().all(|v| v.is_finite()) {
+                    return Err(SynthError::InvalidDomain {
+                        reason: format!(
+                            "level {level} sample {i}: parent {pi} / offset {off:?} invalid"
+                        ),
+                    });
+                }
+                (pi as u32, off)
+            } else {
+                (0, [0.0; 2])
+            };
+            Ok((nb, j, class as u8, parent))
+        })
+        .collect();
+    let mut t = LevelTables {
+        nbr: Vec::with_capacity(n),
+        jac: Vec::with_capacity(n),
+        classes: vec![Vec::new(); subpasses],
+        parent: Vec::with_capacity(n),
+    };
+    for (i, r) in rows.into_iter().enumerate() {
+        let (nb, j, class, parent) = r?;
+        t.nbr.push(nb);
+        t.jac.push(j);
+        t.classes[class as usize].push(i as u32);
+        t.parent.push(parent);
+    }
+    t.classes.retain(|c| !c.is_empty());
+    Ok(t)
+}
+
+#[inline]
+fn mat_vec(j: &[f32; 4], v: [f32; 2]) -> [f32; 2] {
+    [j[0] * v[0] + j[1] * v[1], j[2] * v[0] + j[3] * v[1]]
+}
+
+#[inline]
+fn frobenius(a: &[f32; 4], b: &[f32; 4]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+}
+
+#[inline]
+fn inverse(j: &[f32; 4]) -> [f32; 4] {
+    let det = j[0] * j[3] - j[1] * j[2];
+    [j[3] / det, -j[1] / det, -j[2] / det, j[0] / det]
+}
+
+/// The exemplar side of one level.
+struct ExemplarLevel<'a> {
+    w: usize,
+    h: usize,
+    wf: f32,
+    hf: f32,
+    app: [&'a [[f32; APPEARANCE_DIMS]]; 2],
+    coherence: &'a [u32],
+    k_store: usize,
+}
+
+impl ExemplarLevel<'_> {
+    #[inline]
+    fn wrap(&self, u: [f32; 2]) -> [f32; 2] {
+        let f = |v: f32, s: f32| {
+            let r = v.rem_euclid(s);
+            if r >= s || r.is_nan() { 0.0 } else { r }
+        };
+        [f(u[0], self.wf), f(u[1], self.hf)]
+    }
+
+    /// Pixel of a wrapped coordinate.
+    #[inline]
+    fn pixel(&self, u: [f32; 2]) -> usize {
+        let x = (u[0] as usize).min(self.w - 1);
+        let y = (u[1] as usize).min(self.h - 1);
+        y * self.w + x
+    }
+}
+
+/// Per-level synthesis context.
+struct Pass<'a> {
+    ex: ExemplarLevel<'a>,
+    t: &'a LevelTables,
+    spacing: f32,
+    k: usize,
+    rosy: bool,
+}
+
+impl Pass<'_> {
+    /// New `(S, I)` of sample `p` from the current state.
+    fn correct(&self, p: usize, s: &[[f32; 2]], fl: &[bool]) -> ([f32; 2], bool) {
+        let ex = &self.ex;
+        let h = self.spacing;
+        let jp = self.t.jac[p];
+        let nb = &self.t.nbr[p];
+        // Predictions of p's coordinate by each neighbour.
+        let mut pred = [([0.0f32; 2], false, [0.0f32; 4]); 8];
+        let mut valid = [false; 8];
+        for k in 0..8 {
+            let q = nb[k];
+            if q == NONE {
+                continue;
+            }
+            let q = q as usize;
+            let (fq, alpha) = if self.rosy {
+                let jq = self.t.jac[q];
+                let cons = frobenius(&jq, &jp) < 0.0;
+                let fq = if fl[q] { jq.map(|v| -v) } else { jq };
+                (fq, fl[q] ^ cons)
+            } else {
+                (jp, false)
+            };
+            let d = OFFS8[k];
+            let off = mat_vec(&fq, [d[0] as f32 * h, d[1] as f32 * h]);
+            pred[k] = (ex.wrap([s[q][0] - off[0], s[q][1] - off[1]]), alpha, fq);
+            valid[k] = true;
+        }
+        // Four-corner neighbourhood of p, averaged over three predictions per corner.
+        let jinv = inverse(&jp);
+        let mut target = [[0.0f32; APPEARANCE_DIMS]; 4];
+        let mut weight = [0.0f32; 4];
+        for (ci, cd) in CORNERS.iter().enumerate() {
+            let phi = mat_vec(&jinv, *cd);
+            let oct = (phi[1].atan2(phi[0]) / std::f32::consts::FRAC_PI_4).round() as i32;
+            let mut count = 0.0f32;
+            for t in [oct - 1, oct, oct + 1] {
+                let t = t.rem_euclid(8) as usize;
+                if !valid[t] {
+                    continue;
+                }
+                let (u, a, _) = pred[t];
+                let sg = if a { -h } else { h };
+                let look = ex.wrap([u[0] + sg * cd[0], u[1] + sg * cd[1]]);
+                let v = &ex.app[a as usize][ex.pixel(look)];
+                for (o, x) in target[ci].iter_mut().zip(v) {
+                    *o += x;
+                }
+                count += 1.0;
+            }
+            if count > 0.0 {
+                let inv = 1.0 / count;
+                target[ci].iter_mut().for_each(|x| *x *= inv);
+                weight[ci] = 1.0;
+            }
+        }
+        let score = |u: [f32; 2], b: bool| -> f32 {
+            let sg = if b { -h } else { h };
+            let app = ex.app[b as usize];
+            let mut total = 0.0f32;
+            for (ci, cd) in CORNERS.iter().enumerate() {
+                if weight[ci] == 0.0 {
+                    continue;
+                }
+                let v = &app[ex.pixel(ex.wrap([u[0] + sg * cd[0], u[1] + sg * cd[1]]))];
+                let mut d2 = 0.0f32;
+                for (x, y) in v.iter().zip(&target[ci]) {
+                    let e = x - y;
+                    d2 += e * e;
+                }
+                total += d2;
+            }
+            total
+        };
+        let mut best = (s[p], fl[p] && self.rosy);
+        let mut best_d = score(best.0, best.1);
+        for k in 0..8 {
+            if !valid[k] {
+                continue;
+            }
+            let (u, a, fq) = pred[k];
+            let d = score(u, a);
+            if d < best_d {
+                best_d = d;
+                best = (u, a);
+            }
+            if self.k == 0 {
+                continue;
+            }
+            let sq = s[nb[k] as usize];
+            let frac = [sq[0] - sq[0].floor(), sq[1] - sq[1].floor()];
+            let base = ex.pixel(sq) * ex.k_store;
+            let dd = OFFS8[k];
+            let off = mat_vec(&fq, [dd[0] as f32 * h, dd[1] as f32 * h]);
+            for i in 0..self.k {
+                let v = ex.coherence[base + i] as usize;
+                let c = ex.wrap([
+                    (v % ex.w) as f32 + frac[0] - off[0],
+                    (v / ex.w) as f32 + frac[1] - off[1],
+                ]);
+                let d = score(c, a);
+                if d < best_d {
+                    best_d = d;
+                    best = (c, a);
+                }
+            }
+        }
+        best
+    }
+}
+
+fn validate(options: &SynthesisOptions, analysis: &ExemplarAnalysis) -> Result<(), SynthError> {
+    let bad = |name, value: f64, reason| Err(SynthError::InvalidOption { name, value, reason });
+    if options.correction_passes > 16 {
+        return bad("correction_passes", options.correction_passes as f64, "must be at most 16");
+    }
+    if options.subpasses != 1 && options.subpasses != 4 {
+        return bad("subpasses", options.subpasses as f64, "must be 1 or 4 (2×2 interleaving)");
+    }
+    if !(options.jitter.is_finite() && (0.0..=4.0).contains(&options.jitter)) {
+        return bad(
+            "jitter",
+            options.jitter as f64,
+            "must be in [0, 4] (fraction of the level spacing)",
+        );
+    }
+    if options.k > analysis.k() {
+        return bad("k", options.k as f64, "must not exceed the k of the exemplar analysis");
+    }
+    if !(options.scale.is_finite() && options.scale > 0.0) {
+        return bad("scale", options.scale as f64, "must be a positive finite number");
+    }
+    Ok(())
+}
+
+/// Synthesises a texture over `domain` from the analysed exemplar. Deterministic for a
+/// given seed, independent of the rayon thread count.
+pub fn synthesize(
+    analysis: &ExemplarAnalysis,
+    domain: &dyn SynthesisDomain,
+    options: &SynthesisOptions,
+    progress: &dyn Progress,
+) -> Result<SynthesisResult, SynthError> {
+    validate(options, analysis)?;
+    let n0 = domain.sample_count(0);
+    let (out_w, out_h) = domain.output_size();
+    if n0 == 0 || out_w * out_h != n0 {
+        return Err(SynthError::InvalidDomain {
+            reason: format!("{n0} finest samples but output size {out_w}×{out_h}"),
+        });
+    }
+    if domain.level_count() < 2 {
+        return Err(SynthError::InvalidDomain {
+            reason: "the domain needs at least 2 levels (one for initialisation)".into(),
+        });
+    }
+    let levels = analysis.level_count().min(domain.level_count() - 1).max(1);
+    let (w, h) = (analysis.width(), analysis.height());
+    let (wf, hf) = (w as f32, h as f32);
+    progress.stage("parallel synthesis", levels as u64);
+
+    // Initialisation level: random coordinates, no flips.
+    let mut parent_tables = tabulate(domain, levels, options.scale, 1, false)?;
+    let n_init = domain.sample_count(levels);
+    let mut s: Vec<[f32; 2]> = (0..n_init)
+        .map(|i| {
+            let i = i as u64;
+            [
+                (hash_unit(options.seed, "synthesis-init", 2 * i) * w as f64) as f32 % wf,
+                (hash_unit(options.seed, "synthesis-init", 2 * i + 1) * h as f64) as f32 % hf,
+            ]
+        })
+        .collect();
+    let mut fl = vec![false; n_init];
+    let mut level_timings_ms = Vec::with_capacity(levels);
+
+    for level in (0..levels).rev() {
+        let start = Instant::now();
+        let tables = tabulate(domain, level, options.scale, options.subpasses, true)?;
+        let an = analysis.level(level);
+        let ex = ExemplarLevel {
+            w,
+            h,
+            wf,
+            hf,
+            app: [&an.appearance, &an.appearance_rotated],
+            coherence: &an.coherence,
+            k_store: analysis.k(),
+        };
+        let spacing = an.spacing as f32;
+        let n = tables.jac.len();
+        // 1. Upsampling with the parent's effective frame; 2. jitter.
+        let amp = options.jitter * spacing;
+        let seed = options.seed;
+        let (ps, pf, pj) = (&s, &fl, &parent_tables.jac);
+        let rosy = options.rosy_fix;
+        let (mut ns, mut nf): (Vec<[f32; 2]>, Vec<bool>) = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let (par, off) = tables.parent[i];
+                let par = par as usize;
+                let jpar = pj[par];
+                let flip_par = rosy && pf[par];
+                let f = if flip_par { jpar.map(|v| -v) } else { jpar };
+                let o = mat_vec(&f, [off[0] * spacing, off[1] * spacing]);
+                let idx = ((level * n0 + i) as u64) * 2;
+                let jx = (2.0 * hash_unit(seed, "synthesis-jitter", idx) - 1.0) as f32 * amp;
+                let jy = (2.0 * hash_unit(seed, "synthesis-jitter", idx + 1) - 1.0) as f32 * amp;
+                let u = ex.wrap([ps[par][0] + o[0] + jx, ps[par][1] + o[1] + jy]);
+                let flip = rosy && (flip_par ^ (frobenius(&jpar, &tables.jac[i]) < 0.0));
+                (u, flip)
+            })
+            .unzip();
+        // 3. Correction passes with subpasses.
+        let pass = Pass { ex, t: &tables, spacing, k: options.k, rosy };
+        for _ in 0..options.correction_passes {
+            for class in &tables.classes {
+                let updates: Vec<([f32; 2], bool)> =
+                    class.par_iter().map(|&p| pass.correct(p as usize, &ns, &nf)).collect();
+                for (&p, (u, f)) in class.iter().zip(updates) {
+                    ns[p as usize] = u;
+                    nf[p as usize] = f;
+                }
+            }
+        }
+        s = ns;
+        fl = nf;
+        parent_tables = tables;
+        level_timings_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        progress.advance(1);
+    }
+    progress.finish_stage();
+    let pixels = s.iter().map(|&u| analysis.color_at(u)).collect();
+    Ok(SynthesisResult {
+        colors: Image { width: out_w, height: out_h, pixels },
+        coords: s,
+        flips: fl,
+        level_timings_ms,
+    })
+}

@@ -1,0 +1,270 @@
+//! Invariants of the parallel synthesis engine on small procedural exemplars.
+
+use std::f32::consts::PI;
+
+use fieldtex_core::{Image, NoProgress};
+use fieldtex_synth::{
+    AnalysisOptions, ExemplarAnalysis, ImageDomain, SynthError, SynthesisDomain, SynthesisOptions,
+    synthesize,
+};
+
+/// Horizontal sinusoidal stripes (they run along x, vary along y), period 8 px, tileable.
+fn stripes(size: usize) -> Image {
+    let mut im = Image::new(size, size, [0.0, 0.0, 0.0, 1.0]);
+    for y in 0..size {
+        for x in 0..size {
+            let v = 0.5 + 0.45 * (2.0 * PI * y as f32 / 8.0).sin();
+            // A little x structure so that the exemplar is not degenerate along x.
+            let g = 0.5 + 0.1 * (2.0 * PI * x as f32 / size as f32).cos();
+            im.set(x, y, [v, g * v, 1.0 - v, 1.0]);
+        }
+    }
+    im
+}
+
+/// A small non-square, non-power-of-two, non-periodic exemplar.
+fn blotches(w: usize, h: usize) -> Image {
+    let mut im = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
+    for y in 0..h {
+        for x in 0..w {
+            let (fx, fy) = (x as f32, y as f32);
+            im.set(
+                x,
+                y,
+                [
+                    0.5 + 0.5 * (fx * 0.9 + (fy * 0.4).sin() * 2.0).sin(),
+                    0.5 + 0.5 * (fy * 0.7 - fx * 0.2).cos(),
+                    ((x * 7 + y * 13) % 11) as f32 / 11.0,
+                    1.0,
+                ],
+            );
+        }
+    }
+    im
+}
+
+fn analyse(im: &Image) -> ExemplarAnalysis {
+    ExemplarAnalysis::new(im, &AnalysisOptions::default(), &NoProgress).unwrap()
+}
+
+/// Dominant stripe orientation (radians mod π, 0 = along +x) of a luminance image via
+/// the structure tensor, and its coherence in [0, 1].
+fn stripe_orientation(im: &Image) -> (f32, f32) {
+    let lum = im.luminance();
+    let (w, h) = (im.width, im.height);
+    let (mut jxx, mut jyy, mut jxy) = (0.0f64, 0.0f64, 0.0f64);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let gx = (lum[y * w + x + 1] - lum[y * w + x - 1]) as f64;
+            let gy = (lum[(y + 1) * w + x] - lum[(y - 1) * w + x]) as f64;
+            jxx += gx * gx;
+            jyy += gy * gy;
+            jxy += gx * gy;
+        }
+    }
+    let grad = 0.5 * (2.0 * jxy).atan2(jxx - jyy);
+    let coherence = ((jxx - jyy).powi(2) + 4.0 * jxy * jxy).sqrt() / (jxx + jyy).max(1e-12);
+    (
+        ((grad + std::f64::consts::FRAC_PI_2).rem_euclid(std::f64::consts::PI)) as f32,
+        coherence as f32,
+    )
+}
+
+fn angle_diff_mod_pi(a: f32, b: f32) -> f32 {
+    let d = (a - b).rem_euclid(PI);
+    d.min(PI - d)
+}
+
+#[test]
+fn coords_are_valid_and_colours_match_the_exemplar() {
+    let ex = blotches(20, 13);
+    let an = analyse(&ex);
+    assert_eq!(an.level_count(), 5);
+    let dom = ImageDomain::constant(37, 29, 0.7, 1.0).unwrap();
+    let r = synthesize(&an, &dom, &SynthesisOptions::default(), &NoProgress).unwrap();
+    assert_eq!((r.colors.width, r.colors.height), (37, 29));
+    assert_eq!(r.coords.len(), 37 * 29);
+    assert_eq!(r.flips.len(), 37 * 29);
+    assert_eq!(r.level_timings_ms.len(), 5);
+    for (i, u) in r.coords.iter().enumerate() {
+        assert!(u[0] >= 0.0 && u[0] < 20.0 && u[1] >= 0.0 && u[1] < 13.0, "{i}: {u:?}");
+        let (x, y) = (u[0] as usize, u[1] as usize);
+        assert_eq!(r.colors.pixels[i], ex.get(x, y), "pixel {i}");
+    }
+}
+
+#[test]
+fn output_is_identical_for_one_and_two_threads() {
+    let an = analyse(&blotches(24, 24));
+    let field: Vec<f32> = (0..48 * 40)
+        .flat_map(|i| {
+            let (x, y) = ((i % 48) as f32 - 20.0, (i / 48) as f32 - 17.0);
+            [-y, x] // a vortex: the representative flips nowhere, rotates everywhere
+        })
+        .collect();
+    let dom = ImageDomain::from_direction_field(48, 40, &field, 1.0).unwrap();
+    let run = |threads: usize| {
+        let an = an.clone();
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
+            let a =
+                ExemplarAnalysis::new(&blotches(24, 24), &AnalysisOptions::default(), &NoProgress)
+                    .unwrap();
+            assert_eq!(a.level(0), an.level(0));
+            let opts = SynthesisOptions { seed: 9, ..Default::default() };
+            synthesize(&a, &dom, &opts, &NoProgress).unwrap()
+        })
+    };
+    let (a, b) = (run(1), run(2));
+    let bits = |r: &fieldtex_synth::SynthesisResult| {
+        r.coords.iter().flat_map(|u| [u[0].to_bits(), u[1].to_bits()]).collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(a.flips, b.flips);
+    assert_eq!(a.colors, b.colors);
+    // A different seed gives a different texture.
+    let c =
+        synthesize(&an, &dom, &SynthesisOptions { seed: 10, ..Default::default() }, &NoProgress)
+            .unwrap();
+    assert_ne!(bits(&a), bits(&c));
+}
+
+#[test]
+fn stripes_follow_a_constant_field() {
+    let an = analyse(&stripes(32));
+    for deg in [0.0f32, 45.0, 120.0] {
+        let dom = ImageDomain::constant(64, 64, deg.to_radians(), 1.0).unwrap();
+        let r = synthesize(&an, &dom, &SynthesisOptions::default(), &NoProgress).unwrap();
+        let (theta, coherence) = stripe_orientation(&r.colors);
+        let err = angle_diff_mod_pi(theta, deg.to_radians()).to_degrees();
+        assert!(
+            err < 8.0,
+            "field {deg}°: stripes at {}° (coherence {coherence})",
+            theta.to_degrees()
+        );
+        assert!(coherence > 0.6, "field {deg}°: weak orientation, coherence {coherence}");
+    }
+}
+
+#[test]
+fn neighbouring_samples_are_mostly_coherent() {
+    let an = analyse(&blotches(32, 32));
+    let angle = 0.5f32;
+    let dom = ImageDomain::constant(64, 64, angle, 1.0).unwrap();
+    let r = synthesize(&an, &dom, &SynthesisOptions::default(), &NoProgress).unwrap();
+    let (w, h) = (64usize, 64usize);
+    let (mut ok, mut total) = (0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w - 1 {
+            let (p, q) = (y * w + x, y * w + x + 1);
+            let j = dom.jacobian(0, p);
+            let sign = if r.flips[p] { -1.0 } else { 1.0 };
+            // Expected exemplar step for the domain offset (1, 0).
+            let e = [sign * j[0], sign * j[2]];
+            let wrap = |d: f32| (d + 16.0).rem_euclid(32.0) - 16.0;
+            let dx = wrap(r.coords[q][0] - r.coords[p][0] - e[0]);
+            let dy = wrap(r.coords[q][1] - r.coords[p][1] - e[1]);
+            total += 1;
+            if dx.abs() < 0.5 && dy.abs() < 0.5 {
+                ok += 1;
+            }
+        }
+    }
+    let frac = ok as f32 / total as f32;
+    assert!(frac > 0.6, "only {:.0}% of neighbouring samples are coherent", 100.0 * frac);
+}
+
+/// Fraction of horizontal neighbour pairs in columns `x0..x1` whose coordinates differ by
+/// the effective frame `(−1)^I J` applied to (1, 0), within half a pixel.
+fn coherent_fraction(
+    r: &fieldtex_synth::SynthesisResult,
+    dom: &ImageDomain,
+    ex_size: f32,
+    x0: usize,
+    x1: usize,
+) -> f32 {
+    let (w, h) = (dom.width, dom.height);
+    let (mut ok, mut total) = (0usize, 0usize);
+    let wrap = |d: f32| (d + ex_size / 2.0).rem_euclid(ex_size) - ex_size / 2.0;
+    for y in 0..h {
+        for x in x0..x1.min(w - 1) {
+            let (p, q) = (y * w + x, y * w + x + 1);
+            let j = dom.jacobian(0, p);
+            let sign = if r.flips[p] { -1.0 } else { 1.0 };
+            let dx = wrap(r.coords[q][0] - r.coords[p][0] - sign * j[0]);
+            let dy = wrap(r.coords[q][1] - r.coords[p][1] - sign * j[2]);
+            total += 1;
+            if dx.abs() < 0.5
+                && dy.abs() < 0.5
+                && r.flips[p] == r.flips[q] ^ (dom.jacobian(0, q)[0] * j[0] < 0.0)
+            {
+                ok += 1;
+            }
+        }
+    }
+    ok as f32 / total.max(1) as f32
+}
+
+#[test]
+fn rosy_fix_keeps_patches_coherent_across_a_representative_flip() {
+    // Representative points right on the left half and left on the right half: the same
+    // orientation field everywhere (horizontal), a 180° jump in the vector field.
+    let an = analyse(&blotches(32, 32));
+    let (w, h) = (64usize, 48usize);
+    let field: Vec<f32> =
+        (0..w * h).flat_map(|i| if i % w < w / 2 { [1.0, 0.0] } else { [-1.0, 0.0] }).collect();
+    let dom = ImageDomain::from_direction_field(w, h, &field, 1.0).unwrap();
+    let fixed = synthesize(&an, &dom, &SynthesisOptions::default(), &NoProgress).unwrap();
+    let plain = synthesize(
+        &an,
+        &dom,
+        &SynthesisOptions { rosy_fix: false, ..Default::default() },
+        &NoProgress,
+    )
+    .unwrap();
+    assert!(plain.flips.iter().all(|&f| !f));
+    let seam_fixed = coherent_fraction(&fixed, &dom, 32.0, 29, 35);
+    let seam_plain = coherent_fraction(&plain, &dom, 32.0, 29, 35);
+    let away = coherent_fraction(&fixed, &dom, 32.0, 4, 24);
+    eprintln!("seam fixed {seam_fixed} plain {seam_plain} away {away}");
+    assert!(seam_fixed > seam_plain + 0.1, "fixed {seam_fixed} vs plain {seam_plain}");
+    assert!(seam_fixed > 0.5 * away, "seam {seam_fixed} vs away {away}");
+}
+
+#[test]
+fn bad_exemplars_and_options_are_refused() {
+    let opts = AnalysisOptions::default();
+    assert!(matches!(
+        ExemplarAnalysis::new(&Image::new(7, 30, [0.5; 4]), &opts, &NoProgress),
+        Err(SynthError::ExemplarTooSmall { width: 7, height: 30, .. })
+    ));
+    assert!(matches!(
+        ExemplarAnalysis::new(&Image::new(1100, 9, [0.5; 4]), &opts, &NoProgress),
+        Err(SynthError::ExemplarTooLarge { .. })
+    ));
+    let mut nan = blotches(10, 10);
+    nan.pixels[23][1] = f32::NAN;
+    assert!(matches!(
+        ExemplarAnalysis::new(&nan, &opts, &NoProgress),
+        Err(SynthError::NonFiniteExemplar { index: 23, x: 3, y: 2, .. })
+    ));
+    let mut short = blotches(10, 10);
+    short.pixels.pop();
+    assert!(ExemplarAnalysis::new(&short, &opts, &NoProgress).is_err());
+    // A flat exemplar must not panic (degenerate PCA).
+    let flat = analyse(&Image::new(12, 12, [0.3, 0.3, 0.3, 1.0]));
+    let dom = ImageDomain::constant(16, 16, 0.0, 1.0).unwrap();
+    assert!(synthesize(&flat, &dom, &SynthesisOptions::default(), &NoProgress).is_ok());
+    let an = analyse(&blotches(12, 12));
+    for o in [
+        SynthesisOptions { subpasses: 3, ..Default::default() },
+        SynthesisOptions { k: 5, ..Default::default() },
+        SynthesisOptions { jitter: f32::NAN, ..Default::default() },
+        SynthesisOptions { scale: 0.0, ..Default::default() },
+    ] {
+        assert!(matches!(
+            synthesize(&an, &dom, &o, &NoProgress),
+            Err(SynthError::InvalidOption { .. })
+        ));
+    }
+    assert!(ImageDomain::new(2, 2, vec![[0.0; 4]; 4]).is_err());
+}
