@@ -9,28 +9,16 @@
 
 use crate::EvalError;
 use crate::image_view::ImageView;
-use crate::nearest_patch::{
-    PatchDistanceOptions, PatchDistanceReport, PatchGrid, nearest_patch_ssd, summarize,
-};
+use crate::nearest_patch::{PatchDistanceOptions, PatchDistanceReport, coherence_distances};
 
 /// Coherence of `output` with respect to `exemplar` (same channel count; values
-/// usually sRGB in `[0, 1]`). Errors when either image is smaller than the patch.
+/// usually sRGB in `[0, 1]`). Errors when either image is smaller than the patch. To
+/// get completeness as well, [`crate::coherence_and_completeness`] does both in one
+/// scan.
 pub fn coherence(
     output: &ImageView,
     exemplar: &ImageView,
     options: &PatchDistanceOptions,
 ) -> Result<PatchDistanceReport, EvalError> {
-    options.validate()?;
-    if output.channels != exemplar.channels {
-        return Err(EvalError::ChannelMismatch {
-            what: "coherence",
-            a: output.channels,
-            b: exemplar.channels,
-        });
-    }
-    let n = options.patch_size;
-    let query = PatchGrid::new(output, n, false, "coherence output")?;
-    let db = PatchGrid::new(exemplar, n, options.wrap_exemplar, "coherence exemplar")?;
-    let (d, evals) = nearest_patch_ssd(&query, &db, options.pruning_dims);
-    Ok(summarize(&d, query.dim(), db.count(), n, evals))
+    coherence_distances(output, exemplar, options).map(|r| r.0)
 }

@@ -8,28 +8,15 @@
 
 use crate::EvalError;
 use crate::image_view::ImageView;
-use crate::nearest_patch::{
-    PatchDistanceOptions, PatchDistanceReport, PatchGrid, nearest_patch_ssd, summarize,
-};
+use crate::nearest_patch::{PatchDistanceOptions, PatchDistanceReport, completeness_distances};
 
 /// Completeness of `output` with respect to `exemplar`; `wrap_exemplar` makes the
-/// exemplar's query patches wrap around its edges.
+/// exemplar's patches wrap around its edges. To get coherence as well,
+/// [`crate::coherence_and_completeness`] does both in one scan.
 pub fn completeness(
     output: &ImageView,
     exemplar: &ImageView,
     options: &PatchDistanceOptions,
 ) -> Result<PatchDistanceReport, EvalError> {
-    options.validate()?;
-    if output.channels != exemplar.channels {
-        return Err(EvalError::ChannelMismatch {
-            what: "completeness",
-            a: output.channels,
-            b: exemplar.channels,
-        });
-    }
-    let n = options.patch_size;
-    let query = PatchGrid::new(exemplar, n, options.wrap_exemplar, "completeness exemplar")?;
-    let db = PatchGrid::new(output, n, false, "completeness output")?;
-    let (d, evals) = nearest_patch_ssd(&query, &db, options.pruning_dims);
-    Ok(summarize(&d, query.dim(), db.count(), n, evals))
+    completeness_distances(output, exemplar, options)
 }

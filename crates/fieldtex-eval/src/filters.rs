@@ -19,6 +19,12 @@ pub(crate) fn mirror(i: isize, n: usize) -> usize {
     k as usize
 }
 
+/// `row` extended by `r` mirrored values on each side.
+pub(crate) fn mirrored_row(row: &[f32], r: usize) -> Vec<f32> {
+    let n = row.len();
+    (0..n + 2 * r).map(|i| row[mirror(i as isize - r as isize, n)]).collect()
+}
+
 /// Normalised sampled Gaussian of standard deviation `sigma` and radius `⌈3σ⌉`.
 pub(crate) fn gaussian_kernel(sigma: f64) -> Vec<f32> {
     if sigma.is_nan() || sigma <= 0.0 {
@@ -40,13 +46,14 @@ pub(crate) fn separable(
     ky: &[f32],
 ) -> Vec<f32> {
     let mut tmp = vec![0f32; data.len()];
-    let rx = (kx.len() / 2) as isize;
+    let rx = kx.len() / 2;
     tmp.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
-        let src = &data[y * width..(y + 1) * width];
+        let padded = mirrored_row(&data[y * width..(y + 1) * width], rx);
         for (x, out) in row.iter_mut().enumerate() {
+            let win = &padded[x..x + kx.len()];
             let mut acc = 0f32;
-            for (k, &w) in kx.iter().enumerate() {
-                acc += w * src[mirror(x as isize + k as isize - rx, width)];
+            for (w, v) in kx.iter().zip(win) {
+                acc += w * v;
             }
             *out = acc;
         }

@@ -21,7 +21,6 @@ mod filters;
 pub mod image_view;
 pub mod nearest_patch;
 pub mod orientation;
-mod patch_pca;
 pub mod phase_defects;
 pub mod singularities;
 
@@ -32,7 +31,9 @@ pub use color_sliced_wasserstein::{
 pub use completeness::completeness;
 pub use error::EvalError;
 pub use image_view::{FieldView, ImageView, rgb_buffer};
-pub use nearest_patch::{PatchDistanceOptions, PatchDistanceReport, coherence_map};
+pub use nearest_patch::{
+    PatchDistanceOptions, PatchDistanceReport, coherence_and_completeness, coherence_map,
+};
 pub use orientation::{
     OrientationErrorOptions, OrientationErrorReport, OrientationMap, OrientationOptions,
     OrientationReference, dominant_orientation, image_orientation, luminance_orientation,

@@ -1,30 +1,26 @@
-//! Exact nearest-neighbour search between all `N×N` patches of two images: the core of
-//! [`coherence`](crate::coherence()) and [`completeness`](crate::completeness()).
+//! Exact nearest-patch distances between all `N×N` patches of two images, in both
+//! directions at once: the core of [`coherence`](crate::coherence()) and
+//! [`completeness`](crate::completeness()).
 //!
-//! Distance: sum of squared differences over the `N·N·C` values of two patches. The
-//! search is **exact** (the minimum over every database patch, up to `f32` rounding)
-//! but avoids most of the brute-force work:
-//! 1. a few leading principal directions of the database patches (`patch_pca`) give
-//!    every patch `k` coordinates; since the directions are orthonormal, the squared
-//!    distance of two patches' coordinates is a lower bound of their true distance;
-//! 2. a kd-tree over those coordinates is searched with that bound (a subtree or a
-//!    point is skipped only when its bound exceeds the best distance found so far,
-//!    with a relative slack of 1e-3 against rounding);
-//! 3. each query starts from the best match of its left and upper neighbours, shifted
-//!    by one pixel (coherent outputs make this nearly optimal at once);
-//! 4. true distances stop accumulating once they exceed the best.
+//! Distance: sum of squared differences over the `N·N·C` values of two patches.
+//! Method: a brute-force scan organised **by displacement** instead of by patch pair.
+//! For every offset `δ` between an output patch position `p` and an exemplar patch
+//! position `p + δ`, the per-pixel squared differences of the overlapping region are
+//! computed once and box-summed over `N×N` windows (rows of `N` consecutive values,
+//! then `N` consecutive rows, always in the same order), giving the distance of every
+//! pair at that offset with `3C + 2N` operations per pixel instead of `N²C`. Each
+//! output patch keeps its minimum over all offsets (coherence) and each exemplar patch
+//! its minimum over all offsets (completeness). The cost is
+//! `#output patches × #exemplar patches × (3C + 2N)` flops whatever the content (no
+//! data-dependent worst case), in contiguous vectorisable loops.
 //!
-//! The result is the same for any thread count (each query's minimum is an exact
-//! minimum of deterministically computed sums). Run time depends on the data: outputs
-//! made of exemplar pieces are fast; outputs unlike the exemplar (noise) approach a
-//! brute-force scan.
+//! Exact: every pair is compared; the minimum of floats is order-independent, so the
+//! result is bit-identical for any thread count, and identical patches give exactly 0.
 
 use crate::EvalError;
 use crate::image_view::ImageView;
-use crate::patch_pca::leading_directions;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::borrow::Cow;
 
 /// Options shared by coherence and completeness.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -34,13 +30,11 @@ pub struct PatchDistanceOptions {
     /// Treat the exemplar as tileable: its patches wrap around the edges. Default
     /// false (only patches fully inside the exemplar).
     pub wrap_exemplar: bool,
-    /// Principal directions used for pruning (does not change the result). Default 12.
-    pub pruning_dims: usize,
 }
 
 impl Default for PatchDistanceOptions {
     fn default() -> Self {
-        Self { patch_size: 7, wrap_exemplar: false, pruning_dims: 12 }
+        Self { patch_size: 7, wrap_exemplar: false }
     }
 }
 
@@ -61,22 +55,17 @@ impl PatchDistanceOptions {
                 reason: "must be in 1..=64 pixels",
             });
         }
-        if self.pruning_dims == 0 || self.pruning_dims > 64 {
-            return Err(EvalError::InvalidOption {
-                name: "pruning_dims",
-                value: self.pruning_dims.to_string(),
-                reason: "must be in 1..=64",
-            });
-        }
         Ok(())
     }
 }
 
-/// All `n × n` patches of an image, addressed by their top-left pixel.
-pub(crate) struct PatchGrid<'a> {
-    data: Cow<'a, [f32]>,
-    /// Row length of `data` in pixels.
+/// An image as channel planes, padded by wrapping when patches wrap, with the grid of
+/// patch positions (top-left pixels).
+pub(crate) struct PatchGrid {
+    /// `channels` planes of `stride × height` values.
+    planes: Vec<f32>,
     stride: usize,
+    height: usize,
     channels: usize,
     n: usize,
     /// Patch positions along x and y.
@@ -84,10 +73,10 @@ pub(crate) struct PatchGrid<'a> {
     pub rows: usize,
 }
 
-impl<'a> PatchGrid<'a> {
+impl PatchGrid {
     /// Patches of `img`; with `wrap`, every pixel anchors a patch that wraps around.
     pub fn new(
-        img: &ImageView<'a>,
+        img: &ImageView,
         n: usize,
         wrap: bool,
         what: &'static str,
@@ -96,36 +85,21 @@ impl<'a> PatchGrid<'a> {
         if w < n || h < n || w == 0 || h == 0 {
             return Err(EvalError::TooSmall { what, width: w, height: h, min: n });
         }
-        if !wrap {
-            return Ok(Self {
-                data: Cow::Borrowed(img.data),
-                stride: w,
-                channels: c,
-                n,
-                cols: w - n + 1,
-                rows: h - n + 1,
-            });
-        }
-        let (pw, ph) = (w + n - 1, h + n - 1);
-        let mut data = Vec::with_capacity(pw * ph * c);
-        for y in 0..ph {
-            for x in 0..pw {
-                let i = ((y % h) * w + (x % w)) * c;
-                data.extend_from_slice(&img.data[i..i + c]);
+        let (pw, ph, cols, rows) =
+            if wrap { (w + n - 1, h + n - 1, w, h) } else { (w, h, w - n + 1, h - n + 1) };
+        let mut planes = vec![0f32; c * pw * ph];
+        for ch in 0..c {
+            for y in 0..ph {
+                for x in 0..pw {
+                    planes[(ch * ph + y) * pw + x] = img.data[((y % h) * w + (x % w)) * c + ch];
+                }
             }
         }
-        Ok(Self { data: Cow::Owned(data), stride: pw, channels: c, n, cols: w, rows: h })
+        Ok(Self { planes, stride: pw, height: ph, channels: c, n, cols, rows })
     }
 
     pub fn count(&self) -> usize {
         self.cols * self.rows
-    }
-
-    /// Values of row `r` of the patch at `(x, y)`: `n · channels` floats.
-    #[inline]
-    fn row(&self, x: usize, y: usize, r: usize) -> &[f32] {
-        let s = ((y + r) * self.stride + x) * self.channels;
-        &self.data[s..s + self.n * self.channels]
     }
 
     /// Dimension of a patch vector.
@@ -133,326 +107,237 @@ impl<'a> PatchGrid<'a> {
         self.n * self.n * self.channels
     }
 
-    fn gather(&self, x: usize, y: usize, out: &mut Vec<f32>) {
-        out.clear();
-        for r in 0..self.n {
-            out.extend_from_slice(self.row(x, y, r));
-        }
+    /// `len` values of channel `ch`, row `y`, from column `x`.
+    #[inline]
+    fn span(&self, ch: usize, y: usize, x: usize, len: usize) -> &[f32] {
+        let s = (ch * self.height + y) * self.stride + x;
+        &self.planes[s..s + len]
     }
 }
 
-/// `Σ (a − b)²` with eight fixed accumulators (vectorisable, fixed order).
-#[inline]
-fn sq_diff_sum(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = [0f32; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for k in 0..8 {
-            let d = x[k] - y[k];
-            acc[k] += d * d;
-        }
-    }
-    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-    for (x, y) in ra.iter().zip(rb) {
-        s += (x - y) * (x - y);
-    }
-    s
+/// Running minima and scratch rows of one scanning task.
+struct ScanState {
+    q_min: Vec<f32>,
+    db_min: Vec<f32>,
+    s: Vec<f32>,
+    ring: Vec<f32>,
+    v: Vec<f32>,
+    /// Ring offsets of the last `n` rows, oldest first.
+    offs: Vec<usize>,
+    /// `0, 1, …, n−1`: the shifts of a horizontal window.
+    h_offs: Vec<usize>,
 }
 
-#[inline]
-fn dot(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = [0f32; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for k in 0..8 {
-            acc[k] += x[k] * y[k];
+impl ScanState {
+    fn new(nq: usize, ndb: usize, max_cols: usize, n: usize) -> Self {
+        Self {
+            q_min: vec![f32::INFINITY; nq],
+            db_min: vec![f32::INFINITY; ndb],
+            s: vec![0.0; max_cols.next_multiple_of(BLOCK) + n],
+            ring: vec![0.0; n * max_cols.next_multiple_of(BLOCK)],
+            v: vec![0.0; max_cols.next_multiple_of(BLOCK)],
+            offs: vec![0; n],
+            h_offs: (0..n).collect(),
         }
     }
-    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
+
+    fn merge(mut self, other: Self) -> Self {
+        for (a, b) in self.q_min.iter_mut().zip(&other.q_min) {
+            *a = a.min(*b);
+        }
+        for (a, b) in self.db_min.iter_mut().zip(&other.db_min) {
+            *a = a.min(*b);
+        }
+        self
     }
-    s
 }
 
-/// Squared distance of two patches, stopping early once it exceeds `limit`.
-#[inline]
-fn patch_ssd(
-    a: &PatchGrid,
-    ax: usize,
-    ay: usize,
-    b: &PatchGrid,
-    bx: usize,
-    by: usize,
-    limit: f32,
-) -> f32 {
-    let mut acc = 0f32;
-    for r in 0..a.n {
-        acc += sq_diff_sum(a.row(ax, ay, r), b.row(bx, by, r));
-        if acc > limit {
-            return acc;
+/// `out[j..j+L] = Σ_t data[offs[t] + j..][..L]`, summed in the order of `offs`.
+#[inline(always)]
+fn block_sum<const L: usize>(data: &[f32], offs: &[usize], j: usize, out: &mut [f32]) {
+    let mut acc = [0f32; L];
+    acc.copy_from_slice(&data[offs[0] + j..offs[0] + j + L]);
+    for &o in &offs[1..] {
+        let h = &data[o + j..o + j + L];
+        for k in 0..L {
+            acc[k] += h[k];
         }
     }
-    acc
+    out[j..j + L].copy_from_slice(&acc);
 }
 
-/// Principal directions (rows of `k × dim`, `f32`) of a sample of `grid`'s patches.
-fn pruning_basis(grid: &PatchGrid, k: usize) -> Vec<f32> {
-    let d = grid.dim();
-    let total = grid.count();
-    let step = (total / 4096).max(1);
-    let ids: Vec<usize> = (0..total).step_by(step).collect();
-    let chunks: Vec<(Vec<f64>, Vec<f64>)> = ids
-        .par_chunks(256)
-        .map(|chunk| {
-            let mut sum = vec![0f64; d];
-            let mut outer = vec![0f64; d * d];
-            let mut v = Vec::with_capacity(d);
-            for &id in chunk {
-                grid.gather(id % grid.cols, id / grid.cols, &mut v);
-                for i in 0..d {
-                    let vi = v[i] as f64;
-                    sum[i] += vi;
-                    let row = &mut outer[i * d..(i + 1) * d];
-                    for (o, &vj) in row.iter_mut().zip(&v) {
-                        *o += vi * vj as f64;
+/// Lanes of one block of window sums: four AVX vectors, i.e. four independent
+/// accumulation chains (one chain alone is bound by the latency of the adds). Rows
+/// are padded to a multiple of this, the extra lanes computed and ignored.
+const BLOCK: usize = 32;
+
+/// `out[j] = Σ_t data[offs[t] + j]` for every `j` (`out.len()` a multiple of
+/// [`BLOCK`]), each element summed in the order of `offs`.
+#[inline(always)]
+fn shifted_sums(data: &[f32], offs: &[usize], out: &mut [f32]) {
+    for j in (0..out.len()).step_by(BLOCK) {
+        block_sum::<BLOCK>(data, offs, j, out);
+    }
+}
+
+/// All pairs at displacement `(dx, dy)` (exemplar position = query position + δ).
+/// Per pair the distance is `Σ_rows Σ_cols Σ_channels (a − b)²` summed in that fixed
+/// order, whichever offset or thread computes it.
+#[inline(always)]
+fn scan_offset_impl(q: &PatchGrid, db: &PatchGrid, dx: isize, dy: isize, st: &mut ScanState) {
+    let n = q.n;
+    let x_lo = (-dx).max(0);
+    let x_hi = (q.cols as isize).min(db.cols as isize - dx);
+    let y_lo = (-dy).max(0);
+    let y_hi = (q.rows as isize).min(db.rows as isize - dy);
+    if x_hi <= x_lo || y_hi <= y_lo {
+        return;
+    }
+    let (x_lo, nx) = (x_lo as usize, (x_hi - x_lo) as usize);
+    let (y_lo, ny) = (y_lo as usize, (y_hi - y_lo) as usize);
+    let lpx = nx + n - 1;
+    let nxp = nx.next_multiple_of(BLOCK);
+    let dbx = (x_lo as isize + dx) as usize;
+    let ScanState { q_min, db_min, s, ring, v, offs, h_offs } = st;
+    let s = &mut s[..nxp + n - 1];
+    s[lpx..].fill(0.0);
+    let offs = &mut offs[..n];
+    let h_offs = &h_offs[..n];
+    for r in 0..ny + n - 1 {
+        let py = y_lo + r;
+        let dby = (py as isize + dy) as usize;
+        // Per-pixel squared colour differences.
+        match q.channels {
+            3 => {
+                let (a0, a1, a2) =
+                    (q.span(0, py, x_lo, lpx), q.span(1, py, x_lo, lpx), q.span(2, py, x_lo, lpx));
+                let (b0, b1, b2) = (
+                    db.span(0, dby, dbx, lpx),
+                    db.span(1, dby, dbx, lpx),
+                    db.span(2, dby, dbx, lpx),
+                );
+                let a = a0.iter().zip(a1).zip(a2);
+                let b = b0.iter().zip(b1).zip(b2);
+                for (si, (((a0, a1), a2), ((b0, b1), b2))) in s.iter_mut().zip(a.zip(b)) {
+                    let (d0, d1, d2) = (a0 - b0, a1 - b1, a2 - b2);
+                    *si = d0 * d0 + d1 * d1 + d2 * d2;
+                }
+            }
+            1 => {
+                let (a, b) = (q.span(0, py, x_lo, lpx), db.span(0, dby, dbx, lpx));
+                for (si, (a, b)) in s.iter_mut().zip(a.iter().zip(b)) {
+                    let d = a - b;
+                    *si = d * d;
+                }
+            }
+            _ => {
+                s[..lpx].fill(0.0);
+                for ch in 0..q.channels {
+                    let (a, b) = (q.span(ch, py, x_lo, lpx), db.span(ch, dby, dbx, lpx));
+                    for (si, (a, b)) in s.iter_mut().zip(a.iter().zip(b)) {
+                        let d = a - b;
+                        *si += d * d;
                     }
                 }
             }
-            (sum, outer)
-        })
-        .collect();
-    let mut sum = vec![0f64; d];
-    let mut cov = vec![0f64; d * d];
-    for (s, o) in &chunks {
-        sum.iter_mut().zip(s).for_each(|(a, b)| *a += b);
-        cov.iter_mut().zip(o).for_each(|(a, b)| *a += b);
-    }
-    let n = ids.len() as f64;
-    for i in 0..d {
-        for j in 0..d {
-            cov[i * d + j] = cov[i * d + j] / n - (sum[i] / n) * (sum[j] / n);
         }
-    }
-    leading_directions(&cov, d, k).into_iter().flatten().map(|v| v as f32).collect()
-}
-
-/// Pruning coordinates (`count × k`) of every patch of `grid`.
-fn project_all(grid: &PatchGrid, basis: &[f32], k: usize) -> Vec<f32> {
-    let d = grid.dim();
-    let mut out = vec![0f32; grid.count() * k];
-    out.par_chunks_mut(grid.cols * k).enumerate().for_each(|(y, row)| {
-        let mut v = Vec::with_capacity(d);
-        for x in 0..grid.cols {
-            grid.gather(x, y, &mut v);
-            for j in 0..k {
-                row[x * k + j] = dot(&v, &basis[j * d..(j + 1) * d]);
+        // Horizontal window sums into the ring slot of this row.
+        let slot = r % n;
+        shifted_sums(s, h_offs, &mut ring[slot * nxp..(slot + 1) * nxp]);
+        if r + 1 < n {
+            continue;
+        }
+        // Vertical window sum over the last n rows, oldest first.
+        let mut slot = (r + 1 - n) % n;
+        for o in offs.iter_mut() {
+            *o = slot * nxp;
+            slot = if slot + 1 == n { 0 } else { slot + 1 };
+        }
+        let v = &mut v[..nxp];
+        shifted_sums(ring, offs, v);
+        let v = &v[..nx];
+        let qy = py + 1 - n;
+        if !q_min.is_empty() {
+            let qrow = &mut q_min[qy * q.cols + x_lo..qy * q.cols + x_lo + nx];
+            for (m, d) in qrow.iter_mut().zip(v) {
+                *m = if *d < *m { *d } else { *m };
             }
         }
-    });
-    out
-}
-
-/// Kd-tree over `k`-dimensional points, leaves of at most `LEAF` points stored
-/// contiguously.
-struct KdTree {
-    k: usize,
-    points: Vec<f32>,
-    ids: Vec<u32>,
-    nodes: Vec<Node>,
-}
-
-enum Node {
-    Leaf { start: u32, end: u32 },
-    Split { dim: u32, value: f32, left: u32, right: u32 },
-}
-
-const LEAF: usize = 12;
-
-impl KdTree {
-    fn build(coords: &[f32], k: usize) -> Self {
-        let n = coords.len() / k;
-        let mut order: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = Vec::new();
-        Self::build_node(coords, k, &mut order, 0, &mut nodes);
-        let mut points = Vec::with_capacity(n * k);
-        for &i in &order {
-            points.extend_from_slice(&coords[i as usize * k..(i as usize + 1) * k]);
-        }
-        Self { k, points, ids: order, nodes }
-    }
-
-    fn build_node(
-        coords: &[f32],
-        k: usize,
-        ids: &mut [u32],
-        offset: usize,
-        nodes: &mut Vec<Node>,
-    ) -> u32 {
-        let me = nodes.len() as u32;
-        if ids.len() <= LEAF {
-            nodes.push(Node::Leaf { start: offset as u32, end: (offset + ids.len()) as u32 });
-            return me;
-        }
-        // Split the dimension of largest spread at its median.
-        let mut best = (0usize, -1f32);
-        for dim in 0..k {
-            let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-            for &i in ids.iter() {
-                let v = coords[i as usize * k + dim];
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-            if hi - lo > best.1 {
-                best = (dim, hi - lo);
-            }
-        }
-        let dim = best.0;
-        let mid = ids.len() / 2;
-        ids.select_nth_unstable_by(mid, |&a, &b| {
-            coords[a as usize * k + dim].total_cmp(&coords[b as usize * k + dim]).then(a.cmp(&b))
-        });
-        let value = coords[ids[mid] as usize * k + dim];
-        nodes.push(Node::Leaf { start: 0, end: 0 }); // placeholder
-        let (l, r) = ids.split_at_mut(mid);
-        let left = Self::build_node(coords, k, l, offset, nodes);
-        let right = Self::build_node(coords, k, r, offset + mid, nodes);
-        nodes[me as usize] = Node::Split { dim: dim as u32, value, left, right };
-        me
-    }
-}
-
-/// Best match so far: squared distance and database id.
-#[derive(Clone, Copy)]
-struct Best {
-    dist: f32,
-    id: u32,
-}
-
-impl Best {
-    #[inline]
-    fn bound(&self) -> f32 {
-        self.dist * 1.001 + 1e-6
-    }
-    #[inline]
-    fn offer(&mut self, dist: f32, id: u32) {
-        if dist < self.dist || (dist == self.dist && id < self.id) {
-            *self = Best { dist, id };
-        }
-    }
-}
-
-struct Search<'s> {
-    tree: &'s KdTree,
-    q: &'s [f32],
-    offsets: Vec<f32>,
-    exact: &'s mut dyn FnMut(u32, f32) -> f32,
-    evaluations: u64,
-}
-
-impl Search<'_> {
-    fn visit(&mut self, node: u32, rd: f32, best: &mut Best) {
-        match self.tree.nodes[node as usize] {
-            Node::Leaf { start, end } => {
-                let k = self.tree.k;
-                for slot in start as usize..end as usize {
-                    let p = &self.tree.points[slot * k..(slot + 1) * k];
-                    let lb = sq_diff_sum(p, self.q);
-                    if lb > best.bound() {
-                        continue;
-                    }
-                    let id = self.tree.ids[slot];
-                    let d = (self.exact)(id, best.dist);
-                    self.evaluations += 1;
-                    best.offer(d, id);
-                }
-            }
-            Node::Split { dim, value, left, right } => {
-                let dim = dim as usize;
-                let diff = self.q[dim] - value;
-                let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
-                self.visit(near, rd, best);
-                let old = self.offsets[dim];
-                let far_rd = rd - old * old + diff * diff;
-                if far_rd <= best.bound() {
-                    self.offsets[dim] = diff;
-                    self.visit(far, far_rd, best);
-                    self.offsets[dim] = old;
-                }
+        if !db_min.is_empty() {
+            let dbrow = (qy as isize + dy) as usize * db.cols + dbx;
+            for (m, d) in db_min[dbrow..dbrow + nx].iter_mut().zip(v) {
+                *m = if *d < *m { *d } else { *m };
             }
         }
     }
 }
 
-/// For every query patch (row-major over the query grid), the smallest squared
-/// distance to any database patch; plus the number of full distance evaluations.
-pub(crate) fn nearest_patch_ssd(query: &PatchGrid, db: &PatchGrid, k: usize) -> (Vec<f32>, u64) {
-    let k = k.min(db.dim()).max(1);
-    let basis = pruning_basis(db, k);
-    let db_coords = project_all(db, &basis, k);
-    let q_coords = project_all(query, &basis, k);
-    let tree = KdTree::build(&db_coords, k);
-    const CHUNK: usize = 4;
-    let chunks: Vec<(Vec<f32>, u64)> = (0..query.rows.div_ceil(CHUNK))
+/// The scan compiled for AVX2 (same IEEE operations per lane, no FMA contraction, so
+/// results are bit-identical to the baseline build).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn scan_offset_avx2(q: &PatchGrid, db: &PatchGrid, dx: isize, dy: isize, st: &mut ScanState) {
+    scan_offset_impl(q, db, dx, dy, st);
+}
+
+fn scan_offset(
+    q: &PatchGrid,
+    db: &PatchGrid,
+    dx: isize,
+    dy: isize,
+    st: &mut ScanState,
+    avx2: bool,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: `avx2` is true only when the CPU reports AVX2 support.
+        unsafe { scan_offset_avx2(q, db, dx, dy, st) };
+        return;
+    }
+    let _ = avx2;
+    scan_offset_impl(q, db, dx, dy, st);
+}
+
+/// For every query patch the smallest squared distance to any database patch, and for
+/// every database patch the smallest to any query patch (row-major over each grid);
+/// a direction not wanted comes back empty (and costs nothing).
+pub(crate) fn nearest_patch_ssd(
+    q: &PatchGrid,
+    db: &PatchGrid,
+    want_q: bool,
+    want_db: bool,
+) -> (Vec<f32>, Vec<f32>) {
+    #[cfg(target_arch = "x86_64")]
+    let avx2 = std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx2 = false;
+    scan_all_offsets(q, db, want_q, want_db, avx2)
+}
+
+fn scan_all_offsets(
+    q: &PatchGrid,
+    db: &PatchGrid,
+    want_q: bool,
+    want_db: bool,
+    avx2: bool,
+) -> (Vec<f32>, Vec<f32>) {
+    let max_cols = q.cols.min(db.cols);
+    let nq = if want_q { q.count() } else { 0 };
+    let ndb = if want_db { db.count() } else { 0 };
+    let state = (-(q.rows as isize) + 1..db.rows as isize)
         .into_par_iter()
-        .map(|c| {
-            let (y0, y1) = (c * CHUNK, ((c + 1) * CHUNK).min(query.rows));
-            let mut out = Vec::with_capacity((y1 - y0) * query.cols);
-            let mut evals = 0u64;
-            let mut prev_row: Vec<u32> = Vec::new();
-            let mut this_row: Vec<u32> = Vec::with_capacity(query.cols);
-            for qy in y0..y1 {
-                this_row.clear();
-                for qx in 0..query.cols {
-                    let mut exact = |id: u32, limit: f32| {
-                        let id = id as usize;
-                        patch_ssd(query, qx, qy, db, id % db.cols, id / db.cols, limit)
-                    };
-                    let mut best = Best { dist: f32::INFINITY, id: u32::MAX };
-                    // Shifted matches of the left and upper neighbours.
-                    let mut seeds = [u32::MAX; 2];
-                    if let Some(&l) = this_row.last()
-                        && (l as usize % db.cols) + 1 < db.cols
-                    {
-                        seeds[0] = l + 1;
-                    }
-                    if let Some(&u) = prev_row.get(qx)
-                        && (u as usize / db.cols) + 1 < db.rows
-                    {
-                        seeds[1] = u + db.cols as u32;
-                    }
-                    for s in seeds.into_iter().filter(|&s| s != u32::MAX) {
-                        let d = exact(s, best.dist);
-                        evals += 1;
-                        best.offer(d, s);
-                    }
-                    let q = &q_coords[(qy * query.cols + qx) * k..(qy * query.cols + qx + 1) * k];
-                    let mut search = Search {
-                        tree: &tree,
-                        q,
-                        offsets: vec![0.0; k],
-                        exact: &mut exact,
-                        evaluations: 0,
-                    };
-                    search.visit(0, 0.0, &mut best);
-                    evals += search.evaluations;
-                    out.push(best.dist);
-                    this_row.push(best.id);
+        .fold(
+            || ScanState::new(nq, ndb, max_cols, q.n),
+            |mut st, dy| {
+                for dx in -(q.cols as isize) + 1..db.cols as isize {
+                    scan_offset(q, db, dx, dy, &mut st, avx2);
                 }
-                std::mem::swap(&mut prev_row, &mut this_row);
-            }
-            (out, evals)
-        })
-        .collect();
-    let mut all = Vec::with_capacity(query.count());
-    let mut evals = 0;
-    for (v, e) in chunks {
-        all.extend(v);
-        evals += e;
-    }
-    (all, evals)
+                st
+            },
+        )
+        .reduce_with(ScanState::merge)
+        .expect("at least one displacement row");
+    (state.q_min, state.db_min)
 }
 
 /// Summary of per-query nearest-patch distances, normalised per pixel and channel.
@@ -472,9 +357,8 @@ pub struct PatchDistanceReport {
     /// Database patches searched.
     pub candidates: usize,
     pub patch_size: usize,
-    /// Full patch distances computed (diagnostic of the pruning; brute force would be
-    /// `queries · candidates`).
-    pub distance_evaluations: u64,
+    /// Patch pairs compared (`queries · candidates`).
+    pub pairs_compared: u64,
 }
 
 pub(crate) fn summarize(
@@ -482,7 +366,6 @@ pub(crate) fn summarize(
     dim: usize,
     candidates: usize,
     n: usize,
-    evals: u64,
 ) -> PatchDistanceReport {
     let norm = 1.0 / dim as f64;
     let mut v: Vec<f64> = dists.iter().map(|&d| d.max(0.0) as f64 * norm).collect();
@@ -500,78 +383,150 @@ pub(crate) fn summarize(
         queries: dists.len(),
         candidates,
         patch_size: n,
-        distance_evaluations: evals,
+        pairs_compared: dists.len() as u64 * candidates as u64,
     }
 }
 
-/// Per-pixel normalised nearest-exemplar distance of every output patch (a heat map
-/// for `coherence`): `(map, map_width, map_height)` where entry `(x, y)` belongs to the
+/// The two patch grids of a comparison, checked.
+fn grids(
+    output: &ImageView,
+    exemplar: &ImageView,
+    options: &PatchDistanceOptions,
+    what: &'static str,
+) -> Result<(PatchGrid, PatchGrid), EvalError> {
+    options.validate()?;
+    if output.channels != exemplar.channels {
+        return Err(EvalError::ChannelMismatch { what, a: output.channels, b: exemplar.channels });
+    }
+    let out = PatchGrid::new(output, options.patch_size, false, "output")?;
+    let ex = PatchGrid::new(exemplar, options.patch_size, options.wrap_exemplar, "exemplar")?;
+    Ok((out, ex))
+}
+
+/// Coherence and completeness from one scan (half the cost of calling
+/// [`coherence`](crate::coherence()) and [`completeness`](crate::completeness())).
+pub fn coherence_and_completeness(
+    output: &ImageView,
+    exemplar: &ImageView,
+    options: &PatchDistanceOptions,
+) -> Result<(PatchDistanceReport, PatchDistanceReport), EvalError> {
+    let (out, ex) = grids(output, exemplar, options, "coherence/completeness")?;
+    let (to_ex, to_out) = nearest_patch_ssd(&out, &ex, true, true);
+    let n = options.patch_size;
+    Ok((summarize(&to_ex, out.dim(), ex.count(), n), summarize(&to_out, ex.dim(), out.count(), n)))
+}
+
+/// Output → exemplar distances only (coherence).
+pub(crate) fn coherence_distances(
+    output: &ImageView,
+    exemplar: &ImageView,
+    options: &PatchDistanceOptions,
+) -> Result<(PatchDistanceReport, Vec<f32>, usize, usize), EvalError> {
+    let (out, ex) = grids(output, exemplar, options, "coherence")?;
+    let (to_ex, _) = nearest_patch_ssd(&out, &ex, true, false);
+    let report = summarize(&to_ex, out.dim(), ex.count(), options.patch_size);
+    Ok((report, to_ex, out.cols, out.rows))
+}
+
+/// Exemplar → output distances only (completeness).
+pub(crate) fn completeness_distances(
+    output: &ImageView,
+    exemplar: &ImageView,
+    options: &PatchDistanceOptions,
+) -> Result<PatchDistanceReport, EvalError> {
+    let (out, ex) = grids(output, exemplar, options, "completeness")?;
+    let (_, to_out) = nearest_patch_ssd(&out, &ex, false, true);
+    Ok(summarize(&to_out, ex.dim(), out.count(), options.patch_size))
+}
+
+/// Per-patch normalised nearest-exemplar distance of every output patch (a heat map
+/// for coherence): `(map, map_width, map_height)` where entry `(x, y)` belongs to the
 /// patch whose top-left pixel is `(x, y)`, i.e. centred at `(x + N/2, y + N/2)`.
 pub fn coherence_map(
     output: &ImageView,
     exemplar: &ImageView,
     options: &PatchDistanceOptions,
 ) -> Result<(Vec<f32>, usize, usize), EvalError> {
-    options.validate()?;
-    if output.channels != exemplar.channels {
-        return Err(EvalError::ChannelMismatch {
-            what: "coherence",
-            a: output.channels,
-            b: exemplar.channels,
-        });
-    }
-    let q = PatchGrid::new(output, options.patch_size, false, "coherence output")?;
-    let db =
-        PatchGrid::new(exemplar, options.patch_size, options.wrap_exemplar, "coherence exemplar")?;
-    let (d, _) = nearest_patch_ssd(&q, &db, options.pruning_dims);
-    let norm = 1.0 / q.dim() as f32;
-    Ok((d.iter().map(|v| v.max(0.0) * norm).collect(), q.cols, q.rows))
+    let (_, d, w, h) = coherence_distances(output, exemplar, options)?;
+    let norm = 1.0 / (options.patch_size * options.patch_size * output.channels) as f32;
+    Ok((d.iter().map(|v| v.max(0.0) * norm).collect(), w, h))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn noise(w: usize, h: usize, c: usize, seed: u64) -> Vec<f32> {
-        (0..w * h * c)
-            .map(|i| fieldtex_core::rng::hash_unit(seed, "test-noise", i as u64) as f32)
-            .collect()
+    fn noise(n: usize, seed: u64) -> Vec<f32> {
+        (0..n).map(|i| fieldtex_core::rng::hash_unit(seed, "test-noise", i as u64) as f32).collect()
+    }
+
+    /// Direct patch distance with wrapping in the second image when asked.
+    fn direct(
+        a: &ImageView,
+        ax: usize,
+        ay: usize,
+        b: &ImageView,
+        bx: usize,
+        by: usize,
+        n: usize,
+    ) -> f64 {
+        let mut s = 0f64;
+        for r in 0..n {
+            for t in 0..n {
+                for ch in 0..a.channels {
+                    let va = a.at(ax + t, ay + r, ch) as f64;
+                    let vb = b.at((bx + t) % b.width, (by + r) % b.height, ch) as f64;
+                    s += (va - vb) * (va - vb);
+                }
+            }
+        }
+        s
     }
 
     #[test]
-    fn matches_brute_force() {
+    fn simd_and_baseline_builds_agree_bit_for_bit() {
+        let a = noise(40 * 30 * 3, 3);
+        let b = noise(25 * 22 * 3, 4);
+        let va = ImageView::new(&a, 40, 30, 3).unwrap();
+        let vb = ImageView::new(&b, 25, 22, 3).unwrap();
+        let q = PatchGrid::new(&va, 7, false, "q").unwrap();
+        let db = PatchGrid::new(&vb, 7, true, "db").unwrap();
+        let base = scan_all_offsets(&q, &db, true, true, false);
+        let fast = nearest_patch_ssd(&q, &db, true, true);
+        assert_eq!(base, fast);
+    }
+
+    #[test]
+    fn matches_brute_force_both_ways() {
         let (w, h, c, n) = (23, 19, 3, 5);
-        let a = noise(w, h, c, 1);
-        // Database: smooth-ish image so the PCA is meaningful.
-        let b: Vec<f32> = (0..31 * 27 * c)
-            .map(|i| {
-                ((i as f32 * 0.37).sin() * 0.5 + 0.5) * 0.6
-                    + 0.4 * fieldtex_core::rng::hash_unit(2, "t", i as u64) as f32
-            })
-            .collect();
+        let a = noise(w * h * c, 1);
+        let b = noise(17 * 14 * c, 2);
         let va = ImageView::new(&a, w, h, c).unwrap();
-        let vb = ImageView::new(&b, 31, 27, c).unwrap();
+        let vb = ImageView::new(&b, 17, 14, c).unwrap();
         for wrap in [false, true] {
             let q = PatchGrid::new(&va, n, false, "q").unwrap();
             let db = PatchGrid::new(&vb, n, wrap, "db").unwrap();
-            let (fast, evals) = nearest_patch_ssd(&q, &db, 6);
-            for (i, &f) in fast.iter().enumerate() {
+            let (to_db, to_q) = nearest_patch_ssd(&q, &db, true, true);
+            let mut brute_db = vec![f64::INFINITY; db.count()];
+            for (i, &f) in to_db.iter().enumerate() {
                 let (qx, qy) = (i % q.cols, i / q.cols);
-                let mut best = f32::INFINITY;
-                for j in 0..db.count() {
-                    best = best.min(patch_ssd(
-                        &q,
-                        qx,
-                        qy,
-                        &db,
-                        j % db.cols,
-                        j / db.cols,
-                        f32::INFINITY,
-                    ));
+                let mut best = f64::INFINITY;
+                for (j, bd) in brute_db.iter_mut().enumerate() {
+                    let d = direct(&va, qx, qy, &vb, j % db.cols, j / db.cols, n);
+                    best = best.min(d);
+                    *bd = bd.min(d);
                 }
-                assert_eq!(f, best, "query {i} wrap {wrap}");
+                assert!(
+                    (f as f64 - best).abs() < 1e-4 * best.max(1.0),
+                    "query {i} wrap {wrap}: {f} vs {best}"
+                );
             }
-            assert!(evals > 0);
+            for (j, &f) in to_q.iter().enumerate() {
+                assert!(
+                    (f as f64 - brute_db[j]).abs() < 1e-4 * brute_db[j].max(1.0),
+                    "db {j} wrap {wrap}"
+                );
+            }
         }
     }
 }

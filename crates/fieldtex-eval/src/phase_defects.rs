@@ -31,7 +31,7 @@
 //! (their cores are usually removed by the coherence gate).
 
 use crate::EvalError;
-use crate::filters::{gaussian_blur, gaussian_kernel, gradient, mirror};
+use crate::filters::{gaussian_blur, gaussian_kernel, gradient, mirror, mirrored_row};
 use crate::image_view::ImageView;
 use crate::orientation::{OrientationOptions, luminance_orientation};
 use rayon::prelude::*;
@@ -287,11 +287,11 @@ pub fn phase_defects(
         let mut tre = vec![0f32; w * h];
         let mut tim = vec![0f32; w * h];
         tre.par_chunks_mut(w).zip(tim.par_chunks_mut(w)).enumerate().for_each(|(y, (tr, ti))| {
-            let src = &l0[y * w..(y + 1) * w];
+            let padded = mirrored_row(&l0[y * w..(y + 1) * w], r as usize);
             for x in 0..w {
+                let win = &padded[x..x + hx.len()];
                 let (mut a, mut c) = (0f32, 0f32);
-                for (j, &(hr, hi)) in hx.iter().enumerate() {
-                    let v = src[mirror(x as isize + j as isize - r, w)];
+                for (&(hr, hi), &v) in hx.iter().zip(win) {
                     a += hr * v;
                     c += hi * v;
                 }
@@ -301,14 +301,15 @@ pub fn phase_defects(
         });
         // Column pass at the pixels of this bin: R = Σ hy(d) T(x, y + d).
         re.par_chunks_mut(w).zip(im.par_chunks_mut(w)).enumerate().for_each(|(y, (rr, ri))| {
+            let src_rows: Vec<usize> =
+                (0..hy.len()).map(|j| mirror(y as isize + j as isize - r, h) * w).collect();
             for x in 0..w {
                 if bins[y * w + x] as usize != b {
                     continue;
                 }
                 let (mut a, mut c) = (0f32, 0f32);
-                for (j, &(hr, hi)) in hy.iter().enumerate() {
-                    let i = mirror(y as isize + j as isize - r, h) * w + x;
-                    let (vr, vi) = (tre[i], tim[i]);
+                for (&(hr, hi), &row) in hy.iter().zip(&src_rows) {
+                    let (vr, vi) = (tre[row + x], tim[row + x]);
                     a += hr * vr - hi * vi;
                     c += hr * vi + hi * vr;
                 }
