@@ -1,19 +1,26 @@
 //! Chart packing: places flattened charts into a square atlas with gutters.
 //!
-//! Each chart is rasterised conservatively ([`crate::raster`]) at a trial scale
-//! (texels per unit of chart coordinates) into a *footprint* (per texel row, the sorted
-//! spans of covered texels); the footprint grown by a disk of radius `G` (the gutter)
-//! must not meet any texel already covered by another chart. Charts go in order of
-//! decreasing area, each at the lowest, then leftmost, position where it fits, trying
-//! the four rotations by 90° and keeping the one whose top edge ends lowest (a
-//! bottom-left fill on the real chart shapes rather than on their bounding boxes, in
-//! the spirit of the "Tetris" packing of Lévy et al. 2002 §5 and of xatlas's bitmap
-//! packer). Free space is kept as interval lists per row, so a position test costs
-//! a few interval subtractions per chart row.
+//! Each chart is rasterised conservatively (module `chart_footprint`) at a trial
+//! scale (texels per unit of chart coordinates) into a *footprint* bitmap; the
+//! footprint grown by a disk of radius `G` (the gutter) must not meet any texel already
+//! covered by another chart. Charts go in order of decreasing area, each at the lowest,
+//! then leftmost, position where it fits, trying the four rotations by 90° and keeping
+//! the one whose top edge ends lowest (a bottom-left fill on the real chart shapes
+//! rather than on their bounding boxes, in the spirit of the "Tetris" packing of Lévy
+//! et al. 2002 §5 and of xatlas's bitmap packer). Free space is kept as interval lists
+//! per row, so a position test costs a few interval subtractions per chart row; rows
+//! whose longest free run is too short are skipped at once.
 //!
 //! The scale is the largest one (within [`PackingOptions::tolerance`]) at which every
-//! chart fits: a search over the scale, evaluating three trial scales per round in
-//! parallel. Results do not depend on the thread count.
+//! chart fits. Each trial packs into a grid twice as tall as the atlas and reports the
+//! height it used; the height grows roughly like the square of the scale, which gives
+//! the next guess, and the bracket between the best fitting and the smallest failing
+//! scale is then narrowed with three trial scales per round, evaluated in parallel.
+//! Results do not depend on the thread count.
+//!
+//! **Packing efficiency** (reported by the atlas) is the charts' UV triangle area in
+//! texels over the atlas area; gutters and the conservative coverage of boundary
+//! texels count as waste.
 //!
 //! Conventions: atlas texel `(x, y)` has `x` to the right and `y` **up** (row 0 is the
 //! bottom row, `v` ∈ `[0, 1/H]`). Gutter semantics: the centres of two texels covered by
