@@ -77,6 +77,36 @@ enum Command {
         #[arg(long, default_value_t = 4)]
         gutter: usize,
     },
+    /// Orientation-field guided synthesis (paper D): a design file, a fingerprint preset
+    /// or an external field steers the exemplar's x axis.
+    Orient {
+        /// TOML design file (singularities, strokes, weights).
+        #[arg(long, group = "source")]
+        design: Option<PathBuf>,
+        /// Fingerprint preset: arch, tented-arch, left-loop, right-loop, whorl.
+        #[arg(long, group = "source")]
+        preset: Option<String>,
+        /// External field .npy (H×W×2 float32 (dx, dy), x right, y down).
+        #[arg(long, group = "source")]
+        field: Option<PathBuf>,
+        /// Exemplar image (PNG/JPEG).
+        #[arg(long)]
+        exemplar: PathBuf,
+        /// Output size in pixels (square).
+        #[arg(long, default_value_t = 512)]
+        size: usize,
+        /// Field grid cells per side (presets).
+        #[arg(long, default_value_t = 128)]
+        grid: usize,
+        /// Exemplar pixels per output pixel (below 1 enlarges the pattern).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Disable the 2-RoSy fix of paper D §4 (ablation).
+        #[arg(long)]
+        no_rosy_fix: bool,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Render a shaded preview of a mesh (textured when it has a texture).
     Render {
         model: PathBuf,
@@ -194,6 +224,41 @@ fn run(cli: Cli) -> Result<(), Error> {
             if !g.quiet {
                 println!("{}", serde_json::to_string_pretty(&report.metrics).unwrap_or_default());
             }
+        }
+        Command::Orient {
+            design,
+            preset,
+            field,
+            exemplar,
+            size,
+            grid,
+            scale,
+            no_rosy_fix,
+            out,
+        } => {
+            let source = match (design, preset, field) {
+                (Some(d), _, _) => fieldtex::FieldSource::Design(d),
+                (None, Some(p), _) => fieldtex::FieldSource::Preset(p),
+                (None, None, Some(f)) => fieldtex::FieldSource::Field(f),
+                (None, None, None) => {
+                    return Err(Error::bad_input(
+                        None,
+                        "orient needs one of --design FILE, --preset NAME or --field F.npy",
+                    ));
+                }
+            };
+            let mut opts = fieldtex::OrientOptions::new(source, exemplar);
+            opts.size = size;
+            opts.grid = grid;
+            opts.scale = scale;
+            opts.rosy_fix = !no_rosy_fix;
+            opts.seed = g.seed;
+            let report = fieldtex::orient(&out, &opts, &progress)?;
+            print_warnings(&report.warnings, g.quiet);
+            say(&format!(
+                "wrote {}/texture.png, field.npy, preview.png, report.json",
+                out.display()
+            ));
         }
         Command::Render { model, out, size, view } => {
             let opts = fieldtex::RenderCommandOptions { size, view };

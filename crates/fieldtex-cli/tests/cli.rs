@@ -303,3 +303,59 @@ fn eval_known_answers_and_bad_field() {
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("f.npy"), "{}", stderr(&o));
 }
+
+/// `orient` with a preset: all outputs, a field of the right shape, the designed
+/// singularities in the report, byte-identical outputs for 1 and 2 threads, and a
+/// clear exit 2 for an unknown preset.
+#[test]
+fn orient_preset_outputs_and_determinism() {
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let a = tmp("orient-t1");
+    let b = tmp("orient-t2");
+    let limit = Duration::from_secs(300);
+    for (dir, t) in [(&a, "1"), (&b, "2")] {
+        let o = run(
+            &[
+                "orient",
+                "--preset",
+                "left-loop",
+                "--exemplar",
+                ex.to_str().unwrap(),
+                "--size",
+                "128",
+                "--grid",
+                "32",
+                "--out",
+                dir.to_str().unwrap(),
+                "--threads",
+                t,
+                "--quiet",
+            ],
+            limit,
+        );
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+    }
+    for f in ["texture.png", "field.npy", "preview.png"] {
+        let x = std::fs::read(a.join(f)).unwrap();
+        assert!(x == std::fs::read(b.join(f)).unwrap(), "{f} differs between 1 and 2 threads");
+    }
+    let npy = std::fs::read(a.join("field.npy")).unwrap();
+    assert!(String::from_utf8_lossy(&npy[..128]).contains("(128, 128, 2)"));
+    let r = report_without_timings(&a);
+    let designed = r["metrics"]["designed_singularities"].as_array().unwrap();
+    assert_eq!(designed.len(), 2, "a loop has one core and one delta");
+    assert_eq!(r, report_without_timings(&b));
+    let o = run(
+        &[
+            "orient",
+            "--preset",
+            "spiral-galaxy",
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--out",
+            a.to_str().unwrap(),
+        ],
+        limit,
+    );
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+}

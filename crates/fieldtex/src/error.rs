@@ -19,6 +19,16 @@ impl Error {
     pub fn bad_input(path: Option<&Path>, message: impl Into<String>) -> Self {
         Error::BadInput { path: path.map(Path::to_path_buf), message: message.into() }
     }
+    /// Names `path` in a bad-input error that does not name a file yet.
+    pub fn with_path(self, path: &Path) -> Self {
+        match self {
+            Error::BadInput { path: None, message } => {
+                Error::BadInput { path: Some(path.to_path_buf()), message }
+            }
+            other => other,
+        }
+    }
+
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::BadInput { .. } => 2,

@@ -12,6 +12,7 @@
 //! | [`atlas_file`] | `fieldtex atlas` |
 //! | [`render_file`] | `fieldtex render` |
 //! | [`eval_files`] | `fieldtex eval` |
+//! | [`orient`] | `fieldtex orient` (paper D) |
 
 mod error;
 mod outputs;
@@ -25,6 +26,7 @@ pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
 pub use pipelines::demo::{DemoOptions, demo};
 pub use pipelines::eval::{Guidance, ImageMetrics, eval_files};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
+pub use pipelines::orient::{DesignedSingularity, FieldSource, OrientOptions, orient};
 pub use pipelines::render::{RenderCommandOptions, render_file};
 pub use report::Report;
 

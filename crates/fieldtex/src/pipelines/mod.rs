@@ -3,7 +3,9 @@ pub mod atlas;
 pub mod demo;
 pub mod eval;
 pub mod inspect;
+pub mod orient;
 pub mod render;
+pub(crate) mod synthesis;
 
 use crate::Result;
 use fieldtex_core::Image;

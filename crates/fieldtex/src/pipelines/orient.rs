@@ -1,0 +1,203 @@
+//! `fieldtex orient`: orientation-field guided synthesis (Liu et al., paper D).
+//!
+//! Design (TOML file or fingerprint preset) → DEC field on a triangulated grid
+//! (`fieldtex-fields`) → per-pixel 2-RoSy field → parallel appearance-space synthesis
+//! guided by the field's Jacobian with the 2-RoSy fix (`fieldtex-synth`) → texture,
+//! `field.npy`, a preview with the designed singularities marked, and a report with
+//! the metrics of `eval` plus singularity and phase-defect comparisons.
+
+use crate::outputs::{prepare_out_dir, write_report};
+use crate::pipelines::eval::image_metrics;
+use crate::{Error, Progress, Report, Result};
+use fieldtex_core::Image;
+use fieldtex_fields::{DesignFile, SingularityKind};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Where the guidance field comes from.
+#[derive(Debug, Clone, Serialize)]
+pub enum FieldSource {
+    /// A TOML design file.
+    Design(PathBuf),
+    /// A built-in fingerprint preset: arch, tented-arch, left-loop, right-loop, whorl.
+    Preset(String),
+    /// An external `.npy` field (H×W×2 float32 (dx, dy), x right, y down).
+    Field(PathBuf),
+}
+
+/// Options of [`orient`].
+#[derive(Debug, Clone, Serialize)]
+pub struct OrientOptions {
+    pub source: FieldSource,
+    pub exemplar: PathBuf,
+    /// Output width and height in pixels. Default 512.
+    pub size: usize,
+    /// Field grid cells per side for presets. Default 128.
+    pub grid: usize,
+    /// Exemplar pixels per output pixel. Default 1.
+    pub scale: f64,
+    /// The 2-RoSy fix of paper D §4 (off only for the ablation). Default true.
+    pub rosy_fix: bool,
+    pub seed: u64,
+}
+
+impl OrientOptions {
+    pub fn new(source: FieldSource, exemplar: PathBuf) -> Self {
+        Self { source, exemplar, size: 512, grid: 128, scale: 1.0, rosy_fix: true, seed: 1 }
+    }
+}
+
+/// A designed singularity in pixel coordinates with its orientation index (±1/2, ±1).
+#[derive(Debug, Clone, Serialize)]
+pub struct DesignedSingularity {
+    pub x: f64,
+    pub y: f64,
+    pub index: f64,
+}
+
+fn kind_index(k: SingularityKind) -> f64 {
+    match k {
+        SingularityKind::Wedge => 0.5,
+        SingularityKind::Trisector => -0.5,
+        SingularityKind::Saddle => -1.0,
+        _ => 1.0,
+    }
+}
+
+/// The pixel field and the designed singularities.
+fn build_field(
+    options: &OrientOptions,
+    report: &mut Report,
+) -> Result<(Vec<[f32; 2]>, Vec<DesignedSingularity>)> {
+    let n = options.size;
+    let design = match &options.source {
+        FieldSource::Field(p) => {
+            let (shape, data) = fieldtex_io::read_npy_f32(p)?;
+            if shape != [n, n, 2] {
+                return Err(Error::bad_input(
+                    Some(p),
+                    format!(
+                        "the field has shape {shape:?}; --size {n} needs [{n}, {n}, 2] (H×W×2 float32)"
+                    ),
+                ));
+            }
+            let field: Vec<[f32; 2]> = data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+            if let Some(i) = field.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
+                return Err(Error::bad_input(Some(p), format!("non-finite vector at pixel {i}")));
+            }
+            return Ok((field, Vec::new()));
+        }
+        FieldSource::Design(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| {
+                Error::bad_input(Some(p), format!("cannot read the design file: {e}"))
+            })?;
+            DesignFile::from_toml_str(&text)
+                .map_err(|e| Error::bad_input(Some(p), e.to_string()))?
+        }
+        FieldSource::Preset(name) => {
+            fieldtex_fields::presets::preset(name, n as f64, n as f64, options.grid)
+                .map_err(|e| Error::bad_input(None, format!("--preset {name}: {e}")))?
+        }
+    };
+    let src = match &options.source {
+        FieldSource::Design(p) => Some(p.as_path()),
+        _ => None,
+    };
+    let mut fd = report
+        .time("field_factor", || design.build(None))
+        .map_err(|e| Error::bad_input(src, e.to_string()))?;
+    let solved = report
+        .time("field_solve", || fd.solve())
+        .map_err(|e| Error::Internal(format!("field solve: {e}")))?;
+    report.metric("field_residual", solved.residual);
+    let grid = fd.plane().copied().ok_or_else(|| {
+        Error::bad_input(src, "orient needs a plane design here ([domain] kind = \"plane\")")
+    })?;
+    let pixels = report
+        .time("field_sample", || {
+            fieldtex_fields::orientation_field::sample_plane(&fd, &solved, n, n)
+        })
+        .map_err(|e| Error::Internal(format!("field sampling: {e}")))?;
+    // Design coordinates → pixels.
+    let (sx, sy) = (n as f64 / grid.width, n as f64 / grid.height);
+    let designed = fd
+        .singularities()
+        .into_iter()
+        .map(|(_, s)| DesignedSingularity {
+            x: s.position[0] * sx,
+            y: s.position[1] * sy,
+            index: kind_index(s.kind),
+        })
+        .collect();
+    report.warnings.extend(fd.warnings().iter().cloned());
+    Ok((pixels, designed))
+}
+
+/// Runs the orient pipeline into `out_dir`.
+pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) -> Result<Report> {
+    if !(16..=4096).contains(&options.size) {
+        return Err(Error::bad_input(
+            None,
+            format!("--size must be in 16..=4096, got {}", options.size),
+        ));
+    }
+    if !(options.scale > 0.0 && options.scale <= 16.0) {
+        return Err(Error::bad_input(
+            None,
+            format!("--scale must be in (0, 16], got {}", options.scale),
+        ));
+    }
+    let mut report =
+        Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
+    let exemplar = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    report.input = serde_json::json!({
+        "exemplar": options.exemplar.display().to_string(),
+        "exemplar_size": [exemplar.width, exemplar.height],
+    });
+    prepare_out_dir(out_dir)?;
+    let (field, designed) = build_field(options, &mut report)?;
+    let n = options.size;
+    let synth =
+        super::synthesis::synthesize_image(&exemplar, &field, n, n, options, &mut report, progress)
+            .map_err(|e| e.with_path(&options.exemplar))?;
+    let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
+    fieldtex_io::write_png(&out_dir.join("texture.png"), &synth)?;
+    fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
+    let metrics = report
+        .time("metrics", || image_metrics(&synth, &exemplar, Some(&flat), None, options.seed))
+        .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
+    // Phase defects near designed singularities (within 3 exemplar periods).
+    if let Some(pd) = &metrics.phase_defects {
+        let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
+        let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
+        report.metric("phase_defects_near_singularities", near);
+    }
+    report.metric("designed_singularities", &designed);
+    report.metric("texture", &metrics);
+    let preview = preview_with_singularities(&synth, &designed);
+    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    write_report(out_dir, &report)?;
+    Ok(report)
+}
+
+/// The texture with designed singularities marked: wedges (+1/2) as red discs,
+/// trisectors (−1/2) as blue triangles, other kinds as squares.
+fn preview_with_singularities(texture: &Image, designed: &[DesignedSingularity]) -> Image {
+    use fieldtex_render::{
+        ImageOverlay, ImageOverlayOptions, Marker2, MarkerShape, render_image_overlay,
+    };
+    let mut overlay = ImageOverlay::default();
+    for s in designed {
+        let (shape, color) = if s.index > 0.0 && s.index < 1.0 {
+            (MarkerShape::Disc, [0.9, 0.15, 0.1, 1.0])
+        } else if s.index < 0.0 && s.index > -1.0 {
+            (MarkerShape::Triangle, [0.1, 0.35, 0.95, 1.0])
+        } else {
+            (MarkerShape::Square, [0.95, 0.8, 0.1, 1.0])
+        };
+        overlay
+            .markers
+            .push(Marker2::new([s.x, s.y]).with_shape(shape).with_color(color).with_radius(6.0));
+    }
+    render_image_overlay(texture, &overlay, &ImageOverlayOptions::default())
+}

@@ -1,0 +1,77 @@
+//! Glue between the pipelines and `fieldtex-synth`: exemplar analysis with an
+//! in-process cache, and image-domain synthesis from a per-pixel direction field.
+
+use super::orient::OrientOptions;
+use crate::{Error, Progress, Report, Result};
+use fieldtex_core::Image;
+use fieldtex_synth::{
+    AnalysisOptions, ExemplarAnalysis, ImageDomain, SynthesisOptions, synthesize,
+};
+use std::sync::{Arc, Mutex};
+
+/// The most recent analysis, keyed by a hash of the exemplar pixels and the options:
+/// interactive callers that re-synthesise with a new field reuse it.
+static ANALYSIS_CACHE: Mutex<Option<(u64, Arc<ExemplarAnalysis>)>> = Mutex::new(None);
+
+fn analysis_key(exemplar: &Image, options: &AnalysisOptions) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |x: u64| {
+        h ^= x;
+        h = h.wrapping_mul(0x0000_0100_0000_01B3);
+    };
+    eat(exemplar.width as u64);
+    eat(exemplar.height as u64);
+    for p in &exemplar.pixels {
+        for c in p {
+            eat(u64::from(c.to_bits()));
+        }
+    }
+    eat(options.k as u64);
+    eat(options.coherence_radius as u64);
+    eat(options.max_size as u64);
+    h
+}
+
+/// The analysis of `exemplar`, computed once per exemplar and options.
+pub(crate) fn cached_analysis(
+    exemplar: &Image,
+    options: &AnalysisOptions,
+    progress: &dyn Progress,
+) -> std::result::Result<(Arc<ExemplarAnalysis>, bool), fieldtex_synth::SynthError> {
+    let key = analysis_key(exemplar, options);
+    let mut guard = ANALYSIS_CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((k, a)) = guard.as_ref()
+        && *k == key
+    {
+        return Ok((a.clone(), true));
+    }
+    let a = Arc::new(ExemplarAnalysis::new(exemplar, options, progress)?);
+    *guard = Some((key, a.clone()));
+    Ok((a, false))
+}
+
+/// Synthesises a `width × height` texture whose exemplar x axis follows `field`.
+pub(crate) fn synthesize_image(
+    exemplar: &Image,
+    field: &[[f32; 2]],
+    width: usize,
+    height: usize,
+    options: &OrientOptions,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<Image> {
+    let aopts = AnalysisOptions::default();
+    let (analysis, cached) = report
+        .time("analysis", || cached_analysis(exemplar, &aopts, progress))
+        .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
+    report.metric("analysis_cached", cached);
+    let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
+    let domain = ImageDomain::from_direction_field(width, height, &flat, options.scale as f32)
+        .map_err(|e| Error::Internal(format!("synthesis domain: {e}")))?;
+    let sopts =
+        SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };
+    let result = report
+        .time("synthesis", || synthesize(&analysis, &domain, &sopts, progress))
+        .map_err(|e| Error::Internal(format!("synthesis: {e}")))?;
+    Ok(result.colors)
+}
