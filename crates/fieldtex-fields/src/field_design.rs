@@ -308,6 +308,16 @@ impl FieldDesign {
             .collect()
     }
 
+    /// The singularity with this id, if it is live.
+    pub fn singularity(&self, id: SingularityId) -> Option<Singularity> {
+        self.singularities.get(id.0 as usize)?.as_ref().map(|e| e.singularity)
+    }
+
+    /// The stroke with this id, if it is live.
+    pub fn stroke(&self, id: StrokeId) -> Option<&Stroke> {
+        self.strokes.get(id.0 as usize)?.as_ref().map(|s| &s.0)
+    }
+
     /// Live strokes with their ids, in id order.
     pub fn strokes(&self) -> Vec<(StrokeId, &Stroke)> {
         self.strokes

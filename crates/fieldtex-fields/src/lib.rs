@@ -19,6 +19,29 @@
 //! - [`design_file`]: the TOML design format; [`presets`]: fingerprint classes.
 //! - [`domain`]: plane grids, point location, disk meshes.
 //!
+//! Interactive use (a front end keeps one [`FieldDesign`] per domain):
+//!
+//! ```
+//! use fieldtex_fields::orientation_field::{detect_pixel_singularities, sample_plane};
+//! use fieldtex_fields::{Singularity, SingularityKind, Stroke, Symmetry, presets};
+//!
+//! let file = presets::preset("left-loop", 256.0, 256.0, 64)?; // or DesignFile::from_toml_str
+//! let mut design = file.build(None)?; // operators, matrix, symbolic analysis (once)
+//! let field = design.solve()?; // numeric factorisation on the first solve, then solves
+//! let pixels: Vec<[f32; 2]> = sample_plane(&design, &field, 256, 256)?; // (dx, dy), y down
+//! let found = detect_pixel_singularities(&pixels, 256, 256, Symmetry::Orientation, 6.0)?;
+//! assert_eq!(found.len(), 2);
+//!
+//! let (core, s) = design.singularities()[0];
+//! design.move_singularity(core, [s.position[0] + 8.0, s.position[1], 0.0])?; // b only
+//! let extra = design.add_singularity(Singularity::at_pixel(SingularityKind::Wedge, 60.5, 70.5))?;
+//! design.remove_singularity(extra)?;
+//! let stroke = design.add_stroke(Stroke::from_pixels(&[[20.0, 200.0], [230.0, 210.0]]))?; // refactor
+//! let field = design.solve()?;
+//! # let _ = (field, stroke);
+//! # Ok::<(), fieldtex_fields::FieldsError>(())
+//! ```
+//!
 //! Architecture invariant: no file I/O, no printing, no environment; everything is
 //! deterministic for any thread count (parallel loops write disjoint outputs, and the
 //! linear algebra is deterministic).

@@ -123,14 +123,53 @@ impl ModelField {
     /// Adds this field's exact 1-form to `omega` (`#E`). `floor` is the smallest
     /// distance to the singularity used in the logarithms (a small fraction of the edge
     /// length; only matters for an edge through the singularity).
+    ///
+    /// Same values as [`ModelField::segment_integral`] per edge, computed with one
+    /// logarithm per *vertex*: `Log((b−p)/(a−p)) = (ln|b−p| − ln|a−p|) + i·wrap(θ_b − θ_a)`,
+    /// where the wrapped angle difference is the principal one because a straight edge
+    /// that misses `p` sweeps less than π.
     pub fn add_one_form(&self, dec: &Dec, floor: f64, omega: &mut [f64]) {
-        let values: Vec<f64> = (0..dec.n_edges())
-            .into_par_iter()
-            .map(|e| {
-                let [a, b] = dec.topology.edges[e];
-                let za = self.chart(dec.positions[a as usize]);
-                let zb = self.chart(dec.positions[b as usize]);
-                self.segment_integral(za, zb, floor)
+        use std::f64::consts::{PI, TAU};
+        // Per vertex: chart point (floored away from p), ln r, θ.
+        let polar: Vec<([f64; 2], f64, f64)> = dec
+            .positions
+            .par_iter()
+            .map(|x| {
+                let mut z = self.chart(*x);
+                let r = (z[0] * z[0] + z[1] * z[1]).sqrt();
+                if r < floor {
+                    z = if r > 0.0 { [z[0] * floor / r, z[1] * floor / r] } else { [floor, 0.0] };
+                }
+                let r = (z[0] * z[0] + z[1] * z[1]).sqrt();
+                (z, r.ln(), z[1].atan2(z[0]))
+            })
+            .collect();
+        let cc = cx::conj(self.c);
+        let kind = self.kind;
+        let values: Vec<f64> = dec
+            .topology
+            .edges
+            .par_iter()
+            .map(|&[a, b]| {
+                let (za, la, ta) = polar[a as usize];
+                let (zb, lb, tb) = polar[b as usize];
+                let mut dt = tb - ta;
+                if dt > PI {
+                    dt -= TAU;
+                } else if dt <= -PI {
+                    dt += TAU;
+                }
+                let log = [lb - la, dt];
+                match kind {
+                    ModelKind::Pole => cx::mul(cc, log)[0],
+                    ModelKind::Saddle => {
+                        let d = [zb[0] - za[0], zb[1] - za[1]];
+                        if d[0] == 0.0 && d[1] == 0.0 {
+                            return 0.0;
+                        }
+                        cx::mul(cx::mul(cc, cx::div(d, cx::conj(d))), cx::conj(log))[0]
+                    }
+                }
             })
             .collect();
         for (o, v) in omega.iter_mut().zip(values) {

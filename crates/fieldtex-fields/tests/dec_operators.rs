@@ -89,3 +89,47 @@ fn boundary_term_turns_div_curl_into_dirichlet_energy() {
         );
     }
 }
+
+#[test]
+fn model_field_one_forms_are_exact_edge_integrals() {
+    use fieldtex_fields::singular_model_field::{ModelField, ModelKind};
+    let (dec, _) = Dec::new(&PlaneGrid::with_cells(10.0, 8.0, 10).mesh()).unwrap();
+    for kind in [ModelKind::Pole, ModelKind::Saddle] {
+        let m = ModelField {
+            kind,
+            origin: [4.37, 3.71, 0.0],
+            e1: [1.0, 0.0, 0.0],
+            e2: [0.0, 1.0, 0.0],
+            c: [0.8, -0.6],
+        };
+        let mut omega = vec![0.0; dec.n_edges()];
+        m.add_one_form(&dec, 1e-6, &mut omega);
+        for (e, ed) in dec.topology.edges.iter().enumerate() {
+            let (a, b) = (dec.positions[ed[0] as usize], dec.positions[ed[1] as usize]);
+            let za = [a[0] - 4.37, a[1] - 3.71];
+            let zb = [b[0] - 4.37, b[1] - 3.71];
+            // Per-edge closed form and a 2000-point midpoint quadrature of u·dx.
+            assert!((m.segment_integral(za, zb, 1e-6) - omega[e]).abs() < 1e-12);
+            let n = 2000;
+            let mut q = 0.0;
+            for k in 0..n {
+                let t = (k as f64 + 0.5) / n as f64;
+                let z = [za[0] + t * (zb[0] - za[0]), za[1] + t * (zb[1] - za[1])];
+                let u = m.value(z);
+                q += (u[0] * (zb[0] - za[0]) + u[1] * (zb[1] - za[1])) / n as f64;
+            }
+            assert!(
+                (q - omega[e]).abs() < 1e-4 * (1.0 + q.abs()),
+                "{kind:?} edge {e}: {q} vs {}",
+                omega[e]
+            );
+        }
+        // A pole's circulation is 2π Im c around the triangle that holds it, 0 elsewhere.
+        let curls: Vec<f64> = (0..dec.n_faces()).map(|f| dec.face_curl(f, &omega)).collect();
+        let nonzero: Vec<_> = curls.iter().filter(|c| c.abs() > 1e-9).collect();
+        if kind == ModelKind::Pole {
+            assert_eq!(nonzero.len(), 1);
+            assert!((nonzero[0] - 2.0 * std::f64::consts::PI * -0.6).abs() < 1e-9);
+        }
+    }
+}

@@ -324,3 +324,54 @@ fn design_file_errors_name_the_problem() {
     assert!(mesh_file.build(None).is_err());
     assert!(mesh_file.build(Some(disk_mesh(1.0, 6))).is_ok());
 }
+
+#[test]
+fn designs_on_a_curved_patch() {
+    // A paraboloid cap z = 0.4 (1 − r²) over the unit disk.
+    let mut mesh = disk_mesh(1.0, 20);
+    let lift = |p: [f64; 3]| [p[0], p[1], 0.4 * (1.0 - p[0] * p[0] - p[1] * p[1])];
+    for p in &mut mesh.positions {
+        *p = lift(*p);
+    }
+    let mut v = FieldDesign::new(
+        Domain::Mesh(mesh.clone()),
+        Symmetry::Vector,
+        FieldDesignOptions::default(),
+    )
+    .unwrap();
+    v.add_singularity(Singularity::new(SingularityKind::Source, lift([0.2, -0.1, 0.0]))).unwrap();
+    let f = v.solve().unwrap();
+    let found = detect_design_singularities(&v, &f, 1.5 * v.dec().mean_edge_length);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].index, 1.0);
+
+    let mut o =
+        FieldDesign::new(Domain::Mesh(mesh), Symmetry::Orientation, FieldDesignOptions::default())
+            .unwrap();
+    // The frame field is smooth: neighbouring triangles' e1 differ by little.
+    let frames = o.frames().to_vec();
+    let dec = o.dec();
+    for e in 0..dec.n_edges() {
+        let faces = dec.topology.edge_faces(e);
+        if faces.len() == 2 {
+            let (a, b) = (frames[faces[0] as usize].0, frames[faces[1] as usize].0);
+            assert!(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > 0.9, "frame jump at edge {e}");
+        }
+    }
+    o.add_singularity(Singularity::new(SingularityKind::Wedge, lift([0.0, 0.35, 0.0]))).unwrap();
+    o.add_singularity(Singularity::new(SingularityKind::Trisector, lift([0.0, -0.35, 0.0])))
+        .unwrap();
+    let f = o.solve().unwrap();
+    let found = detect_design_singularities(&o, &f, 1.5 * o.dec().mean_edge_length);
+    let mut idx: Vec<f64> = found.iter().map(|s| s.index).collect();
+    idx.sort_by(|a, b| a.total_cmp(b));
+    assert_eq!(idx, vec![-0.5, 0.5], "{found:?}");
+    let dirs = fieldtex_fields::orientation_field::vertex_directions(&o, &f);
+    for (v, d) in dirs.iter().enumerate() {
+        let n = o.dec().vertex_normals[v];
+        assert!(
+            (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]).abs() < 1e-9,
+            "vertex direction not tangent"
+        );
+    }
+}
