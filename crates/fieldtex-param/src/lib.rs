@@ -33,6 +33,7 @@
 pub mod atlas;
 pub mod bake;
 mod chart_footprint;
+mod chart_merging;
 pub mod chart_segmentation;
 pub mod chart_topology;
 pub mod distortion;
