@@ -73,3 +73,19 @@ pub use field_design::{
     Domain, FieldDesign, FieldDesignOptions, SingularityId, SingularityModel, SolvedField, StrokeId,
 };
 pub use singularity_index::DetectedSingularity;
+
+// Paper A §4: curve-constrained harmonic diffusion, greedy curve orientation, metrics.
+pub mod greedy_curve_orientation;
+pub mod harmonic_diffusion;
+pub mod surface_field_metrics;
+pub use greedy_curve_orientation::{
+    CurveOrientationOptions, CurveOrientationResult, OrientationMode, OrientationScore,
+    OrientationStep, orient_curves, orientation_score,
+};
+pub use harmonic_diffusion::{
+    AddReport, CurveConstraints, CurveField, CurveFieldOptions, CurveFieldSolver, OverlapPolicy,
+    SolveReport, UnconstrainedFallback, VertexFieldStatus,
+};
+pub use surface_field_metrics::{
+    AlignmentError, FieldSingularity, SurfaceFieldMetrics, surface_field_metrics,
+};

@@ -1,0 +1,288 @@
+//! Greedy orientation of unoriented feature curves (Xu, Kim, Huang & Kalogerakis 2009,
+//! "Feature-aligned shape texturing" — paper A, §4.1, eq. (1)), driving the harmonic
+//! diffusion of [`crate::harmonic_diffusion`].
+//!
+//! **Score, eq. (1).** For a curve `c` with constraint vertices `V(c)` (its sampled
+//! vertices, [`CurveFieldSolver::sample_curve`]) and the current field `u`, let
+//! `θ_p ∈ [0, π]` be the angle between the curve's forward tangent at `p` and `u(p)`.
+//! `forward = Σ_p (π − θ_p)/(π + θ_p)` scores the forward orientation (each term in
+//! `[0, 1]`, 1 when aligned), `backward = Σ_p θ_p/(2π − θ_p)` the reversed one (the same
+//! term for `π − θ_p`), and `g(c, u) = max(forward, backward)`, invariant to the curve's
+//! orientation. The sum (not the mean) favours long consistent curves, as in the paper.
+//! Vertices where `u` is not defined (component not yet solved, degenerate vector) do not
+//! count ([`OrientationScore::n_points`]).
+//!
+//! **Greedy loop** ([`OrientationMode::Greedy`]). The longest curve (on-mesh arc length;
+//! ties → lowest index) is taken first in its given (forward) orientation. Then, until
+//! every curve is oriented: solve the field, score every unoriented curve, orient the
+//! one with the highest `g` (ties → lowest index) by its better term (`forward ≥
+//! backward` → `+1`), add its constraints as rank-1 updates. A curve whose vertices see
+//! no field yet (it lies on a component no oriented curve touches) only becomes a
+//! candidate when no scored curve remains; then the longest such curve starts its
+//! component with `+1`.
+//!
+//! **Arbitrary** ([`OrientationMode::Arbitrary`]): curve `i` gets `±1` from the random
+//! stream `(seed, "curve-orientation", i)`, all constraints are added at once (one
+//! factorisation per component) and solved once — the paper's Fig. 3(a) baseline.
+//!
+//! Curves that sample to no constraint (empty, off the mesh) are skipped with a warning
+//! and get sign `0`.
+
+use std::time::Instant;
+
+use fieldtex_core::vec3::{self, V3};
+use fieldtex_core::{Progress, Warning};
+use fieldtex_mesh::TriMesh;
+use rand::RngExt;
+use rayon::prelude::*;
+
+use crate::FieldsError;
+use crate::harmonic_diffusion::{
+    CurveConstraints, CurveField, CurveFieldOptions, CurveFieldSolver,
+};
+
+/// Eq. (1) for both orientations of one curve.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct OrientationScore {
+    /// `Σ (π − θ)/(π + θ)`: consistency of the forward orientation.
+    pub forward: f64,
+    /// `Σ θ/(2π − θ)`: consistency of the reversed orientation.
+    pub backward: f64,
+    /// Curve vertices where the field is defined (the terms of the sums).
+    pub n_points: usize,
+}
+
+impl OrientationScore {
+    /// `g(c, u) = max(forward, backward)`.
+    pub fn best(&self) -> f64 {
+        self.forward.max(self.backward)
+    }
+    /// Orientation achieving [`OrientationScore::best`]: `+1` (ties) or `−1`.
+    pub fn sign(&self) -> i8 {
+        if self.forward >= self.backward { 1 } else { -1 }
+    }
+    /// `forward − backward`: `+n` for a curve aligned with the field, `−n` reversed.
+    pub fn signed(&self) -> f64 {
+        self.forward - self.backward
+    }
+}
+
+/// Eq. (1) of `tangents` (unit, forward orientation) against `field(i)`, the unit field
+/// at the `i`-th point (`None` where undefined; such points are skipped).
+pub fn orientation_score(tangents: &[V3], field: impl Fn(usize) -> Option<V3>) -> OrientationScore {
+    use std::f64::consts::PI;
+    let mut s = OrientationScore::default();
+    for (i, &t) in tangents.iter().enumerate() {
+        let Some(u) = field(i) else { continue };
+        let theta = vec3::norm(vec3::cross(t, u)).atan2(vec3::dot(t, u));
+        if !theta.is_finite() {
+            continue;
+        }
+        s.forward += (PI - theta) / (PI + theta);
+        s.backward += theta / (2.0 * PI - theta);
+        s.n_points += 1;
+    }
+    s
+}
+
+/// How curve orientations are chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OrientationMode {
+    /// Paper A §4.1 (module docs). Default.
+    #[default]
+    Greedy,
+    /// Random signs from `(seed, "curve-orientation", i)`, all constraints at once.
+    Arbitrary { seed: u64 },
+}
+
+/// Options of [`orient_curves`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CurveOrientationOptions {
+    /// Default [`OrientationMode::Greedy`].
+    pub mode: OrientationMode,
+    /// Options of the diffusion (penalty `1e8`, sampling, overlap, fallback).
+    pub field: CurveFieldOptions,
+}
+
+/// One orientation step (greedy), or the single step of the arbitrary mode
+/// (`curve = usize::MAX`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrientationStep {
+    /// Input index of the curve oriented in this step.
+    pub curve: usize,
+    /// `+1`: as given; `−1`: reversed.
+    pub sign: i8,
+    /// `g(c, u)` against the field before this step (`NaN` for a curve that starts a
+    /// component and the arbitrary step).
+    pub score: f64,
+    /// `g / n_points` (mean consistency in `[0, 1]`; `NaN` as above).
+    pub normalized_score: f64,
+    /// Penalties added in this step (rank-1 updates, or a first factorisation).
+    pub new_constraints: usize,
+    /// Time of the rank-1 updates of this step.
+    pub update_ms: f64,
+    /// Time of first factorisations in this step (the first curve of a component).
+    pub factor_ms: f64,
+    /// Time of the solve after this step.
+    pub solve_ms: f64,
+    /// Largest relative residual of that solve.
+    pub residual: f64,
+}
+
+/// Result of [`orient_curves`].
+pub struct CurveOrientationResult<'m> {
+    /// Per input curve: `+1`, `−1`, or `0` for curves that gave no constraint.
+    pub signs: Vec<i8>,
+    /// Constraints of every input curve (forward orientation).
+    pub curves: Vec<CurveConstraints>,
+    pub steps: Vec<OrientationStep>,
+    /// The final field (projected, normalised, fallback applied).
+    pub field: CurveField,
+    /// The solver with the final factorisation (for metrics and comparisons).
+    pub solver: CurveFieldSolver<'m>,
+    /// Wall time of the whole procedure (sampling, factorisations, updates, solves,
+    /// scoring), in milliseconds.
+    pub total_ms: f64,
+    pub warnings: Vec<Warning>,
+}
+
+/// Orients `curves` (polylines, `#points × 3` each) and solves the constrained field on
+/// `mesh` (module docs). Errors: invalid mesh or options, failed solves.
+pub fn orient_curves<'m>(
+    mesh: &'m TriMesh,
+    curves: &[Vec<V3>],
+    options: &CurveOrientationOptions,
+    progress: &dyn Progress,
+) -> Result<CurveOrientationResult<'m>, FieldsError> {
+    let t_start = Instant::now();
+    let mut solver = CurveFieldSolver::new(mesh, &options.field)?;
+    let sampled: Vec<CurveConstraints> =
+        curves.par_iter().map(|c| solver.sample_curve(c)).collect();
+    let mut warnings = Vec::new();
+    let mut signs = vec![0i8; curves.len()];
+    let mut pending: Vec<usize> = Vec::new();
+    let (mut n_empty, mut n_dropped) = (0usize, 0usize);
+    for (i, c) in sampled.iter().enumerate() {
+        n_dropped += c.dropped_samples;
+        if c.vertices.is_empty() {
+            n_empty += 1;
+        } else {
+            pending.push(i);
+        }
+    }
+    if n_empty > 0 {
+        warnings.push(Warning::new(
+            "curves-without-constraints",
+            format!(
+                "{n_empty} of {} curves are empty, too short or off the mesh and were ignored",
+                curves.len()
+            ),
+        ));
+    }
+    if n_dropped > 0 {
+        warnings.push(Warning::new(
+            "curve-samples-off-mesh",
+            format!(
+                "{n_dropped} curve samples were non-finite or farther than {} mean edge lengths \
+                 from the mesh and were dropped",
+                options.field.max_distance
+            ),
+        ));
+    }
+    progress.stage("orient curves", pending.len() as u64);
+    let mut steps = Vec::new();
+    match options.mode {
+        OrientationMode::Arbitrary { seed } => {
+            let mut step = empty_step(usize::MAX, 0);
+            for &i in &pending {
+                let sign = if fieldtex_core::stream(seed, "curve-orientation", i as u64).random() {
+                    1
+                } else {
+                    -1
+                };
+                signs[i] = sign;
+                let r = solver.add_constraints(&sampled[i], f64::from(sign))?;
+                step.new_constraints += r.new_vertices;
+                step.update_ms += 1e3 * r.update_seconds;
+                step.factor_ms += 1e3 * r.factor_seconds;
+                progress.advance(1);
+            }
+            let s = solver.solve()?;
+            step.solve_ms = 1e3 * s.seconds;
+            step.residual = s.max_residual;
+            steps.push(step);
+        }
+        OrientationMode::Greedy => {
+            while !pending.is_empty() {
+                let scores: Vec<OrientationScore> = pending
+                    .par_iter()
+                    .map(|&i| {
+                        let c = &sampled[i];
+                        orientation_score(&c.tangents, |k| {
+                            solver.tangent_at(c.vertices[k] as usize)
+                        })
+                    })
+                    .collect();
+                // Best scored curve (ties → lowest index), else the longest unscored one.
+                let mut pick: Option<(usize, f64)> = None;
+                for (k, s) in scores.iter().enumerate() {
+                    if s.n_points > 0 && pick.is_none_or(|(_, b)| s.best() > b) {
+                        pick = Some((k, s.best()));
+                    }
+                }
+                let (k, sign, score) = match pick {
+                    Some((k, g)) => (k, scores[k].sign(), g),
+                    None => {
+                        let mut k = 0;
+                        for j in 1..pending.len() {
+                            if sampled[pending[j]].length > sampled[pending[k]].length {
+                                k = j;
+                            }
+                        }
+                        (k, 1, f64::NAN)
+                    }
+                };
+                let i = pending.remove(k);
+                signs[i] = sign;
+                let mut step = empty_step(i, sign);
+                step.score = score;
+                step.normalized_score = score / scores[k].n_points as f64;
+                let r = solver.add_constraints(&sampled[i], f64::from(sign))?;
+                step.new_constraints = r.new_vertices;
+                step.update_ms = 1e3 * r.update_seconds;
+                step.factor_ms = 1e3 * r.factor_seconds;
+                let s = solver.solve()?;
+                step.solve_ms = 1e3 * s.seconds;
+                step.residual = s.max_residual;
+                steps.push(step);
+                progress.advance(1);
+            }
+        }
+    }
+    progress.finish_stage();
+    let field = solver.field()?;
+    warnings.extend(field.warnings.iter().cloned());
+    Ok(CurveOrientationResult {
+        signs,
+        curves: sampled,
+        steps,
+        field,
+        solver,
+        total_ms: 1e3 * t_start.elapsed().as_secs_f64(),
+        warnings,
+    })
+}
+
+fn empty_step(curve: usize, sign: i8) -> OrientationStep {
+    OrientationStep {
+        curve,
+        sign,
+        score: f64::NAN,
+        normalized_score: f64::NAN,
+        new_constraints: 0,
+        update_ms: 0.0,
+        factor_ms: 0.0,
+        solve_ms: 0.0,
+        residual: 0.0,
+    }
+}
