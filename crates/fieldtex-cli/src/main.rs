@@ -107,6 +107,22 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Crest lines (ridges, valleys) and salient creases as OBJ polylines (paper A).
+    Crest {
+        mesh: PathBuf,
+        /// Output OBJ with `l` polylines.
+        #[arg(long)]
+        out: PathBuf,
+        /// Ascending strength thresholds (comma-separated), one level of detail each.
+        #[arg(long, value_delimiter = ',')]
+        levels: Option<Vec<f64>>,
+        /// Keep only lines of this level and above.
+        #[arg(long, default_value_t = 0)]
+        level: usize,
+        /// Render the mesh with the lines drawn (red ridges, blue valleys).
+        #[arg(long)]
+        preview: Option<PathBuf>,
+    },
     /// Render a shaded preview of a mesh (textured when it has a texture).
     Render {
         model: PathBuf,
@@ -259,6 +275,12 @@ fn run(cli: Cli) -> Result<(), Error> {
                 "wrote {}/texture.png, field.npy, preview.png, report.json",
                 out.display()
             ));
+        }
+        Command::Crest { mesh, out, levels, level, preview } => {
+            let opts = fieldtex::CrestCommandOptions { levels, min_level: level, preview };
+            let summary = fieldtex::crest_file(&mesh, &out, &opts)?;
+            print_warnings(&summary.warnings, g.quiet);
+            println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
         }
         Command::Render { model, out, size, view } => {
             let opts = fieldtex::RenderCommandOptions { size, view };

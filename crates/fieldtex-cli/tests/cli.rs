@@ -359,3 +359,25 @@ fn orient_preset_outputs_and_determinism() {
     );
     assert_eq!(code(&o), 2, "{}", stderr(&o));
 }
+
+/// `crest` writes OBJ polylines on fandisk and refuses bad `--levels`.
+#[test]
+fn crest_on_fandisk_writes_polylines() {
+    let d = tmp("crest");
+    let m = shared().join("meshes/fandisk.obj");
+    let out = d.join("curves.obj");
+    let o = run(
+        &["crest", m.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"],
+        Duration::from_secs(60),
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["lines_written"].as_u64().unwrap() >= 10);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.lines().filter(|l| l.starts_with("l ")).count() >= 10);
+    let o = run(
+        &["crest", m.to_str().unwrap(), "--out", out.to_str().unwrap(), "--levels", "5,1"],
+        Duration::from_secs(60),
+    );
+    assert_eq!(code(&o), 2);
+}

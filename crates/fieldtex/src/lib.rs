@@ -12,6 +12,7 @@
 //! | [`atlas_file`] | `fieldtex atlas` |
 //! | [`render_file`] | `fieldtex render` |
 //! | [`eval_files`] | `fieldtex eval` |
+//! | [`crest_file`] | `fieldtex crest` |
 //! | [`orient`] | `fieldtex orient` (paper D) |
 
 mod error;
@@ -23,6 +24,7 @@ pub use error::{Error, Result};
 pub use fieldtex_core::{Image, NoProgress, Progress, Warning};
 pub use outputs::write_text;
 pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
+pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};
 pub use pipelines::eval::{Guidance, ImageMetrics, eval_files};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
@@ -34,6 +36,7 @@ pub use report::Report;
 pub mod crates {
     pub use fieldtex_core as core;
     pub use fieldtex_eval as eval;
+    pub use fieldtex_features as features;
     pub use fieldtex_fields as fields;
     pub use fieldtex_io as io;
     pub use fieldtex_linalg as linalg;

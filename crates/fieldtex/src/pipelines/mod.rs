@@ -1,5 +1,6 @@
 //! One module per pipeline.
 pub mod atlas;
+pub mod crest;
 pub mod demo;
 pub mod eval;
 pub mod inspect;
