@@ -111,3 +111,58 @@ pub fn sharp_edge_coverage(
         radius,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_shapes::cube;
+
+    #[test]
+    fn exact_lines_cover_everything() {
+        let m = cube();
+        let edges: Vec<[V3; 2]> = (0..12)
+            .map(|i| {
+                // The twelve cube edges: axis k, the other two coordinates from i.
+                let (k, a, b) = (i / 4, (i & 1) as f64, ((i >> 1) & 1) as f64);
+                let mut p = [a, b, 0.0];
+                p.rotate_right(k);
+                let mut q = p;
+                p[(k + 2) % 3] = 0.0;
+                q[(k + 2) % 3] = 1.0;
+                [p, q]
+            })
+            .collect();
+        let lines: Vec<&[V3]> = edges.iter().map(|e| e.as_slice()).collect();
+        let c = sharp_edge_coverage(&m, &lines, 30.0, 0.05).unwrap();
+        assert_eq!(c.sharp_edges, 12);
+        assert!((c.sharp_length - 12.0).abs() < 1e-12);
+        assert!((c.line_length - 12.0).abs() < 1e-12);
+        assert!((c.sharp_covered - 1.0).abs() < 1e-12, "{c:?}");
+        assert!((c.lines_on_sharp - 1.0).abs() < 1e-12, "{c:?}");
+    }
+
+    #[test]
+    fn partial_and_missing_lines() {
+        let m = cube();
+        let h = crate::mean_edge_length(&m).unwrap();
+        // A line 0.02 beside the edge x ∈ [0, 1], y = z = 0, on the bottom face.
+        let beside: Vec<V3> = vec![[0.0, 0.02, 0.0], [1.0, 0.02, 0.0]];
+        let r = 0.05 / h;
+        let c = sharp_edge_coverage(&m, &[&beside], 30.0, r).unwrap();
+        assert!((c.lines_on_sharp - 1.0).abs() < 1e-12, "{c:?}");
+        // One edge of 12, plus the ends of the two edges meeting it within the radius.
+        assert!(
+            c.sharp_covered > 1.0 / 12.0 - 1e-9 && c.sharp_covered < 1.0 / 12.0 + 0.03,
+            "{c:?}"
+        );
+        // A line in the middle of a face is on no sharp edge.
+        let middle: Vec<V3> = vec![[0.3, 0.5, 1.0], [0.7, 0.5, 1.0]];
+        let c = sharp_edge_coverage(&m, &[&middle], 30.0, r).unwrap();
+        assert_eq!(c.lines_on_sharp, 0.0);
+        assert_eq!(c.sharp_covered, 0.0);
+        // No line: nothing covered, precision vacuous.
+        let c = sharp_edge_coverage(&m, &[], 30.0, r).unwrap();
+        assert_eq!((c.sharp_covered, c.lines_on_sharp), (0.0, 1.0));
+        assert!(sharp_edge_coverage(&m, &[], 30.0, 0.0).is_err());
+    }
+}

@@ -25,6 +25,8 @@ pub mod mesh_scale;
 pub mod sharp_edges;
 mod spatial_grid;
 pub mod surface_snapping;
+#[cfg(test)]
+mod test_shapes;
 
 pub use crest_lines::{
     CrestLine, CrestLines, CrestOptions, CrestStats, LineKind, LineSource, crest_lines,

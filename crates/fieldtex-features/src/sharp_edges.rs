@@ -76,6 +76,20 @@ pub fn edge_dihedral(
     Some((angle, convex))
 }
 
+/// `#E` dihedral angle and convexity of every edge ([`edge_dihedral`]), in parallel.
+pub fn edge_dihedrals(
+    mesh: &TriMesh,
+    topo: &Topology,
+    face_normals: &[V3],
+) -> Vec<Option<(f64, bool)>> {
+    use rayon::prelude::*;
+    (0..topo.n_edges())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|e| edge_dihedral(mesh, topo, face_normals, e))
+        .collect()
+}
+
 /// Every edge whose dihedral angle exceeds `threshold_rad`, in edge order.
 pub fn sharp_edges(
     mesh: &TriMesh,
@@ -83,9 +97,19 @@ pub fn sharp_edges(
     face_normals: &[V3],
     threshold_rad: f64,
 ) -> Vec<SharpEdge> {
-    (0..topo.n_edges())
-        .filter_map(|e| {
-            let (angle, convex) = edge_dihedral(mesh, topo, face_normals, e)?;
+    sharp_from(topo, &edge_dihedrals(mesh, topo, face_normals), threshold_rad)
+}
+
+fn sharp_from(
+    topo: &Topology,
+    dihedrals: &[Option<(f64, bool)>],
+    threshold_rad: f64,
+) -> Vec<SharpEdge> {
+    dihedrals
+        .iter()
+        .enumerate()
+        .filter_map(|(e, d)| {
+            let (angle, convex) = (*d)?;
             (angle > threshold_rad).then(|| SharpEdge {
                 edge: e as u32,
                 angle,
@@ -109,29 +133,33 @@ pub fn salient_creases(
     threshold_rad: f64,
     contrast: f64,
 ) -> Vec<SharpEdge> {
-    let sharp = sharp_edges(mesh, topo, face_normals, threshold_rad);
+    let dihedrals = edge_dihedrals(mesh, topo, face_normals);
+    let sharp = sharp_from(topo, &dihedrals, threshold_rad);
     if contrast <= 0.0 || sharp.is_empty() {
         return sharp;
     }
-    let angles: Vec<f64> = (0..topo.n_edges())
-        .map(|e| edge_dihedral(mesh, topo, face_normals, e).map_or(0.0, |x| x.0))
-        .collect();
-    let incident = fieldtex_mesh::Csr::from_pairs(
-        topo.n_vertices,
-        topo.edges.iter().enumerate().flat_map(|(e, &[a, b])| [(a, e as u32), (b, e as u32)]),
-    );
-    let mut buf = Vec::new();
+    // Median over the edges of the triangles around `v` that touch `v`.
+    let mut buf: Vec<(u32, f64)> = Vec::new();
     let mut median_at = |v: u32| {
         buf.clear();
-        buf.extend(incident.row(v as usize).iter().map(|&e| angles[e as usize]));
-        buf.sort_by(f64::total_cmp);
+        for &f in topo.vertex_faces(v as usize) {
+            for &e in &topo.face_edges[f as usize] {
+                let [a, b] = topo.edges[e as usize];
+                if a == v || b == v {
+                    buf.push((e, dihedrals[e as usize].map_or(0.0, |d| d.0)));
+                }
+            }
+        }
+        buf.sort_by_key(|x| x.0);
+        buf.dedup_by_key(|x| x.0);
+        buf.sort_by(|x, y| x.1.total_cmp(&y.1));
         let n = buf.len();
         if n == 0 {
             0.0
         } else if n % 2 == 1 {
-            buf[n / 2]
+            buf[n / 2].1
         } else {
-            0.5 * (buf[n / 2 - 1] + buf[n / 2])
+            0.5 * (buf[n / 2 - 1].1 + buf[n / 2].1)
         }
     };
     sharp
@@ -220,16 +248,8 @@ pub fn sharp_edge_chains(topo: &Topology, sharp: &[SharpEdge]) -> Vec<SharpChain
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_shapes::cube;
     use fieldtex_mesh::face_normals;
-
-    /// An axis-aligned cube `[0,1]³`, 2 triangles per side, outward normals.
-    pub(crate) fn cube() -> TriMesh {
-        let p = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]);
-        let quads =
-            [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let t = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-        TriMesh::new(p.collect(), t)
-    }
 
     #[test]
     fn cube_has_twelve_convex_sharp_edges_in_twelve_chains() {
