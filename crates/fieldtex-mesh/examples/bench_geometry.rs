@@ -11,7 +11,10 @@ use fieldtex_core::rng::hash_unit;
 use fieldtex_core::vec3;
 use fieldtex_linalg::SparseMatrix;
 use fieldtex_mesh::primitives::{subdivide_midpoint, torus};
-use fieldtex_mesh::{Bvh, CotanOptions, Ray, TriMesh, VertexAreaKind, cotan_laplacian_and_mass};
+use fieldtex_mesh::{
+    Bvh, CotanOptions, PoissonDiskOptions, Ray, TriMesh, VertexAreaKind, cotan_laplacian_and_mass,
+    poisson_disk_sampling, total_area,
+};
 use std::time::Instant;
 
 fn parse_obj(text: &str) -> TriMesh {
@@ -128,5 +131,14 @@ fn main() {
             std::hint::black_box(bvh.occluded_many(&rays));
         });
         println!("BENCH any_hit_rays_per_s value={:.0}", rays.len() as f64 / (ms * 1e-3));
+        // About 100K samples.
+        let r = (0.7 * total_area(&mesh) / 100_000.0).sqrt();
+        let opts = PoissonDiskOptions { radius: Some(r), seed: 1, ..Default::default() };
+        let mut count = 0;
+        let ms = median_ms(3, || {
+            count = poisson_disk_sampling(&mesh, &opts).unwrap().0.samples.len();
+        });
+        println!("poisson samples {count}");
+        println!("BENCH poisson_disk median_ms={ms:.2}");
     });
 }

@@ -66,3 +66,6 @@ mod repair_tests;
 #[cfg(test)]
 mod test_fixtures;
 pub use bvh::{Bvh, ClosestPoint, Hit, Ray};
+pub use poisson_disk_sampling::{
+    PoissonDiskOptions, PoissonDiskSamples, SurfaceSample, poisson_disk_sampling,
+};

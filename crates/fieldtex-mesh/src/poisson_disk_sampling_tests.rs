@@ -1,0 +1,139 @@
+//! Poisson-disk sampling tests: true minimum distance (checked with an independent grid
+//! hash), coverage, determinism, target counts and bad input.
+
+use super::*;
+use crate::primitives::{grid, icosphere};
+use crate::test_meshes::{categories, load_obj};
+use std::collections::HashMap;
+
+/// The smallest pairwise distance, by an independent grid hash of cell size `r`
+/// (any pair closer than `r` lies in neighbouring cells).
+fn min_distance(points: &[V3], r: f64) -> f64 {
+    let key = |p: V3| [0, 1, 2].map(|k| (p[k] / r).floor() as i64);
+    let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (i, p) in points.iter().enumerate() {
+        cells.entry(key(*p)).or_default().push(i);
+    }
+    let mut best = f64::INFINITY;
+    for (i, p) in points.iter().enumerate() {
+        let c = key(*p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &j in cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]).into_iter().flatten() {
+                        if j != i {
+                            best = best.min(vec3::norm(vec3::sub(points[j], *p)));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+fn check(name: &str, mesh: &TriMesh, s: &PoissonDiskSamples) {
+    let pts: Vec<V3> = s.samples.iter().map(|x| x.position).collect();
+    if pts.len() > 1 {
+        let d = min_distance(&pts, s.radius);
+        assert!(d >= s.radius, "{name}: two samples {d} apart, radius {}", s.radius);
+    }
+    for x in &s.samples {
+        let t = mesh.triangle_positions(x.triangle as usize);
+        let b = x.barycentric;
+        assert!(
+            b.iter().all(|v| (0.0..=1.0).contains(v))
+                && (b.iter().sum::<f64>() - 1.0).abs() < 1e-12
+        );
+        let q = (0..3).fold([0.0; 3], |a, k| vec3::add(a, vec3::scale(t[k], b[k])));
+        assert!(vec3::norm(vec3::sub(q, x.position)) < 1e-12, "{name}");
+    }
+}
+
+#[test]
+fn minimum_distance_holds_over_categories_and_fixtures() {
+    let mut all = categories();
+    for name in ["stanford-bunny.obj", "fertility.obj", "defects/narrow_triangles.obj"] {
+        all.extend(load_obj(name).map(|m| (name, m)));
+    }
+    for (name, m) in &all {
+        // About 1750 samples whatever the size (the defective patch's needle is huge).
+        let r = 0.02 * crate::areas::total_area(m).sqrt();
+        let opts = PoissonDiskOptions { radius: Some(r), seed: 3, ..Default::default() };
+        let (s, _) = poisson_disk_sampling(m, &opts).unwrap();
+        assert!(s.samples.len() > 50, "{name}: {}", s.samples.len());
+        check(name, m, &s);
+    }
+}
+
+#[test]
+fn sphere_samples_cover_the_surface() {
+    let m = icosphere(4);
+    let r = 0.05;
+    let opts = PoissonDiskOptions { radius: Some(r), ..Default::default() };
+    let (s, w) = poisson_disk_sampling(&m, &opts).unwrap();
+    assert!(w.is_empty());
+    check("sphere", &m, &s);
+    // Near-maximal: a maximal set on the unit sphere has roughly 0.7 · 4π / r² samples.
+    let n = s.samples.len() as f64;
+    let expect = 0.7 * 4.0 * std::f64::consts::PI / (r * r);
+    assert!(n > 0.8 * expect && n < 1.2 * expect, "{n} vs {expect}");
+    // Every vertex of the sphere mesh has a sample within 2r.
+    let bvh_free: Vec<V3> = s.samples.iter().map(|x| x.position).collect();
+    let far = m
+        .positions
+        .iter()
+        .filter(|p| bvh_free.iter().all(|q| vec3::norm(vec3::sub(**p, *q)) >= 2.0 * r))
+        .count();
+    assert!(far * 200 < m.n_vertices(), "{far} uncovered vertices");
+}
+
+#[test]
+fn deterministic_for_any_thread_count_and_seed_dependent() {
+    let m = crate::test_meshes::two_components();
+    let opts = PoissonDiskOptions { radius: Some(0.1), seed: 11, ..Default::default() };
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| poisson_disk_sampling(&m, &opts).unwrap().0)
+    };
+    let (a, b) = (run(1), run(3));
+    assert_eq!(a, b);
+    let other = poisson_disk_sampling(&m, &PoissonDiskOptions { seed: 12, ..opts }).unwrap().0;
+    assert_ne!(a.samples, other.samples);
+}
+
+#[test]
+fn target_count_is_approached() {
+    let m = grid(20, 20, 2.0, 1.0);
+    for target in [200, 1500] {
+        let opts = PoissonDiskOptions { target_count: Some(target), ..Default::default() };
+        let (s, _) = poisson_disk_sampling(&m, &opts).unwrap();
+        let n = s.samples.len() as f64;
+        assert!((n / target as f64 - 1.0).abs() < 0.05, "{n} for {target}");
+        check("grid", &m, &s);
+    }
+}
+
+#[test]
+fn bad_options_and_arealess_meshes() {
+    let m = icosphere(1);
+    for bad in [Some(0.0), Some(-1.0), Some(f64::NAN), Some(f64::INFINITY)] {
+        let o = PoissonDiskOptions { radius: bad, ..Default::default() };
+        assert!(poisson_disk_sampling(&m, &o).is_err());
+    }
+    assert!(poisson_disk_sampling(&m, &PoissonDiskOptions::default()).is_err());
+    let flat = TriMesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], vec![[0, 1, 2]]);
+    let (s, w) = poisson_disk_sampling(
+        &flat,
+        &PoissonDiskOptions { radius: Some(0.1), ..Default::default() },
+    )
+    .unwrap();
+    assert!(s.samples.is_empty());
+    assert_eq!(w[0].code, "sampling-no-area");
+    // A radius far too small is capped, not a hang or an allocation failure.
+    let o =
+        PoissonDiskOptions { radius: Some(1e-6), max_candidates: 100_000, ..Default::default() };
+    let (s, w) = poisson_disk_sampling(&m, &o).unwrap();
+    assert!(w.iter().any(|w| w.code == "sampling-candidates-capped"));
+    check("capped", &m, &s);
+}
