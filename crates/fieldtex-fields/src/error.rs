@@ -28,8 +28,10 @@ pub enum FieldsError {
     NonFinite { what: &'static str, index: usize, field: &'static str, value: f64 },
     #[error("{what} at ({x}, {y}, {z}) lies outside the design domain; move it inside")]
     OutsideDomain { what: &'static str, x: f64, y: f64, z: f64 },
-    #[error("stroke {stroke} has {points} point(s) inside the domain; a stroke needs at least two")]
+    #[error("stroke {stroke} has {points} point(s); a stroke needs at least two")]
     StrokeTooShort { stroke: usize, points: usize },
+    #[error("stroke {stroke} does not cross the design domain; draw it inside the domain")]
+    StrokeMissesDomain { stroke: usize },
     #[error("no {what} with id {id} exists in this design (it may have been removed)")]
     UnknownId { what: &'static str, id: u32 },
     #[error(

@@ -221,6 +221,13 @@ impl FieldDesign {
         options.validate()?;
         let (mesh, plane) = match domain {
             Domain::Plane(g) => {
+                if g.nx == 0 || g.ny == 0 || g.nx.saturating_mul(g.ny) > 1 << 22 {
+                    return Err(FieldsError::InvalidOption {
+                        name: "grid cells",
+                        value: g.nx as f64 * g.ny as f64,
+                        expected: "between 1 and 4 194 304 cells (e.g. 128 × 128)",
+                    });
+                }
                 for (name, v) in [("width", g.width), ("height", g.height)] {
                     if !(v.is_finite() && v > 0.0) {
                         return Err(FieldsError::InvalidOption {
@@ -234,7 +241,21 @@ impl FieldDesign {
             }
             Domain::Mesh(m) => (m, None),
         };
-        let (dec, warnings) = Dec::new(&mesh)?;
+        let (dec, mut warnings) = Dec::new(&mesh)?;
+        if plane.is_none() {
+            // Orientation designs measure angles in frames made from one fixed vector, which
+            // needs a single disk-like patch (paper D, §3: trivial topology).
+            let (_, components) = dec.topology.face_components(&dec.triangles);
+            let euler = dec.n_vertices() as i64 - dec.n_edges() as i64 + dec.n_faces() as i64;
+            if components != 1 || euler != 1 {
+                warnings.push(fieldtex_core::Warning::new(
+                    "field-domain-not-a-disk",
+                    format!(
+                        "the field design mesh has {components} component(s) and Euler characteristic {euler}; designs assume one disk-like patch (1 and 1), so frames and angles may be inconsistent — cut or parameterise the mesh into a disk first"
+                    ),
+                ));
+            }
+        }
         let equations = NormalEquations::new(&dec, &options)?;
         let symbolic = SymbolicCholesky::analyze(&equations.matrix)?;
         let area: f64 = dec.face_areas.iter().sum();
@@ -369,6 +390,13 @@ impl FieldDesign {
                 || self.options.singularity_model == SingularityModel::PointDelta)
         {
             return Err(outside());
+        }
+        // Outside the plane is allowed, but not absurdly far (1000 domain sizes).
+        if let (None, Some(g)) = (face, &self.plane) {
+            let far = 1e3 * (g.width + g.height);
+            if s.position[0].abs() > far || s.position[1].abs() > far || s.position[2].abs() > far {
+                return Err(outside());
+            }
         }
         // Keep the model field's pole off vertices and edges (its edge integrals would be
         // undefined there): nudge the barycentric coordinates towards the centre.

@@ -58,23 +58,32 @@ pub fn stroke_edge_constraints(
             expected: "a finite number ≥ 0",
         });
     }
-    let inside = stroke.points.iter().filter(|p| locate(**p).is_some()).count();
-    if stroke.points.len() < 2 || inside < 2 {
-        return Err(FieldsError::StrokeTooShort { stroke: index, points: inside });
+    if stroke.points.len() < 2 {
+        return Err(FieldsError::StrokeTooShort { stroke: index, points: stroke.points.len() });
     }
     let n = symmetry.n() as f64;
     let step = 0.25 * dec.mean_edge_length;
+    // Only the part of each segment inside the domain's (padded) bounding box is sampled,
+    // so a huge stroke cannot make a huge number of samples.
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in &dec.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k] - dec.mean_edge_length);
+            hi[k] = hi[k].max(p[k] + dec.mean_edge_length);
+        }
+    }
     // Per face: accumulated N-th power direction.
     let mut acc: Vec<(usize, [f64; 2])> = Vec::new();
     for seg in stroke.points.windows(2) {
         let d = sub(seg[1], seg[0]);
-        let len = norm(d);
-        if len <= 0.0 {
+        let Some((t0, t1)) = clip_to_box(seg[0], d, lo, hi) else { continue };
+        let len = norm(d) * (t1 - t0);
+        if len <= 0.0 || !len.is_finite() {
             continue;
         }
         let samples = ((len / step).ceil() as usize).max(1);
         for s in 0..samples {
-            let t = (s as f64 + 0.5) / samples as f64;
+            let t = t0 + (t1 - t0) * (s as f64 + 0.5) / samples as f64;
             let p = add(seg[0], scale(d, t));
             let Some((f, _)) = locate(p) else { continue };
             let (e1, e2) = frames[f];
@@ -106,6 +115,9 @@ pub fn stroke_edge_constraints(
             per_edge.push((e, we, we * dot(target, ev)));
         }
     }
+    if per_edge.is_empty() {
+        return Err(FieldsError::StrokeMissesDomain { stroke: index });
+    }
     per_edge.sort_by_key(|c| c.0);
     let mut merged: Vec<EdgeConstraint> = Vec::with_capacity(per_edge.len());
     for (e, we, wt) in per_edge {
@@ -118,4 +130,22 @@ pub fn stroke_edge_constraints(
         }
     }
     Ok(merged)
+}
+
+/// Parameter range `[t0, t1] ⊂ [0, 1]` of the segment `a + t·d` inside the box
+/// (slab clipping), `None` if it misses the box.
+fn clip_to_box(a: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> Option<(f64, f64)> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for k in 0..3 {
+        if d[k] == 0.0 {
+            if a[k] < lo[k] || a[k] > hi[k] {
+                return None;
+            }
+            continue;
+        }
+        let (u, v) = ((lo[k] - a[k]) / d[k], (hi[k] - a[k]) / d[k]);
+        t0 = t0.max(u.min(v));
+        t1 = t1.min(u.max(v));
+    }
+    (t0 <= t1).then_some((t0, t1))
 }

@@ -226,7 +226,7 @@ fn bad_input_is_an_error_not_a_panic() {
     ));
     assert!(matches!(
         d.add_stroke(Stroke::from_pixels(&[[-30.0, 3.0], [-10.0, 5.0]])),
-        Err(FieldsError::StrokeTooShort { .. })
+        Err(FieldsError::StrokeMissesDomain { .. })
     ));
     assert!(matches!(
         d.add_stroke(Stroke::from_pixels(&[[3.0, 3.0], [f64::INFINITY, 5.0]])),
@@ -236,6 +236,15 @@ fn bad_input_is_an_error_not_a_panic() {
         d.move_singularity(SingularityId(7), [1.0, 1.0, 0.0]),
         Err(FieldsError::UnknownId { .. })
     ));
+    let huge = Stroke::from_pixels(&[[-1e15, 3.0], [1e15, 5.0]]);
+    d.add_stroke(huge).unwrap(); // clipped to the domain: no runaway sampling
+    let nowhere = Singularity::at_pixel(SingularityKind::Wedge, 1e12, 3.0);
+    assert!(matches!(d.add_singularity(nowhere), Err(FieldsError::OutsideDomain { .. })));
+    let no_cells = PlaneGrid { width: 10.0, height: 10.0, nx: 0, ny: 3 };
+    assert!(
+        FieldDesign::new(Domain::Plane(no_cells), Symmetry::Vector, FieldDesignOptions::default())
+            .is_err()
+    );
     // A singularity outside the plane is allowed (it shapes the field from outside)...
     d.add_singularity(Singularity::at_pixel(SingularityKind::Wedge, -20.0, 30.0)).unwrap();
     assert!(d.solve().is_ok());
@@ -246,6 +255,14 @@ fn bad_input_is_an_error_not_a_panic() {
         FieldDesignOptions::default(),
     )
     .unwrap();
+    assert!(m.warnings().is_empty(), "{:?}", m.warnings());
+    let sphere = FieldDesign::new(
+        Domain::Mesh(primitives::icosphere(1)),
+        Symmetry::Vector,
+        FieldDesignOptions::default(),
+    )
+    .unwrap();
+    assert!(sphere.warnings().iter().any(|w| w.code == "field-domain-not-a-disk"));
     let far = Singularity::new(SingularityKind::Source, [5.0, 0.0, 0.0]);
     assert!(matches!(m.add_singularity(far), Err(FieldsError::OutsideDomain { .. })));
     // Broken meshes.
