@@ -123,6 +123,19 @@ enum Command {
         #[arg(long)]
         preview: Option<PathBuf>,
     },
+    /// A tangent field following oriented feature curves (paper A §4); writes a PLY with
+    /// per-vertex `x y z nx ny nz fx fy fz`.
+    Field {
+        mesh: PathBuf,
+        /// OBJ polylines (`l` elements); default: detected crest lines.
+        #[arg(long)]
+        curves: Option<PathBuf>,
+        /// Curve orientation: greedy (paper A §4.1) or arbitrary (random, from --seed).
+        #[arg(long, default_value = "greedy", value_parser = ["greedy", "arbitrary"])]
+        orient: String,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Render a shaded preview of a mesh (textured when it has a texture).
     Render {
         model: PathBuf,
@@ -279,6 +292,13 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Crest { mesh, out, levels, level, preview } => {
             let opts = fieldtex::CrestCommandOptions { levels, min_level: level, preview };
             let summary = fieldtex::crest_file(&mesh, &out, &opts)?;
+            print_warnings(&summary.warnings, g.quiet);
+            println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+        }
+        Command::Field { mesh, curves, orient, out } => {
+            let opts =
+                fieldtex::FieldCommandOptions { curves, greedy: orient == "greedy", seed: g.seed };
+            let summary = fieldtex::field_file(&mesh, &out, &opts, &progress)?;
             print_warnings(&summary.warnings, g.quiet);
             println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
         }

@@ -381,3 +381,36 @@ fn crest_on_fandisk_writes_polylines() {
     );
     assert_eq!(code(&o), 2);
 }
+
+/// `field` on fandisk: greedy orientation gives no more singularities and no higher
+/// Dirichlet energy than an arbitrary orientation, the index sum equals χ = 2, and the
+/// PLY has the `fx fy fz` properties.
+#[test]
+fn field_greedy_beats_arbitrary_on_fandisk() {
+    let d = tmp("field");
+    let m = shared().join("meshes/fandisk.obj");
+    let mut res = Vec::new();
+    for o in ["greedy", "arbitrary"] {
+        let out = d.join(format!("{o}.ply"));
+        let r = run(
+            &[
+                "field",
+                m.to_str().unwrap(),
+                "--orient",
+                o,
+                "--out",
+                out.to_str().unwrap(),
+                "--quiet",
+            ],
+            Duration::from_secs(120),
+        );
+        assert_eq!(code(&r), 0, "{}", stderr(&r));
+        let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+        assert_eq!(v["index_sum"].as_i64(), Some(2), "{o}: index sum = χ");
+        let header = std::fs::read(&out).unwrap();
+        assert!(String::from_utf8_lossy(&header[..400]).contains("property float fz"));
+        res.push((v["singularities"].as_u64().unwrap(), v["dirichlet_energy"].as_f64().unwrap()));
+    }
+    assert!(res[0].0 <= res[1].0, "singularities greedy {} vs arbitrary {}", res[0].0, res[1].0);
+    assert!(res[0].1 <= res[1].1, "energy greedy {} vs arbitrary {}", res[0].1, res[1].1);
+}

@@ -30,6 +30,7 @@ mod obj_reader;
 mod obj_writer;
 mod ply_reader;
 mod ply_writer;
+mod polyline_reader;
 mod read_mesh;
 mod stl_reader;
 
@@ -44,4 +45,5 @@ pub use mesh_format::{MeshFormat, sniff_mesh_format};
 pub use npy::{decode_npy_f32, encode_npy_f32, read_npy_f32, write_npy_f32};
 pub use obj_writer::{write_obj, write_obj_polylines};
 pub use ply_writer::{encode_ply, write_ply};
+pub use polyline_reader::{parse_obj_polylines, read_obj_polylines};
 pub use read_mesh::{LoadedMesh, read_mesh, read_mesh_bytes};

@@ -13,6 +13,7 @@
 //! | [`render_file`] | `fieldtex render` |
 //! | [`eval_files`] | `fieldtex eval` |
 //! | [`crest_file`] | `fieldtex crest` |
+//! | [`field_file`] | `fieldtex field` (paper A §4) |
 //! | [`orient`] | `fieldtex orient` (paper D) |
 
 mod error;
@@ -27,6 +28,7 @@ pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
 pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};
 pub use pipelines::eval::{Guidance, ImageMetrics, eval_files};
+pub use pipelines::field::{FieldCommandOptions, FieldSummary, field_file};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
 pub use pipelines::orient::{DesignedSingularity, FieldSource, OrientOptions, orient};
 pub use pipelines::render::{RenderCommandOptions, render_file};

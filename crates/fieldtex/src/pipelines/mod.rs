@@ -3,6 +3,7 @@ pub mod atlas;
 pub mod crest;
 pub mod demo;
 pub mod eval;
+pub mod field;
 pub mod inspect;
 pub mod orient;
 pub mod render;
