@@ -13,7 +13,7 @@
 //!    curvature tensor over a small neighbourhood before differentiating.
 //! 2. **Extremality** ([`crate::extremality`]): `e_max = ∇k_max · t_max`,
 //!    `e_min = ∇k_min · t_min`, gradients from per-triangle linear interpolation.
-//! 3. **Zero crossings and linking** ([`crate::crest_crossings`]): ridges are maxima
+//! 3. **Zero crossings and linking** (module `crest_crossings`): ridges are maxima
 //!    of `k_max` along `t_max` where `k_max > |k_min|`, valleys minima of `k_min` where
 //!    `k_min < −|k_max|` (Ohtake, Belyaev & Seidel 2004, eq. 2 and 3); directions are
 //!    oriented per edge, triangles that cannot be oriented are skipped, crossings are
@@ -22,23 +22,27 @@
 //!    anisotropy `|k_max − k_min| / |k|` is below [`CrestOptions::min_anisotropy`]
 //!    (near umbilics) are ignored.
 //! 4. **Sharp creases** ([`crate::sharp_edges`]): edges with a dihedral angle above
-//!    [`CrestOptions::sharp_angle_deg`] are chained; convex chains are ridges, concave
-//!    ones valleys. Curvature crossings within [`CrestOptions::crease_exclusion_rings`]
-//!    rings of a crease vertex, or [`CrestOptions::boundary_exclusion_rings`] of a
-//!    boundary vertex, are not traced: there the curvature estimate is dominated by the
-//!    crease (or one-sided) and its derivative is noise.
+//!    [`CrestOptions::sharp_angle_deg`] that stand out from their neighbourhood
+//!    (at least [`CrestOptions::crease_contrast`] times the median angle around their
+//!    vertices, so rough scans do not turn into crease networks) are chained; convex
+//!    chains are ridges, concave ones valleys. Curvature crossings within
+//!    [`CrestOptions::crease_exclusion_rings`] rings of a crease vertex, or
+//!    [`CrestOptions::boundary_exclusion_rings`] of a boundary or non-manifold vertex,
+//!    are not traced: there the curvature estimate is dominated by the crease (or
+//!    one-sided) and its derivative is noise.
 //! 5. **Preprocessing** ([`crate::curve_preprocessing`]): fragments of one feature are
 //!    joined, lines broken at sharp turns, short pieces (below
-//!    [`CrestOptions::min_length`]) dropped.
+//!    [`CurvePreprocessOptions::min_length`]) dropped.
 //! 6. **Strength and levels.** The strength of a line is `∫ |k| ds` along it (`k_max`
 //!    for ridges, `k_min` for valleys, interpolated at each point from its triangle's
-//!    vertices), Yoshizawa et al.'s measure. A crease turns by its dihedral angle `θ`
-//!    within about one edge, so at crease vertices `|k|` is at least `θ / h` (`h` the
-//!    mean edge length): a crease of `n` edges at 90° has strength ≈ `1.6 n`. It is dimensionless, hence invariant to a
+//!    vertices), Yoshizawa et al.'s measure. It is dimensionless, hence invariant to a
 //!    uniform scaling of the mesh (equivalently: curvature normalised by the bounding
-//!    diagonal, integrated over length normalised by it). A line is kept when its
-//!    strength reaches `levels[0]`; its [`CrestLine::level`] is the highest `i` with
-//!    `strength ≥ levels[i]`, so higher levels are coarser, more salient subsets.
+//!    diagonal, integrated over length normalised by it). A crease turns by its
+//!    dihedral angle `θ` within about one edge, so at crease vertices `|k|` is at least
+//!    `θ / h` (`h` the mean edge length): a crease of `n` edges at 90° has strength
+//!    ≈ `1.6 n`. A line is kept when its strength reaches `levels[0]`; its
+//!    [`CrestLine::level`] is the highest `i` with `strength ≥ levels[i]`, so higher
+//!    levels are coarser, more salient subsets.
 //!
 //! # Not implemented
 //! The focal-surface curvature estimate and the implicit (MPU) surface fit of the
@@ -59,7 +63,9 @@ use fieldtex_core::{NoProgress, Progress, Warning};
 use fieldtex_mesh::{CurvatureOptions, PrincipalCurvatures, Topology, TriMesh};
 use serde::Serialize;
 
-/// What a line is the crest of.
+/// What a line is the crest of. Ridge and valley assume outward-facing triangles
+/// (counter-clockwise seen from outside, as `fieldtex_mesh::repair` orients closed
+/// meshes); on an inside-out mesh they swap.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub enum LineKind {
     /// Maximum of `k_max` (convex), or a convex crease.
@@ -138,6 +144,11 @@ impl CrestLines {
     /// The polylines' points, e.g. for an OBJ writer or the coverage metric.
     pub fn polylines(&self) -> Vec<&[V3]> {
         self.lines.iter().map(|l| l.points.as_slice()).collect()
+    }
+    /// Owned polylines of the lines at level `≥ level`, strongest first (for
+    /// `fieldtex_io::write_obj_polylines`).
+    pub fn polylines_at_level(&self, level: usize) -> Vec<Vec<V3>> {
+        self.at_level(level).map(|l| l.points.clone()).collect()
     }
     /// Lines at level `≥ level` (coarser subsets as `level` grows).
     pub fn at_level(&self, level: usize) -> impl Iterator<Item = &CrestLine> {

@@ -1,6 +1,6 @@
 //! Closest points on a triangle mesh, for snapping user curves onto the surface.
 //!
-//! Triangles are binned in a uniform grid ([`crate::spatial_grid`]) with cells of two
+//! Triangles are binned in a uniform grid (module `spatial_grid`) with cells of two
 //! mean edge lengths; a query searches a box that doubles until it holds a triangle
 //! no farther than the box's half-size, which makes the answer exact. The closest
 //! point on one triangle follows Ericson 2005 ("Real-Time Collision Detection",

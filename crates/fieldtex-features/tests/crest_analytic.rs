@@ -55,6 +55,23 @@ fn flattened_ellipsoid_has_its_rim_as_ridge() {
     }
 }
 
+/// The same ellipsoid seen from inside (triangles flipped, normals inward): every
+/// curvature changes sign, the rim becomes a valley (a minimum of `k_min`).
+#[test]
+fn inside_out_ellipsoid_has_its_rim_as_valley() {
+    let (a, b, c) = (2.0, 1.4, 0.6);
+    let mut m = scaled(icosphere(5), [a, b, c]);
+    for t in &mut m.triangles {
+        t.swap(1, 2);
+    }
+    let crest = crest_lines(&m, &CrestOptions::default()).unwrap();
+    assert!(!crest.lines.is_empty());
+    assert!(crest.lines.iter().all(|l| l.kind == LineKind::Valley));
+    for p in crest.lines.iter().flat_map(|l| &l.points) {
+        assert!(p[2].abs() < 0.05 * c, "point {p:?} off the rim plane");
+    }
+}
+
 /// A cube with 8×8 cells per side: flat faces, twelve 90° creases meeting three at a
 /// time at the corners, so twelve convex crease lines (no join across a corner).
 #[test]
