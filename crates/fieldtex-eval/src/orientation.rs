@@ -192,7 +192,9 @@ pub fn dominant_orientation(image: &ImageView) -> Result<(f64, f64), EvalError> 
     let phi = 0.5 * (2.0 * xy).atan2(xx - yy);
     let trace = xx + yy;
     let coh = if trace > 0.0 { ((xx - yy).powi(2) + 4.0 * xy * xy).sqrt() / trace } else { 0.0 };
-    Ok(((phi + 0.5 * PI).rem_euclid(PI).to_degrees(), coh))
+    let deg = (phi + 0.5 * PI).rem_euclid(PI).to_degrees();
+    // rem_euclid of a tiny negative angle rounds up to 180°: report 0 instead.
+    Ok((if deg >= 180.0 - 1e-9 { 0.0 } else { deg }, coh))
 }
 
 /// The guidance an output is compared with.

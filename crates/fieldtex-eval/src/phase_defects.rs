@@ -21,19 +21,22 @@
 //! 6. gating: the amplitude always vanishes *at* a dislocation, so loops are gated on
 //!    the amplitude and coherence **smoothed** over one period (≥ `min_amplitude` ×
 //!    their median, ≥ `min_coherence`), which rejects flat, noisy or isotropic regions;
-//! 7. candidates closer than `merge_radius_periods`·T are merged (single linkage) and
+//! 7. loops within 1.5·T of a ±1/2 singularity of the orientation (where the normal
+//!    turns by 180° around the point and the phase winding is undefined) are skipped:
+//!    those are counted by [`crate::singularities()`], not as stripe breaks;
+//! 8. candidates closer than `merge_radius_periods`·T are merged (single linkage) and
 //!    their charges summed, so dipoles of noise cancel. The count is the sum of the
 //!    absolute net charges.
 //!
 //! The sign of a charge is relative to the normal direction in `[0°, 180°)` and is not
 //! meaningful on its own; only counts are. Not implemented: multi-scale periods (one
-//! period per image) and the defects of ±1/2 orientation singularities themselves
-//! (their cores are usually removed by the coherence gate).
+//! period per image).
 
 use crate::EvalError;
 use crate::filters::{gaussian_blur, gaussian_kernel, gradient, mirror, mirrored_row};
 use crate::image_view::ImageView;
 use crate::orientation::{OrientationOptions, luminance_orientation};
+use crate::singularities::loop_winding;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -319,6 +322,25 @@ pub fn phase_defects(
         });
     }
 
+    // Cores of ±1/2 orientation singularities: there the normal turns by 180° around
+    // any loop, so the phase winding is not defined. Loops within `core` pixels of one
+    // are not counted (they are reported by `singularities`, not as stripe breaks).
+    let core = (1.5 * t).ceil() as isize;
+    let mut near_core = vec![false; w * h];
+    for y in 0..h - 1 {
+        for x in 0..w - 1 {
+            if loop_winding(&map, x, y) != 0.0 {
+                for yy in (y as isize + 1 - core).max(0)..(y as isize + 1 + core).min(h as isize) {
+                    for xx in
+                        (x as isize + 1 - core).max(0)..(x as isize + 1 + core).min(w as isize)
+                    {
+                        near_core[yy as usize * w + xx as usize] = true;
+                    }
+                }
+            }
+        }
+    }
+
     // Gates on smoothed amplitude and coherence.
     let amp: Vec<f32> = re.iter().zip(&im).map(|(a, b)| (a * a + b * b).sqrt()).collect();
     let amp_s = gaussian_blur(&amp, w, h, t);
@@ -352,6 +374,9 @@ pub fn phase_defects(
             for x in border..w.saturating_sub(border + 1) {
                 let idx = [y * w + x, y * w + x + 1, (y + 1) * w + x + 1, (y + 1) * w + x];
                 total += 1;
+                if near_core[idx[0]] {
+                    continue;
+                }
                 if idx.iter().any(|&i| amp_s[i] < amp_threshold || coh_s[i] < options.min_coherence)
                 {
                     continue;

@@ -90,6 +90,20 @@ fn wrap(a: f64) -> f64 {
     r
 }
 
+/// Turns of the doubled angle around the loop through the centres of pixels
+/// `(x, y)`, `(x+1, y)`, `(x+1, y+1)`, `(x, y+1)` (index = turns / 2).
+pub(crate) fn loop_winding(map: &OrientationMap, x: usize, y: usize) -> f64 {
+    let w = map.width;
+    let idx = [y * w + x, y * w + x + 1, (y + 1) * w + x + 1, (y + 1) * w + x];
+    let mut total = 0.0;
+    for k in 0..4 {
+        let a = 2.0 * map.angle[idx[k]] as f64;
+        let b = 2.0 * map.angle[idx[(k + 1) % 4]] as f64;
+        total += wrap(b - a);
+    }
+    (total / (2.0 * PI)).round()
+}
+
 /// Finds the singularities of `map`; see the module docs.
 pub fn singularities(map: &OrientationMap, options: &SingularityOptions) -> SingularityReport {
     let (w, h) = (map.width, map.height);
@@ -124,17 +138,14 @@ pub fn singularities(map: &OrientationMap, options: &SingularityOptions) -> Sing
     };
     for y in border..(h - 1).saturating_sub(border) {
         for x in border..(w - 1).saturating_sub(border) {
-            let idx = [y * w + x, y * w + x + 1, (y + 1) * w + x + 1, (y + 1) * w + x];
-            if idx.iter().any(|&i| map.coherence[i] <= 0.0 && sigma == 0.0) {
+            if sigma == 0.0
+                && [y * w + x, y * w + x + 1, (y + 1) * w + x + 1, (y + 1) * w + x]
+                    .iter()
+                    .any(|&i| map.coherence[i] <= 0.0)
+            {
                 continue;
             }
-            let mut total = 0.0;
-            for k in 0..4 {
-                let a = 2.0 * map.angle[idx[k]] as f64;
-                let b = 2.0 * map.angle[idx[(k + 1) % 4]] as f64;
-                total += wrap(b - a);
-            }
-            let winding = (total / (2.0 * PI)).round();
+            let winding = loop_winding(map, x, y);
             if winding == 0.0 {
                 continue;
             }

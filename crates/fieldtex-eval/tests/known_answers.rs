@@ -200,6 +200,28 @@ fn singularities_of_striped_textures() {
 }
 
 #[test]
+fn singular_cores_are_not_phase_defects() {
+    let (w, h) = (160, 160);
+    let (x0, y0) = (80.0, 80.0);
+    let k = 2.0 * PI / 8.0;
+    // Uniformly spaced loop: straight stripes on one side, half circles around the core.
+    let loop_core = grey(w, h, |x, y| {
+        let (dx, dy) = (x - x0, y - y0);
+        let d = if dx >= 0.0 { dy.abs() } else { dx.hypot(dy) };
+        0.5 + 0.4 * (k * d).cos()
+    });
+    let delta = grey(w, h, |x, y| {
+        let (dx, dy) = (x - x0, y - y0);
+        0.5 + 0.4 * (0.12 * dx.hypot(dy).powf(1.5) * (1.5 * dy.atan2(dx)).cos()).cos()
+    });
+    for img in [loop_core, delta] {
+        let v = ImageView::new(&img, w, h, 1).unwrap();
+        let r = phase_defects(&v, &PhaseDefectOptions::default()).unwrap();
+        assert_eq!(r.count, 0, "{r:?}");
+    }
+}
+
+#[test]
 fn period_estimate_of_stripes() {
     for (theta, period) in [(0.0, 8.0), (35.0, 11.0), (100.0, 6.0)] {
         let img = stripes(96, 96, theta, period);
