@@ -5,12 +5,15 @@
 //! Layout: every item is entered in each cell its box overlaps, as a `(cell key, item)`
 //! pair; the pairs are sorted by key, so a cell is one binary search away and the grid
 //! is deterministic (no hashing). The number of cells per axis is capped at `2^20`; a
-//! cell size that would exceed it is enlarged. Items much larger than a cell occupy many
-//! entries: callers split long segments first (see [`split_segment`]).
+//! cell size that would exceed it is enlarged. An item spanning more than
+//! `MAX_ITEM_CELLS` cells is kept in a short list visited by every query instead, so a
+//! few huge triangles among tiny ones cannot blow up memory; callers split long
+//! segments first (see [`split_segment`]) so that this stays rare.
 
 use fieldtex_core::vec3::{self, V3};
 
 const MAX_CELLS_PER_AXIS: f64 = (1u64 << 20) as f64;
+const MAX_ITEM_CELLS: u64 = 512;
 
 /// A sorted-key uniform grid of item boxes.
 #[derive(Debug, Clone)]
@@ -19,6 +22,8 @@ pub(crate) struct BoxGrid {
     cell: f64,
     dims: [u64; 3],
     entries: Vec<(u64, u32)>,
+    /// Items too large for the cells, checked by every query.
+    large: Vec<u32>,
 }
 
 impl BoxGrid {
@@ -34,7 +39,13 @@ impl BoxGrid {
             }
         }
         if lo[0] > hi[0] {
-            return Self { origin: [0.0; 3], cell: 1.0, dims: [1; 3], entries: Vec::new() };
+            return Self {
+                origin: [0.0; 3],
+                cell: 1.0,
+                dims: [1; 3],
+                entries: Vec::new(),
+                large: Vec::new(),
+            };
         }
         let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
         let mut cell = if cell > 0.0 && cell.is_finite() { cell } else { extent.max(1.0) };
@@ -42,13 +53,18 @@ impl BoxGrid {
             cell = extent / (MAX_CELLS_PER_AXIS - 2.0);
         }
         let dims = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / cell).floor() as u64 + 1);
-        let mut grid = Self { origin: lo, cell, dims, entries: Vec::new() };
+        let mut grid = Self { origin: lo, cell, dims, entries: Vec::new(), large: Vec::new() };
         let mut entries = Vec::with_capacity(boxes.len());
         for (i, (a, b)) in boxes.iter().enumerate() {
             if !(vec3::is_finite(*a) && vec3::is_finite(*b)) {
                 continue;
             }
             let (c0, c1) = (grid.cell_of(*a), grid.cell_of(*b));
+            let span: u64 = (0..3).map(|k| c1[k] - c0[k] + 1).product();
+            if span > MAX_ITEM_CELLS {
+                grid.large.push(i as u32);
+                continue;
+            }
             for x in c0[0]..=c1[0] {
                 for y in c0[1]..=c1[1] {
                     for z in c0[2]..=c1[2] {
@@ -78,6 +94,7 @@ impl BoxGrid {
     /// Calls `f` with every item whose cells overlap the box `(lo, hi)`; an item may be
     /// reported more than once (once per shared cell).
     pub(crate) fn for_each_candidate(&self, lo: V3, hi: V3, mut f: impl FnMut(u32)) {
+        self.large.iter().for_each(|&i| f(i));
         if self.entries.is_empty() {
             return;
         }
@@ -180,6 +197,18 @@ mod tests {
         // Queries outside the grid's box clamp to border cells and stay correct.
         assert!(g.nearest_within([-50.0, 0.0, 0.0], 0.5).is_none());
         assert!((g.nearest_within([10.3, 0.0, 0.0], 0.5).unwrap() - 0.3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn huge_items_are_found_without_filling_cells() {
+        let boxes = vec![([0.0; 3], [0.01; 3]), ([-1e3; 3], [1e3; 3]), ([5.0; 3], [5.01; 3])];
+        let g = BoxGrid::new(&boxes, 0.01);
+        assert!(g.entries.len() <= 16, "{} entries", g.entries.len());
+        let mut found = Vec::new();
+        g.for_each_candidate([4.99; 3], [5.02; 3], |i| found.push(i));
+        found.sort_unstable();
+        found.dedup();
+        assert_eq!(found, vec![1, 2]);
     }
 
     #[test]
