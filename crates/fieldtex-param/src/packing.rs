@@ -172,6 +172,9 @@ impl Grid {
             return None;
         }
         let nrows = grown.rows.len() as i64;
+        // Widest rows first: in a fragmented atlas they are the likeliest to fail.
+        let mut by_need: Vec<i64> = (0..nrows).collect();
+        by_need.sort_by_key(|&r| (std::cmp::Reverse(grown.need[r as usize]), r));
         let mut feasible: Vec<(i64, i64)> = Vec::new();
         let mut scratch: Vec<(i64, i64)> = Vec::new();
         // Atlas row where the last test failed: the obstacle there usually blocks the
@@ -187,9 +190,9 @@ impl Grid {
             feasible.push((ox_lo, ox_hi));
             // Rows in any order give the same set; start at the last obstacle.
             let r0 = hint_y - (oy + grown.y0);
-            let hint = if (0..nrows).contains(&r0) { r0 } else { 0 };
-            for k in 0..nrows {
-                let r = (hint + k) % nrows;
+            let first = if (0..nrows).contains(&r0) { Some(r0) } else { None };
+            for r in first.into_iter().chain(by_need.iter().copied().filter(|&r| Some(r) != first))
+            {
                 let y = oy + grown.y0 + r;
                 if y < 0 || y >= self.height {
                     continue;

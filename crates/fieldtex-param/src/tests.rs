@@ -97,6 +97,18 @@ fn moebius(nu: usize, nv: usize) -> TriMesh {
 /// Checks every invariant of an atlas and returns it.
 fn check_atlas(mesh: &TriMesh, opts: &AtlasOptions) -> Atlas {
     let atlas = build_atlas(mesh, opts, &NoProgress).expect("atlas");
+    check_structure(mesh, opts, &atlas);
+    let s = atlas.stats;
+    assert!(s.angle_distortion_mean >= 1.0 && s.angle_distortion_mean < 1.2, "{s:?}");
+    assert!(s.angle_distortion_p95 < 2.0, "{s:?}");
+    assert!(s.area_distortion >= 1.0 && s.area_distortion < 3.0, "{s:?}");
+    assert!(s.packing_efficiency > 0.0 && s.packing_efficiency < 1.0, "{s:?}");
+    atlas
+}
+
+/// No flips, UVs in the unit square, every chart one disk, no texel shared by two
+/// charts nor closer than the gutter, one texel density for all charts.
+fn check_structure(mesh: &TriMesh, opts: &AtlasOptions, atlas: &Atlas) {
     let s = atlas.stats;
     let uvs = atlas.mesh.uvs.as_ref().expect("uvs");
     assert_eq!(s.flipped_triangles, 0, "flipped triangles");
@@ -178,11 +190,6 @@ fn check_atlas(mesh: &TriMesh, opts: &AtlasOptions) -> Atlas {
     let rs: Vec<f64> = ratio.iter().filter(|r| r.1 > 0.0).map(|r| r.0 / r.1).collect();
     let (lo, hi) = rs.iter().fold((f64::INFINITY, 0.0f64), |a, &r| (a.0.min(r), a.1.max(r)));
     assert!(hi <= lo * (1.0 + 1e-6), "texel density varies: {lo} .. {hi}");
-    assert!(s.angle_distortion_mean >= 1.0 && s.angle_distortion_mean < 1.2, "{s:?}");
-    assert!(s.angle_distortion_p95 < 2.0, "{s:?}");
-    assert!(s.area_distortion >= 1.0 && s.area_distortion < 3.0, "{s:?}");
-    assert!(s.packing_efficiency > 0.0 && s.packing_efficiency < 1.0, "{s:?}");
-    atlas
 }
 
 fn small_opts() -> AtlasOptions {
@@ -429,4 +436,33 @@ fn texel_map_and_bake_bad_input() {
     assert!(parameterization_distortion(&broken, atlas.mesh.uvs.as_ref().unwrap()).is_err());
     let short = fieldtex_mesh::CornerUvs { values: vec![], indices: vec![[0, 0, 0]] };
     assert!(parameterization_distortion(&mesh, &short).is_err());
+}
+
+#[test]
+fn random_soups_never_panic() {
+    use fieldtex_core::rng::hash_unit;
+    for seed in 0..24u64 {
+        let u = |k: u64| hash_unit(seed, "soup", k);
+        let nv = 4 + (u(0) * 40.0) as usize;
+        let nf = 1 + (u(1) * 80.0) as usize;
+        // Coordinates on a coarse lattice, so coincident and collinear points happen.
+        let positions: Vec<[f64; 3]> = (0..nv as u64)
+            .map(|i| {
+                [
+                    (u(10 + 3 * i) * 4.0).floor(),
+                    (u(11 + 3 * i) * 4.0).floor(),
+                    (u(12 + 3 * i) * 2.0).floor(),
+                ]
+            })
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..nf as u64)
+            .map(|f| [0, 1, 2].map(|k| (u(1000 + 3 * f + k) * nv as f64) as u32 % nv as u32))
+            .collect();
+        let mesh = TriMesh::new(positions, triangles);
+        let opts = small_opts();
+        match build_atlas(&mesh, &opts, &NoProgress) {
+            Ok(atlas) => check_structure(&mesh, &opts, &atlas),
+            Err(e) => panic!("seed {seed}: {e}"),
+        }
+    }
 }
