@@ -8,9 +8,14 @@
 //! - `field_full_solve`: design → pixel field on the factored design: every singularity
 //!   re-placed (all model fields recomputed), right-hand side, solve, sample 512²;
 //! - `field_move_singularity`: move one wedge, re-solve (right-hand side only), sample 512²;
-//! - `field_add_stroke`: add one stroke, numeric refactorisation with the kept symbolic
-//!   analysis, solve, sample 512² (the stroke is removed again untimed);
-//! - `field_numeric_refactor`: the numeric factorisation alone.
+//! - `field_add_stroke`: add one stroke (rank-1 factor updates per changed edge, see
+//!   `FieldDesignOptions::rank1_update_limit`), solve, sample 512²; the stroke is
+//!   removed again untimed (downdates);
+//! - `field_add_stroke_refactor`: the same with `rank1_update_limit = 0` (numeric
+//!   refactorisation with the kept symbolic analysis);
+//! - `field_numeric_refactor`: the numeric factorisation alone;
+//! - `field_move_singularity_solve_only` / `field_sample_512`: the move split into
+//!   re-solve and pixel sampling.
 //!
 //! Targets (issue 3): move < 20 ms, full < 50 ms. Timings depend on machine load; the
 //! first line reports the load average where /proc/loadavg exists.
@@ -86,27 +91,76 @@ fn main() {
         assert_eq!(px.len(), size * size);
     }
 
-    let mut t_stroke = Vec::new();
-    let mut t_refactor = Vec::new();
+    let mut t_solve_only = Vec::new();
+    let mut t_sample = Vec::new();
     for k in 0..repeats {
-        let y = 150.0 + 10.0 * k as f64;
+        let p = [p0[0] + 2.0 * ((k % 4) as f64 - 1.5) + 0.13, p0[1] + 0.29, 0.0];
         let t = Instant::now();
-        let sid = d
-            .add_stroke(Stroke::from_pixels(&[[60.0, y], [200.0, y - 20.0], [300.0, y + 10.0]]))
-            .unwrap();
+        d.move_singularity(ids[0], p).unwrap();
+        let f = d.solve().unwrap();
+        t_solve_only.push(ms(t));
+        let t = Instant::now();
+        let px = sample_plane(&d, &f, size, size).unwrap();
+        t_sample.push(ms(t));
+        assert_eq!(px.len(), size * size);
+    }
+
+    let stroke_at = |k: usize| {
+        let y = 150.0 + 10.0 * k as f64;
+        Stroke::from_pixels(&[[60.0, y], [200.0, y - 20.0], [300.0, y + 10.0]])
+    };
+    let mut t_stroke = Vec::new();
+    let updates_before = d.rank1_update_count();
+    for k in 0..repeats {
+        let t = Instant::now();
+        let sid = d.add_stroke(stroke_at(k)).unwrap();
         let f = d.solve().unwrap();
         let px = sample_plane(&d, &f, size, size).unwrap();
         t_stroke.push(ms(t));
         assert_eq!(px.len(), size * size);
         d.remove_stroke(sid).unwrap();
-        let t = Instant::now();
         d.refactor_if_needed().unwrap();
+    }
+    println!(
+        "info: {} rank-1 updates for {repeats} stroke additions + removals, {} refactorisations in all",
+        d.rank1_update_count() - updates_before,
+        d.refactor_count()
+    );
+
+    let mut refactoring = FieldDesign::new(
+        Domain::Plane(grid),
+        symmetry,
+        fieldtex_fields::FieldDesignOptions { rank1_update_limit: 0, ..options.clone() },
+    )
+    .unwrap();
+    for s in file.stroke_list() {
+        refactoring.add_stroke(s).unwrap();
+    }
+    for s in &singularities {
+        refactoring.add_singularity(*s).unwrap();
+    }
+    refactoring.solve().unwrap();
+    let mut t_stroke_refactor = Vec::new();
+    let mut t_refactor = Vec::new();
+    for k in 0..repeats {
+        let t = Instant::now();
+        let sid = refactoring.add_stroke(stroke_at(k)).unwrap();
+        let f = refactoring.solve().unwrap();
+        let px = sample_plane(&refactoring, &f, size, size).unwrap();
+        t_stroke_refactor.push(ms(t));
+        assert_eq!(px.len(), size * size);
+        refactoring.remove_stroke(sid).unwrap();
+        let t = Instant::now();
+        refactoring.refactor_if_needed().unwrap();
         t_refactor.push(ms(t));
     }
 
     println!("BENCH field_factor median_ms={:.2}", median(t_factor));
     println!("BENCH field_full_solve median_ms={:.2}", median(t_full));
     println!("BENCH field_move_singularity median_ms={:.2}", median(t_move));
+    println!("BENCH field_move_singularity_solve_only median_ms={:.2}", median(t_solve_only));
+    println!("BENCH field_sample_512 median_ms={:.2}", median(t_sample));
     println!("BENCH field_add_stroke median_ms={:.2}", median(t_stroke));
+    println!("BENCH field_add_stroke_refactor median_ms={:.2}", median(t_stroke_refactor));
     println!("BENCH field_numeric_refactor median_ms={:.2}", median(t_refactor));
 }

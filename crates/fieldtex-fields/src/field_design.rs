@@ -40,17 +40,17 @@
 //! singularity keeps `A` fixed, so moving any singularity is one back-substitution (its
 //! model 1-form is recomputed, the others are cached).
 //!
-//! Factor once: [`FieldDesign::new`] assembles `A` and factors it (symbolic analysis
-//! kept). Strokes change the diagonal of `A`: the next [`FieldDesign::solve`] refactors
-//! numerically with the kept symbolic analysis (TODO: switch to the rank-1
-//! `Cholesky::update` of `fieldtex-linalg` once it lands and measure — each stroke edge
-//! is a rank-1 term `w_e e_e e_eᵀ`, a typical stroke touches a few hundred edges).
+//! Factor once: [`FieldDesign::new`] assembles `A` and analyses its pattern; the first
+//! solve factors it. Strokes change the diagonal of `A` by `Σ Δw_e e_e e_eᵀ`: small edits
+//! are rank-1 updates/downdates of the factor, larger ones a numeric refactorisation with
+//! the kept symbolic analysis ([`FieldDesign::refactor_if_needed`]; measured in
+//! `examples/bench_fields.rs`: a typical stroke touches ~240 edges, about break-even).
 
 use std::sync::Arc;
 
 use fieldtex_core::Warnings;
 use fieldtex_core::vec3::{add, scale};
-use fieldtex_linalg::{Cholesky, SparseMatrix, SymbolicCholesky};
+use fieldtex_linalg::{Cholesky, SparseMatrix, SymbolicCholesky, UpdateSign};
 use fieldtex_mesh::TriMesh;
 
 use crate::FieldsError;
@@ -91,6 +91,11 @@ pub struct FieldDesignOptions {
     pub regularization: f64,
     /// How singularities enter. Default [`SingularityModel::ModelField`].
     pub singularity_model: SingularityModel,
+    /// Stroke edits touching at most this many edges update the factorisation by rank-1
+    /// updates instead of refactoring (0: always refactor). Default 100: on the 128² grid
+    /// one update costs about 1/250 of a numeric factorisation (bench_fields), and
+    /// solves after downdates take an extra refinement step.
+    pub rank1_update_limit: usize,
 }
 
 impl Default for FieldDesignOptions {
@@ -102,6 +107,7 @@ impl Default for FieldDesignOptions {
             stroke_weight: 4.0,
             regularization: 1e-6,
             singularity_model: SingularityModel::ModelField,
+            rank1_update_limit: 100,
         }
     }
 }
@@ -194,6 +200,8 @@ pub struct FieldDesign {
     strokes: Vec<Option<(Stroke, Vec<EdgeConstraint>)>>,
     warnings: Warnings,
     refactor_count: usize,
+    rank1_update_count: usize,
+    updates_since_factor: usize,
 }
 
 impl std::fmt::Debug for FieldDesign {
@@ -275,6 +283,8 @@ impl FieldDesign {
             strokes: Vec::new(),
             warnings,
             refactor_count: 0,
+            rank1_update_count: 0,
+            updates_since_factor: 0,
         };
         design.frames = if design.plane.is_some() {
             vec![([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]); design.dec.n_faces()]
@@ -310,6 +320,10 @@ impl FieldDesign {
     /// Number of numeric factorisations done so far (the first one included).
     pub fn refactor_count(&self) -> usize {
         self.refactor_count
+    }
+    /// Number of rank-1 factor updates done for stroke edits so far.
+    pub fn rank1_update_count(&self) -> usize {
+        self.rank1_update_count
     }
     /// Magnitude scale of singularity model fields: a quarter of `sqrt(area)`.
     pub fn reference_radius(&self) -> f64 {
@@ -534,16 +548,60 @@ impl FieldDesign {
     }
 
     /// Brings the numeric factorisation up to date with the strokes (no-op when it is;
-    /// the first call makes it). Reuses the symbolic analysis.
+    /// the first call makes it). A stroke edit changes `A` by `Σ Δw_e e_e e_eᵀ`: when at
+    /// most [`FieldDesignOptions::rank1_update_limit`] edges change, the factor gets one
+    /// rank-1 update per edge (`Cholesky::update`, Davis & Hager 1999; additions first,
+    /// then removals as downdates); otherwise, if a downdate is refused, or after
+    /// `16 ×` that many updates since the last factorisation (to bound rounding drift),
+    /// it is refactored numerically with the kept symbolic analysis.
     pub fn refactor_if_needed(&mut self) -> Result<(), FieldsError> {
         let d = self.stroke_diagonal();
-        if self.factor.is_none() || d != self.factored_stroke_diag {
-            let a = self.equations.matrix.add_diagonal(&d);
-            self.factor = Some(Cholesky::factor_with(&self.symbolic, &a)?);
-            self.factored_stroke_diag = d;
-            self.refactor_count += 1;
+        if self.factor.is_some() && d == self.factored_stroke_diag {
+            return Ok(());
         }
+        let limit = self.options.rank1_update_limit;
+        if let Some(factor) = self.factor.as_mut() {
+            let changes: Vec<(usize, f64)> = d
+                .iter()
+                .zip(&self.factored_stroke_diag)
+                .enumerate()
+                .filter(|(_, (a, b))| a != b)
+                .map(|(e, (a, b))| (e, a - b))
+                .collect();
+            if changes.len() <= limit && self.updates_since_factor + changes.len() <= 16 * limit {
+                let ups = changes.iter().filter(|c| c.1 > 0.0);
+                let downs = changes.iter().filter(|c| c.1 < 0.0);
+                let mut ok = true;
+                for &(e, delta) in ups {
+                    factor.update(&[(e, delta.sqrt())], UpdateSign::Up)?;
+                }
+                for &(e, delta) in downs {
+                    if factor.update(&[(e, (-delta).sqrt())], UpdateSign::Down).is_err() {
+                        ok = false;
+                        break;
+                    }
+                }
+                if ok {
+                    self.updates_since_factor += changes.len();
+                    self.rank1_update_count += changes.len();
+                    self.factored_stroke_diag = d;
+                    return Ok(());
+                }
+            }
+        }
+        let a = self.equations.matrix.add_diagonal(&d);
+        self.factor = Some(Cholesky::factor_with(&self.symbolic, &a)?);
+        self.factored_stroke_diag = d;
+        self.refactor_count += 1;
+        self.updates_since_factor = 0;
         Ok(())
+    }
+
+    /// Refactors numerically now (e.g. when a front end is idle after many stroke edits:
+    /// solves after rank-1 downdates take an extra refinement step until then).
+    pub fn refresh_factorization(&mut self) -> Result<(), FieldsError> {
+        self.factor = None;
+        self.refactor_if_needed()
     }
 
     /// The right-hand side `b` (`#E`) for the current singularities and strokes.

@@ -392,3 +392,37 @@ fn designs_on_a_curved_patch() {
         );
     }
 }
+
+#[test]
+fn rank1_stroke_updates_match_refactoring() {
+    let file = preset("whorl", 200.0, 200.0, 40).unwrap();
+    let short = Stroke::from_pixels(&[[30.0, 100.0], [52.0, 93.0]]);
+    let solve = |limit: usize| {
+        let d = file.build(None).unwrap();
+        let o = FieldDesignOptions { rank1_update_limit: limit, ..d.options().clone() };
+        let mut d =
+            FieldDesign::new(Domain::Plane(*d.plane().unwrap()), Symmetry::Orientation, o).unwrap();
+        for s in file.singularity_list().unwrap() {
+            d.add_singularity(s).unwrap();
+        }
+        for s in file.stroke_list() {
+            d.add_stroke(s).unwrap();
+        }
+        d.solve().unwrap();
+        let id = d.add_stroke(short.clone()).unwrap();
+        let with = d.solve().unwrap();
+        d.remove_stroke(id).unwrap();
+        let without = d.solve().unwrap();
+        (with, without, d.rank1_update_count(), d.refactor_count())
+    };
+    let (w1, wo1, updates, refactors) = solve(1000);
+    assert!(updates > 0 && refactors == 1, "updates {updates}, refactors {refactors}");
+    let (w0, wo0, updates, refactors) = solve(0);
+    assert!(updates == 0 && refactors == 3);
+    for (a, b) in [(&w1, &w0), (&wo1, &wo0)] {
+        let scale = b.one_form.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff =
+            a.one_form.iter().zip(&b.one_form).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(diff <= 1e-9 * scale, "rank-1 vs refactor: {diff:e}");
+    }
+}
