@@ -148,9 +148,9 @@ impl Shear {
     fn intersect(&self, tri: &Triangle) -> f32 {
         let [kx, ky, kz] = self.k;
         let [sx, sy, sz] = self.s;
-        let a = tri.v0 - self.org;
-        let b = tri.v1 - self.org;
-        let c = tri.v2 - self.org;
+        let a = (tri.v0 - self.org).to_array();
+        let b = (tri.v1 - self.org).to_array();
+        let c = (tri.v2 - self.org).to_array();
         let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
         let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
         let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
@@ -316,12 +316,15 @@ impl Bvh {
         let mut state = self.cwbvh.new_traversal(oray.direction);
         let mut node;
         let mut hit = false;
-        obvhs::traverse!(self.cwbvh, node, state, node.intersect_ray(&oray, state.oct_inv4), {
-            if shear.intersect(&self.prim_tris[state.primitive_id as usize]).is_finite() {
-                hit = true;
-                break;
-            }
-        });
+        // A plain `break` would only leave the macro's inner primitive loop.
+        'traversal: {
+            obvhs::traverse!(self.cwbvh, node, state, node.intersect_ray(&oray, state.oct_inv4), {
+                if shear.intersect(&self.prim_tris[state.primitive_id as usize]).is_finite() {
+                    hit = true;
+                    break 'traversal;
+                }
+            });
+        }
         hit
     }
 

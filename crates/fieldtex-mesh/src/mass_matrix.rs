@@ -47,6 +47,23 @@ mod tests {
     }
 
     #[test]
+    fn mass_sums_to_area_over_categories_and_fixtures() {
+        let mut all = crate::test_meshes::categories();
+        for name in ["fertility.obj", "stanford-bunny.obj", "defects/narrow_triangles.obj"] {
+            all.extend(crate::test_meshes::load_obj(name).map(|m| (name, m)));
+        }
+        for (name, m) in &all {
+            let a = total_area(m);
+            for kind in [VertexAreaKind::Barycentric, VertexAreaKind::MixedVoronoi] {
+                let d = lumped_mass(m, kind).unwrap();
+                assert!(d.iter().all(|x| x.is_finite() && *x >= 0.0), "{name}");
+                let s: f64 = d.iter().sum();
+                assert!((s - a).abs() <= 1e-9 * a, "{name} {kind:?}: {s} vs {a}");
+            }
+        }
+    }
+
+    #[test]
     fn unreferenced_vertex_has_zero_mass_and_bad_index_is_an_error() {
         let mut m = icosphere(1);
         m.positions.push([5.0, 5.0, 5.0]);

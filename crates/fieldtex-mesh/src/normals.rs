@@ -232,6 +232,24 @@ mod tests {
     }
 
     #[test]
+    fn unit_and_finite_over_categories_and_fixtures() {
+        let mut all = crate::test_meshes::categories();
+        for name in ["fertility.obj", "stanford-bunny.obj", "defects/narrow_triangles.obj"] {
+            all.extend(crate::test_meshes::load_obj(name).map(|m| (name, m)));
+        }
+        for (name, m) in &all {
+            for w in [NormalWeighting::Angle, NormalWeighting::Area, NormalWeighting::Uniform] {
+                let (vn, _) = vertex_normals(m, w);
+                assert!(vn.iter().all(|n| (vec3::norm(*n) - 1.0).abs() < 1e-12), "{name} {w:?}");
+            }
+            for n in face_normals(m) {
+                let l = vec3::norm(n);
+                assert!(l == 0.0 || (l - 1.0).abs() < 1e-12, "{name}");
+            }
+        }
+    }
+
+    #[test]
     fn corner_angles_sum_to_pi() {
         let (a, b, c) = ([0.0, 0.0, 0.0], [3.0, 0.1, 0.0], [0.4, 2.0, 0.5]);
         let s = corner_angle(a, b, c) + corner_angle(b, c, a) + corner_angle(c, a, b);
