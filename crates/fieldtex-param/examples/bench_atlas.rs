@@ -2,17 +2,18 @@
 //!
 //! Loads an OBJ (a tiny `v`/`f` reader: polygons fanned, `a/b/c` and negative indices
 //! accepted), builds the atlas `RUNS` times (default 3) and prints `BENCH` lines: the
-//! median wall time and the quality of the last run. Default mesh: the Stanford bunny
+//! median wall time and the quality of the last run, then the median times of the
+//! texel map and of a bake at the atlas resolution. Default mesh: the Stanford bunny
 //! of the shared test data.
 
 use fieldtex_core::Progress;
 use fieldtex_mesh::TriMesh;
-use fieldtex_param::{AtlasOptions, build_atlas};
+use fieldtex_param::{AtlasOptions, bake_surface, build_atlas, build_texel_map};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
-pub fn load_obj(path: &Path) -> Result<TriMesh, String> {
+fn load_obj(path: &Path) -> Result<TriMesh, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
@@ -129,6 +130,26 @@ fn main() {
     println!("BENCH atlas_{name}_angle_p95 value={:.4}", s.angle_distortion_p95);
     println!("BENCH atlas_{name}_area_distortion value={:.4}", s.area_distortion);
     println!("BENCH atlas_{name}_flips value={}", s.flipped_triangles);
+    // Texel map and bake at the atlas resolution (median over the same number of runs).
+    let res = resolution as usize;
+    let mut map_ms = Vec::new();
+    let mut bake_ms = Vec::new();
+    for _ in 0..runs {
+        let t = Instant::now();
+        let map = build_texel_map(&atlas.mesh, res, res, gutter).expect("atlas UVs are valid");
+        map_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = Instant::now();
+        let img = bake_surface(&atlas.mesh, &map, [0.0; 4], |_, _, p| {
+            [p[0] as f32, p[1] as f32, p[2] as f32, 1.0]
+        })
+        .expect("map matches mesh");
+        bake_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        assert_eq!(img.pixels.len(), res * res);
+    }
+    map_ms.sort_by(|a, b| a.total_cmp(b));
+    bake_ms.sort_by(|a, b| a.total_cmp(b));
+    println!("BENCH texel_map_{name} median_ms={:.1}", map_ms[map_ms.len() / 2]);
+    println!("BENCH bake_{name} median_ms={:.1}", bake_ms[bake_ms.len() / 2]);
     println!("# stages (last run): {stages}");
     for w in &atlas.warnings {
         println!("# warning: {w}");
