@@ -32,8 +32,11 @@ pub(crate) fn uv_checker(size: usize, cells: usize) -> Image {
         for x in 0..size {
             let cx = x * cells / size;
             let cy = y * cells / size;
-            let c =
-                if (cx + cy) % 2 == 0 { [0.93, 0.93, 0.9, 1.0] } else { [0.25, 0.45, 0.7, 1.0] };
+            let c = if (cx + cy).is_multiple_of(2) {
+                [0.93, 0.93, 0.9, 1.0]
+            } else {
+                [0.25, 0.45, 0.7, 1.0]
+            };
             im.set(x, y, c);
         }
     }

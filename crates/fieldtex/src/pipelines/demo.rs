@@ -57,7 +57,7 @@ pub fn demo_exemplar(size: usize, seed: u64) -> Image {
     for y in 0..size {
         for x in 0..size {
             let row = (y as f64 / bh).floor();
-            let shift = if row as usize % 2 == 1 { 0.5 * bw } else { 0.0 };
+            let shift = if !(row as usize).is_multiple_of(2) { 0.5 * bw } else { 0.0 };
             let fx = ((x as f64 + shift) % bw) / bw;
             let fy = (y as f64 % bh) / bh;
             let mortar = fx < 0.06 || fy < 0.12;
