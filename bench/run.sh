@@ -19,6 +19,8 @@ cargo build --release --examples -p fieldtex -p fieldtex-linalg -p fieldtex-io -
   -p fieldtex-param -p fieldtex-synth -p fieldtex-fields -p fieldtex-eval
 ex=target/release/examples
 run() { echo "## $*" >&2; "$@" | tee -a "$log"; }
+# Geometry first: its procedural-torus cotan line is superseded by the horse one below.
+run "$ex/bench_geometry"
 run "$ex/bench_foundation" $quick
 for b in bench_linalg bench_io bench_synth bench_fields bench_eval; do
   [ -x "$ex/$b" ] && run "$ex/$b"
