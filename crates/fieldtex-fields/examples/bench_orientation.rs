@@ -3,17 +3,21 @@
 //!
 //! ```text
 //! cargo run --release -p fieldtex-fields --example bench_orientation -- \
-//!     [MESH.obj|.ply] [--refine] [--curves C.obj] [--seeds 20] [--runs 3] [--name NAME]
+//!     [MESH.obj|.ply] [--refine] [--curves C.obj | --sharp] [--seeds 20] [--runs 3]
+//!     [--batch 0.9] [--name NAME]
 //! ```
 //! Default mesh: `shared/data/meshes/fandisk.obj`. Curves: the polylines (`l` elements)
-//! of `--curves`, else sharp-edge chains (dihedral angle > 30°, broken at turns > 60°,
-//! at least 3 edges) — a stand-in until `fieldtex_features::crest_lines` lands.
+//! of `--curves`; with `--sharp`, plain sharp-edge chains (dihedral angle > 30°, broken
+//! at turns > 60°, more than 3 edges; a private stand-in kept for comparison); otherwise
+//! every crest line of `fieldtex_features::crest_lines` with default options (timed
+//! separately, not part of the orientation time).
 //!
 //! Prints `BENCH orient_<name>_{greedy,arbitrary}_{singularities,dirichlet} value=..`
 //! (arbitrary: median over the seeds), `BENCH orient_<name>_total median_ms=..` (whole
 //! greedy procedure, median over runs), `..._update_ms` (rank-1 updates of one step,
 //! median over steps), `..._refactor_ms` (numeric refactorisation of the final `L + P`
-//! with the kept symbolic analysis, median of 3), and `INFO` lines.
+//! with the kept symbolic analysis, median of 3), the same for the batched greedy
+//! (`--batch τ`, default 0.9; 0 skips it) as `..._batched_*`, and `INFO` lines.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -149,10 +153,13 @@ fn main() {
     let mut mesh_path: Option<PathBuf> = None;
     let (mut refine, mut curves_path, mut seeds, mut runs, mut name) =
         (false, None, 20u64, 3, None);
+    let mut sharp = false;
+    let mut batch = 0.9;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
             "--refine" => refine = true,
+            "--sharp" => sharp = true,
             "--curves" => {
                 i += 1;
                 curves_path = Some(PathBuf::from(&args[i]));
@@ -164,6 +171,10 @@ fn main() {
             "--runs" => {
                 i += 1;
                 runs = args[i].parse().expect("--runs N");
+            }
+            "--batch" => {
+                i += 1;
+                batch = args[i].parse().expect("--batch TAU (0 disables)");
             }
             "--name" => {
                 i += 1;
@@ -184,13 +195,20 @@ fn main() {
         mesh = subdivide_midpoint(&mesh);
         name.push_str("_refined");
     }
-    let curves = match &curves_path {
-        Some(p) => read_obj_polylines(p),
-        None => sharp_edge_chains(&mesh, 30.0, 60.0, 3),
+    let t_curves = Instant::now();
+    let (curves, source) = match &curves_path {
+        Some(p) => (read_obj_polylines(p), "file"),
+        None if sharp => (sharp_edge_chains(&mesh, 30.0, 60.0, 3), "sharp-edge chains"),
+        None => {
+            let crest =
+                fieldtex_features::crest_lines(&mesh, &fieldtex_features::CrestOptions::default())
+                    .expect("crest lines");
+            (crest.lines.into_iter().map(|l| l.points).collect(), "crest lines")
+        }
     };
-    let source = if curves_path.is_some() { "file" } else { "sharp-edge chains" };
+    let curves_ms = 1e3 * t_curves.elapsed().as_secs_f64();
     println!(
-        "INFO mesh={name} vertices={} triangles={} curves={} ({source}) threads={}",
+        "INFO mesh={name} vertices={} triangles={} curves={} ({source}, {curves_ms:.0} ms) threads={}",
         mesh.n_vertices(),
         mesh.n_triangles(),
         curves.len(),
@@ -221,6 +239,13 @@ fn main() {
     let solve_ms = median(steps.iter().map(|s| s.solve_ms).collect());
     let factor_ms: f64 = steps.iter().map(|s| s.factor_ms).sum();
     let constrained = r.solver.constraints().len();
+    let sum_update: f64 = steps.iter().map(|s| s.update_ms).sum();
+    let sum_solve: f64 = steps.iter().map(|s| s.solve_ms).sum();
+    println!(
+        "INFO greedy_breakdown_ms total={:.0} factor={factor_ms:.0} updates={sum_update:.0} solves={sum_solve:.0} other={:.0}",
+        r.total_ms,
+        r.total_ms - factor_ms - sum_update - sum_solve
+    );
     let mut refactor = Vec::new();
     let mut rel_diff = 0.0f64;
     for _ in 0..3 {
@@ -254,6 +279,32 @@ fn main() {
             refactor_ms / per_rank1.max(1e-9),
             ratios.iter().filter(|&&x| x < 10.0).count()
         );
+    }
+
+    // Batched greedy (not in the paper): same measures, and agreement with the exact one.
+    if batch > 0.0 {
+        let o = CurveOrientationOptions { batch_consistency: Some(batch), ..Default::default() };
+        let mut totals = Vec::new();
+        let mut last = None;
+        for _ in 0..runs.max(1) {
+            let t0 = Instant::now();
+            let b = orient_curves(&mesh, &curves, &o, &NoProgress).expect("batched greedy");
+            totals.push(1e3 * t0.elapsed().as_secs_f64());
+            last = Some(b);
+        }
+        let b = last.expect("at least one run");
+        let mb = surface_field_metrics(&mesh, &b.field.vectors, &b.solver.constraints())
+            .expect("metrics");
+        let same = b.signs.iter().zip(&r.signs).filter(|(x, y)| x == y).count();
+        let rounds = b.steps.last().map_or(0, |s| s.round + 1);
+        println!(
+            "INFO batched tau={batch} rounds={rounds} same_signs={same}/{} index_sum={}",
+            b.signs.len(),
+            mb.index_sum
+        );
+        println!("BENCH orient_{name}_batched_singularities value={}", mb.singularities.len());
+        println!("BENCH orient_{name}_batched_dirichlet value={:.4}", mb.dirichlet_energy);
+        println!("BENCH orient_{name}_batched_total median_ms={:.1}", median(totals));
     }
 
     // Arbitrary orientations: median over seeds.

@@ -90,10 +90,11 @@ fn one_and_two_threads_give_identical_results() {
             if k % 2 == 0 { meridian(lon, -1.0, 0.9, 30) } else { meridian(lon, 0.8, -0.7, 30) }
         })
         .collect();
-    let run = |threads: usize, mode: OrientationMode| {
+    let run = |threads: usize, mode: OrientationMode, batch: Option<f64>| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
-            let options = CurveOrientationOptions { mode, ..Default::default() };
+            let options =
+                CurveOrientationOptions { mode, batch_consistency: batch, ..Default::default() };
             let r = orient_curves(&mesh, &curves, &options, &NoProgress).unwrap();
             let m =
                 surface_field_metrics(&mesh, &r.field.vectors, &r.solver.constraints()).unwrap();
@@ -102,12 +103,52 @@ fn one_and_two_threads_give_identical_results() {
             (r.signs, bits, scores, m.dirichlet_energy.to_bits(), m.singularities)
         })
     };
-    for mode in [OrientationMode::Greedy, OrientationMode::Arbitrary { seed: 7 }] {
-        let a = run(1, mode);
-        let b = run(2, mode);
-        assert!(a == b, "{mode:?}: 1 and 2 threads differ");
+    for (mode, batch) in [
+        (OrientationMode::Greedy, None),
+        (OrientationMode::Greedy, Some(0.8)),
+        (OrientationMode::Arbitrary { seed: 7 }, None),
+    ] {
+        let a = run(1, mode, batch);
+        let b = run(2, mode, batch);
+        assert!(a == b, "{mode:?} {batch:?}: 1 and 2 threads differ");
     }
-    let a = run(2, OrientationMode::Arbitrary { seed: 7 });
-    let b = run(2, OrientationMode::Arbitrary { seed: 8 });
+    let a = run(2, OrientationMode::Arbitrary { seed: 7 }, None);
+    let b = run(2, OrientationMode::Arbitrary { seed: 8 }, None);
     assert!(a.0 != b.0 || a.1 == b.1, "seeds give streams");
+}
+
+#[test]
+fn batched_rounds_orient_consistent_curves_together() {
+    let mesh = grid(30, 30, 1.0, 1.0);
+    // Four parallel curves, alternately given in opposite directions.
+    let curves: Vec<Vec<V3>> = (0..4)
+        .map(|k| {
+            let y = 0.2 + 0.2 * k as f64;
+            let len = 0.8 - 0.05 * k as f64;
+            let (a, b) = ([0.1, y, 0.0], [0.1 + len, y, 0.0]);
+            if k % 2 == 0 { line(a, b, 8) } else { line(b, a, 8) }
+        })
+        .collect();
+    let exact =
+        orient_curves(&mesh, &curves, &CurveOrientationOptions::default(), &NoProgress).unwrap();
+    assert_eq!(exact.signs, vec![1, -1, 1, -1]);
+    assert_eq!(exact.steps.iter().map(|s| s.round).collect::<Vec<_>>(), vec![0, 1, 2, 3]);
+    let options = CurveOrientationOptions { batch_consistency: Some(0.9), ..Default::default() };
+    let batched = orient_curves(&mesh, &curves, &options, &NoProgress).unwrap();
+    assert_eq!(batched.signs, exact.signs);
+    // Round 0: the longest curve alone; round 1: the other three at once, one solve.
+    assert_eq!(batched.steps.iter().map(|s| s.round).collect::<Vec<_>>(), vec![0, 1, 1, 1]);
+    assert_eq!(batched.steps.iter().filter(|s| s.solve_ms > 0.0).count(), 2);
+    let max_diff = batched
+        .field
+        .vectors
+        .iter()
+        .zip(&exact.field.vectors)
+        .map(|(a, b)| vec3::norm(vec3::sub(*a, *b)))
+        .fold(0.0, f64::max);
+    assert!(max_diff < 1e-9, "same signs give the same field: {max_diff:e}");
+    for tau in [0.0, -1.0, 1.5, f64::NAN] {
+        let o = CurveOrientationOptions { batch_consistency: Some(tau), ..Default::default() };
+        assert!(orient_curves(&mesh, &curves, &o, &NoProgress).is_err(), "τ = {tau}");
+    }
 }
