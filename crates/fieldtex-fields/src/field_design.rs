@@ -57,91 +57,11 @@ use crate::FieldsError;
 use crate::dec::Dec;
 use crate::design_elements::{Singularity, SingularityKind, Stroke, Symmetry};
 use crate::domain::{Frame, PlaneGrid, locate_in_mesh};
+pub use crate::field_design_options::{FieldDesignOptions, SingularityModel};
 use crate::normal_equations::NormalEquations;
 use crate::reference_frames::reference_frames;
 use crate::singular_model_field::{ModelField, ModelKind};
 use crate::stroke_constraints::{EdgeConstraint, stroke_edge_constraints};
-
-/// How singularities become prescribed divergence and curl.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum SingularityModel {
-    /// Discrete divergence and curl of the exact model-field 1-forms (default).
-    #[default]
-    ModelField,
-    /// Point divergence/curl at the containing triangle (the paper's literal form;
-    /// saddles and trisectors fall back to their model field).
-    PointDelta,
-}
-
-/// Weights and switches of a field design.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FieldDesignOptions {
-    /// `w_s`, weight of the smoothness (divergence + curl + boundary) energy. Default 1.
-    pub smoothness_weight: f64,
-    /// Include the natural boundary term (paper D §2.2). Default `true`; `false` is the
-    /// ablation with Fisher et al.'s free boundary only.
-    pub natural_boundary: bool,
-    /// `β`, scale of the natural boundary term, in `[0, 1]` (1 = Dirichlet energy).
-    /// Default 1.
-    pub boundary_weight: f64,
-    /// Global stroke weight, multiplied by each stroke's own weight. Default 4.
-    pub stroke_weight: f64,
-    /// `ε`, relative Tikhonov regularisation (times the diagonal of the smoothness
-    /// matrix; on the deviation from the model fields). Default `1e-6`.
-    pub regularization: f64,
-    /// How singularities enter. Default [`SingularityModel::ModelField`].
-    pub singularity_model: SingularityModel,
-    /// Stroke edits touching at most this many edges update the factorisation by rank-1
-    /// updates instead of refactoring (0: always refactor). Default 100: on the 128² grid
-    /// one update costs about 1/250 of a numeric factorisation (bench_fields), and
-    /// solves after downdates take an extra refinement step.
-    pub rank1_update_limit: usize,
-}
-
-impl Default for FieldDesignOptions {
-    fn default() -> Self {
-        Self {
-            smoothness_weight: 1.0,
-            natural_boundary: true,
-            boundary_weight: 1.0,
-            stroke_weight: 4.0,
-            regularization: 1e-6,
-            singularity_model: SingularityModel::ModelField,
-            rank1_update_limit: 100,
-        }
-    }
-}
-
-impl FieldDesignOptions {
-    fn validate(&self) -> Result<(), FieldsError> {
-        let check = |name: &'static str, v: f64, ok: bool, expected: &'static str| {
-            if ok && v.is_finite() {
-                Ok(())
-            } else {
-                Err(FieldsError::InvalidOption { name, value: v, expected })
-            }
-        };
-        check(
-            "smoothness_weight",
-            self.smoothness_weight,
-            self.smoothness_weight > 0.0,
-            "a number > 0",
-        )?;
-        check(
-            "boundary_weight",
-            self.boundary_weight,
-            (0.0..=1.0).contains(&self.boundary_weight),
-            "a number in [0, 1] (1 = Dirichlet energy)",
-        )?;
-        check("stroke_weight", self.stroke_weight, self.stroke_weight >= 0.0, "a number ≥ 0")?;
-        check(
-            "regularization",
-            self.regularization,
-            self.regularization > 0.0 && self.regularization < 1.0,
-            "a number in (0, 1), e.g. 1e-6",
-        )
-    }
-}
 
 /// The domain of a design.
 #[derive(Debug, Clone, PartialEq)]

@@ -55,6 +55,7 @@ pub mod design_file;
 pub mod domain;
 pub mod error;
 pub mod field_design;
+pub mod field_design_options;
 pub mod natural_boundary;
 pub mod normal_equations;
 pub mod orientation_field;

@@ -426,3 +426,12 @@ fn rank1_stroke_updates_match_refactoring() {
         assert!(diff <= 1e-9 * scale, "rank-1 vs refactor: {diff:e}");
     }
 }
+
+#[test]
+fn design_objects_can_move_between_threads() {
+    fn send_sync<T: Send + Sync>() {}
+    send_sync::<FieldDesign>();
+    send_sync::<SolvedField>();
+    send_sync::<DesignFile>();
+    send_sync::<FieldsError>();
+}
