@@ -27,6 +27,11 @@
 //! 5. **Linking.** Crossings are shared by the two triangles of their edge, so
 //!    segments form a graph whose nodes have degree ≤ 2 except at junctions; maximal
 //!    paths through degree-2 nodes become polylines, closed cycles closed polylines.
+//! 6. **Sharpness.** A line is kept when the length-weighted mean of the
+//!    dimensionless sharpness `|∂e/∂t| / |k|³` of its triangles reaches a minimum.
+//!    This is a scale-free form of the sharpness Yoshizawa et al. integrate along
+//!    crest lines; it removes the zero sets of `e` where `k` barely varies across the
+//!    line (cylinders, tori, tube-like limbs), which are discretisation noise.
 
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_mesh::{Csr, Topology, TriMesh};
@@ -47,6 +52,8 @@ pub(crate) struct Family<'a> {
     pub flat: f64,
     /// Minimum `|k − k_other| / max(|k|, |k_other|)` at a crossing.
     pub anisotropy: f64,
+    /// Minimum length-weighted mean sharpness of a traced line.
+    pub sharpness: f64,
 }
 
 /// A polyline on the mesh with the triangle of every point.
@@ -64,6 +71,8 @@ pub(crate) struct CrossingCounts {
     pub segments: usize,
     pub junctions: usize,
     pub inconsistent_triangles: usize,
+    /// Linked lines dropped for a mean sharpness below the minimum.
+    pub blunt_lines: usize,
 }
 
 /// The crossing on edge `e`, as `λ` from `edges[e][0]`, or `None` (module docs).
@@ -154,7 +163,61 @@ pub(crate) fn trace_family(
         }
     }
     counts.segments = segments.len();
-    (link_segments(&nodes, &segments), counts)
+    let mut lines = link_segments(&nodes, &segments);
+    let before = lines.len();
+    lines.retain(|l| line_sharpness(mesh, fam, l) >= fam.sharpness);
+    counts.blunt_lines = before - lines.len();
+    (lines, counts)
+}
+
+/// Dimensionless sharpness of the extremum inside triangle `f`:
+/// `max(0, ∓∂e/∂t) / |k|³` (`−` for ridges, `+` for valleys), with `e` and `t`
+/// oriented like the triangle's first corner, `∂e/∂t` the derivative of the linear
+/// interpolant of `e` along the mean direction and `k` the mean curvature of the
+/// corners. For a ridge whose cross-section is an ellipse with semi-axes `a ≥ b`
+/// (the ridge at the end of `a`) it equals `3 (1 − b²/a²)`: 0 on a circle or cylinder,
+/// where `e ≡ 0` and its zero set is noise, and up to 3 on knife edges.
+fn face_sharpness(mesh: &TriMesh, fam: &Family, f: usize) -> f64 {
+    let tri = mesh.triangles[f].map(|v| v as usize);
+    let [pa, pb, pc] = tri.map(|v| mesh.positions[v]);
+    let cr = vec3::cross(vec3::sub(pb, pa), vec3::sub(pc, pa));
+    let dbl_area = vec3::norm(cr);
+    if !(dbl_area > 0.0 && dbl_area.is_finite()) {
+        return 0.0;
+    }
+    let n = vec3::scale(cr, 1.0 / dbl_area);
+    let t0 = fam.t[tri[0]];
+    let mut t_sum = [0.0; 3];
+    let mut e = [0.0; 3];
+    for (i, &v) in tri.iter().enumerate() {
+        let s = if vec3::dot(fam.t[v], t0) < 0.0 { -1.0 } else { 1.0 };
+        t_sum = vec3::add(t_sum, vec3::scale(fam.t[v], s));
+        e[i] = s * fam.e[v];
+    }
+    let Some(t) = vec3::normalize(t_sum) else { return 0.0 };
+    let grad = vec3::add(
+        vec3::add(
+            vec3::scale(vec3::cross(n, vec3::sub(pc, pb)), e[0]),
+            vec3::scale(vec3::cross(n, vec3::sub(pa, pc)), e[1]),
+        ),
+        vec3::scale(vec3::cross(n, vec3::sub(pb, pa)), e[2]),
+    );
+    let de_dt = vec3::dot(grad, t) / dbl_area;
+    let k = (fam.k[tri[0]] + fam.k[tri[1]] + fam.k[tri[2]]) / 3.0;
+    let s = if fam.ridge { -de_dt } else { de_dt };
+    let value = s.max(0.0) / k.abs().powi(3);
+    if value.is_finite() { value } else { 0.0 }
+}
+
+/// Length-weighted mean of [`face_sharpness`] over a line's segments.
+fn line_sharpness(mesh: &TriMesh, fam: &Family, line: &RawLine) -> f64 {
+    let (mut acc, mut len) = (0.0, 0.0);
+    for (i, w) in line.points.windows(2).enumerate() {
+        let l = vec3::norm(vec3::sub(w[1], w[0]));
+        acc += l * face_sharpness(mesh, fam, line.faces[i] as usize);
+        len += l;
+    }
+    if len > 0.0 { acc / len } else { 0.0 }
 }
 
 /// Maximal paths of the segment graph through degree-2 nodes, then cycles (module

@@ -20,7 +20,9 @@
 //!    linked into polylines. Crossings where `|k| · diagonal` is below
 //!    [`CrestOptions::flat_curvature`] (flat and nearly flat regions) or where the
 //!    anisotropy `|k_max − k_min| / |k|` is below [`CrestOptions::min_anisotropy`]
-//!    (near umbilics) are ignored.
+//!    (near umbilics) are ignored, and so are traced lines whose mean sharpness
+//!    `|∂e/∂t| / |k|³` is below [`CrestOptions::min_sharpness`] (where `k` hardly
+//!    varies across the line, its extremality is noise).
 //! 4. **Sharp creases** ([`crate::sharp_edges`]): edges with a dihedral angle above
 //!    [`CrestOptions::sharp_angle_deg`] that stand out from their neighbourhood
 //!    (at least [`CrestOptions::crease_contrast`] times the median angle around their
@@ -46,8 +48,7 @@
 //!
 //! # Not implemented
 //! The focal-surface curvature estimate and the implicit (MPU) surface fit of the
-//! cited papers (the mesh's own tensor estimate is used); their "sharpness" measure
-//! (the integral of `∂e/∂t` along the line) is not used as a threshold; crest lines
+//! cited papers (the mesh's own tensor estimate is used); crest lines
 //! crossing between a crease and the smooth part of the surface are not connected
 //! geometrically, only by the endpoint joining of step 5.
 
@@ -119,6 +120,8 @@ pub struct CrestStats {
     pub valley_crossings: usize,
     /// Triangles skipped because their principal directions cannot be oriented.
     pub inconsistent_triangles: usize,
+    /// Traced curvature lines dropped for a low sharpness.
+    pub blunt_lines: usize,
     pub sharp_edges: usize,
     pub sharp_chains: usize,
     /// Polylines before preprocessing (curvature + crease).
@@ -167,6 +170,10 @@ pub struct CrestOptions {
     /// Crossings where `|k_max − k_min| / |k|` is below this are ignored as nearly
     /// umbilic (principal directions unreliable). Default 0.25.
     pub min_anisotropy: f64,
+    /// Curvature lines whose mean sharpness `|∂e/∂t| / |k|³` is below this are dropped
+    /// (constant curvature across the line: cylinders, tori). Default 0.3 (an
+    /// elliptic ridge profile with axis ratio above ~0.95 is dropped).
+    pub min_sharpness: f64,
     /// Trace ridges. Default `true`.
     pub ridges: bool,
     /// Trace valleys. Default `true`.
@@ -198,6 +205,7 @@ impl Default for CrestOptions {
             curvature_smoothing: 2,
             flat_curvature: 4.0,
             min_anisotropy: 0.25,
+            min_sharpness: 0.3,
             ridges: true,
             valleys: true,
             sharp_angle_deg: 30.0,
@@ -215,6 +223,7 @@ impl CrestOptions {
     pub fn validate(&self) -> Result<(), FeaturesError> {
         check_option("flat_curvature", self.flat_curvature, self.flat_curvature >= 0.0, "≥ 0")?;
         check_option("min_anisotropy", self.min_anisotropy, self.min_anisotropy >= 0.0, "≥ 0")?;
+        check_option("min_sharpness", self.min_sharpness, self.min_sharpness >= 0.0, "≥ 0")?;
         check_option(
             "sharp_angle_deg",
             self.sharp_angle_deg,
@@ -305,7 +314,16 @@ pub fn crest_lines_with_progress(
             (&curv.k_min, &curv.k_max, &curv.dir_min)
         };
         let e = extremality(mesh, k, t, &curv.normals, (&corners.0, &corners.1));
-        let fam = Family { k, k_other, t, e: &e, ridge, flat, anisotropy: options.min_anisotropy };
+        let fam = Family {
+            k,
+            k_other,
+            t,
+            e: &e,
+            ridge,
+            flat,
+            anisotropy: options.min_anisotropy,
+            sharpness: options.min_sharpness,
+        };
         let (lines, counts): (_, CrossingCounts) = trace_family(mesh, &topo, &fam, &face_allowed);
         let kind = if ridge { LineKind::Ridge } else { LineKind::Valley };
         raw.extend(lines.into_iter().map(|l| (l, kind, LineSource::Curvature)));
@@ -315,11 +333,13 @@ pub fn crest_lines_with_progress(
         let c = trace(true, &mut raw);
         stats.ridge_crossings = c.crossings;
         stats.inconsistent_triangles += c.inconsistent_triangles;
+        stats.blunt_lines += c.blunt_lines;
     }
     if options.valleys {
         let c = trace(false, &mut raw);
         stats.valley_crossings = c.crossings;
         stats.inconsistent_triangles += c.inconsistent_triangles;
+        stats.blunt_lines += c.blunt_lines;
     }
     progress.advance(1);
     stats.raw_lines = raw.len();

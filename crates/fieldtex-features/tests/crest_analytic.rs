@@ -7,7 +7,7 @@ mod common;
 use fieldtex_core::vec3;
 use fieldtex_features::{CrestOptions, LineKind, LineSource, crest_lines, sharp_edge_coverage};
 use fieldtex_mesh::TriMesh;
-use fieldtex_mesh::primitives::{grid, icosphere};
+use fieldtex_mesh::primitives::{grid, icosphere, torus};
 
 fn scaled(mut m: TriMesh, s: [f64; 3]) -> TriMesh {
     for p in &mut m.positions {
@@ -70,6 +70,21 @@ fn inside_out_ellipsoid_has_its_rim_as_valley() {
     for p in crest.lines.iter().flat_map(|l| &l.points) {
         assert!(p[2].abs() < 0.05 * c, "point {p:?} off the rim plane");
     }
+}
+
+/// On a torus the tube curvature `k_max = 1/r` is the same everywhere, so `e_max ≡ 0`
+/// and any zero crossing is discretisation noise: the sharpness test removes it (and
+/// a torus has no valley of `k_min` with `|k_min| > |k_max|`).
+#[test]
+fn torus_has_no_crest_lines() {
+    for (nu, nv) in [(96, 32), (150, 40)] {
+        let m = torus(2.0, 0.5, nu, nv);
+        let c = crest_lines(&m, &CrestOptions::default()).unwrap();
+        assert!(c.lines.is_empty(), "{nu}×{nv}: {} lines, {:?}", c.lines.len(), c.stats);
+    }
+    let shared = common::load("meshes/torus.obj");
+    let c = crest_lines(&shared, &CrestOptions::default()).unwrap();
+    assert!(c.lines.is_empty(), "shared torus: {:?}", c.stats);
 }
 
 /// A cube with 8×8 cells per side: flat faces, twelve 90° creases meeting three at a
