@@ -128,30 +128,31 @@ fn face_half_cotans(p: [[f64; 3]; 3], floor: f64) -> ([f64; 3], u8) {
     (w, status)
 }
 
-/// Per-face pass shared by every builder: `#F × 3` half-cotangents, optionally `#F × 3`
-/// corner mass shares, and the statistics. Indices must be checked.
+/// Per-face pass shared by every builder: `#F` records `[w0, w1, w2, m]` (the
+/// half-cotangents and, for barycentric mass, a third of the area), `#F × 3` mixed
+/// Voronoi shares when those are asked for, and the statistics. Indices must be checked.
 fn face_pass(
     mesh: &TriMesh,
     floor: f64,
     mass: Option<VertexAreaKind>,
-) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, CotanStats) {
+) -> (Vec<[f64; 4]>, Vec<[f64; 3]>, CotanStats) {
     let nf = mesh.n_triangles();
-    let mut w = vec![[0.0; 3]; nf];
-    let mut shares = vec![[0.0; 3]; if mass.is_some() { nf } else { 0 }];
+    let voronoi = mass == Some(VertexAreaKind::MixedVoronoi);
+    let mut recs = vec![[0.0; 4]; nf];
+    let mut shares = vec![[0.0; 3]; if voronoi { nf } else { 0 }];
     let mut share_chunks: Vec<&mut [[f64; 3]]> = shares.chunks_mut(FACE_CHUNK).collect();
     share_chunks.resize_with(nf.div_ceil(FACE_CHUNK), Default::default);
-    let per_chunk: Vec<CotanStats> = w
+    let per_chunk: Vec<CotanStats> = recs
         .par_chunks_mut(FACE_CHUNK)
         .zip(share_chunks.into_par_iter())
         .enumerate()
-        .map(|(c, (wc, sc))| {
+        .map(|(c, (rc, sc))| {
             let mut st = CotanStats::default();
-            for (o, wf) in wc.iter_mut().enumerate() {
+            for (o, rec) in rc.iter_mut().enumerate() {
                 let f = c * FACE_CHUNK + o;
                 let t = mesh.triangles[f];
                 let p = [0, 1, 2].map(|i| mesh.positions[t[i] as usize]);
-                let (wv, status) = face_half_cotans(p, floor);
-                *wf = wv;
+                let (w, status) = face_half_cotans(p, floor);
                 if status == 1 {
                     st.n_floored += 1;
                     st.first_floored.get_or_insert(f);
@@ -159,15 +160,15 @@ fn face_pass(
                     st.n_skipped += 1;
                     st.first_skipped.get_or_insert(f);
                 }
-                match mass {
-                    Some(VertexAreaKind::Barycentric) => {
-                        sc[o] = [triangle_area(p[0], p[1], p[2]) / 3.0; 3];
-                    }
+                let m = match mass {
+                    Some(VertexAreaKind::Barycentric) => triangle_area(p[0], p[1], p[2]) / 3.0,
                     Some(VertexAreaKind::MixedVoronoi) => {
                         sc[o] = mixed_voronoi_corner_areas(p[0], p[1], p[2]);
+                        0.0
                     }
-                    None => {}
-                }
+                    None => 0.0,
+                };
+                *rec = [w[0], w[1], w[2], m];
             }
             st
         })
@@ -179,7 +180,7 @@ fn face_pass(
         stats.first_floored = stats.first_floored.or(st.first_floored);
         stats.first_skipped = stats.first_skipped.or(st.first_skipped);
     }
-    (w, shares, stats)
+    (recs, shares, stats)
 }
 
 /// `#F × 3` half-cotangent weights (`w[f][i]` for the edge between corners `i` and
@@ -189,8 +190,8 @@ pub fn cotan_face_weights(
     options: &CotanOptions,
 ) -> Result<(Vec<[f64; 3]>, CotanStats), MeshError> {
     crate::checks::check_indices(mesh)?;
-    let (w, _, stats) = face_pass(mesh, effective_floor(options), None);
-    Ok((w, stats))
+    let (recs, _, stats) = face_pass(mesh, effective_floor(options), None);
+    Ok((recs.into_iter().map(|r| [r[0], r[1], r[2]]).collect(), stats))
 }
 
 /// `#E` edge weights `w_e = ½ Σ cot` over the triangles of edge `e`, indexed like
@@ -253,30 +254,38 @@ pub(crate) fn vertex_corners(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec
     (offsets, items)
 }
 
-/// Gathers the `(row, half-cotangent)` pairs of column `v` into `buf`, sorted by row
-/// with a stable insertion sort (columns hold ≈ 12 entries), so that duplicates are
-/// adjacent and in triangle order. Without `fw` the weights are left 0.
-#[inline]
-fn gather_column(
-    v: usize,
-    tris: &[[u32; 3]],
-    corners: &[u32],
-    fw: Option<&[[f64; 3]]>,
-    buf: &mut Vec<(u32, f64)>,
-) {
-    buf.clear();
-    for &corner in corners {
-        let (f, i) = ((corner / 3) as usize, (corner % 3) as usize);
-        let t = tris[f];
-        let w = fw.map_or([0.0; 3], |fw| fw[f]);
-        let (next, prev) = (t[(i + 1) % 3], t[(i + 2) % 3]);
-        if next as usize != v {
-            buf.push((next, w[i]));
-        }
-        if prev as usize != v {
-            buf.push((prev, w[(i + 2) % 3]));
+/// Corners grouped by vertex (counting sort), with their two neighbours:
+/// `items[offsets[v]..offsets[v + 1]]` are `[next, prev, 3 f + i]` for every corner `i`
+/// of triangle `f` at `v`, in triangle order (`u32::MAX` for a neighbour equal to `v`).
+fn vertex_corner_neighbours(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec<[u32; 3]>) {
+    let mut offsets = vec![0u32; n + 1];
+    for t in triangles {
+        for &v in t {
+            offsets[v as usize + 1] += 1;
         }
     }
+    for v in 0..n {
+        offsets[v + 1] += offsets[v];
+    }
+    let mut next = offsets.clone();
+    let mut items = vec![[0u32; 3]; 3 * triangles.len()];
+    for (f, t) in triangles.iter().enumerate() {
+        for i in 0..3 {
+            let v = t[i];
+            let other = |u: u32| if u == v { u32::MAX } else { u };
+            let k = &mut next[v as usize];
+            items[*k as usize] =
+                [other(t[(i + 1) % 3]), other(t[(i + 2) % 3]), 3 * f as u32 + i as u32];
+            *k += 1;
+        }
+    }
+    (offsets, items)
+}
+
+/// Stable insertion sort by row (columns hold ≈ 12 entries), so duplicates are adjacent
+/// and in triangle order.
+#[inline]
+fn sort_by_row<T: Copy>(buf: &mut [(u32, T)]) {
     for k in 1..buf.len() {
         let x = buf[k];
         let mut j = k;
@@ -300,10 +309,14 @@ fn split_lengths<'a, T>(mut data: &'a mut [T], lengths: &[usize]) -> Vec<&'a mut
 }
 
 /// CSC arrays of `L`, the masses (empty when `mass` is `None`) and the statistics.
-/// Two column-parallel passes write straight into the final arrays (no intermediate
-/// copies: on large meshes first-touch page faults cost as much as the arithmetic):
-/// the first counts the distinct rows of every column, the second fills them.
 /// Indices must be checked.
+///
+/// The per-face pass runs beside a counting sort of the corners by vertex that also
+/// records each corner's two neighbours; then two column-parallel passes count the
+/// distinct rows of every column (from the neighbour lists alone) and fill the final
+/// arrays directly, reading each corner's face record once. Intermediate arrays are kept
+/// few and small: on large meshes cache misses and first-touch page faults cost more
+/// than the arithmetic.
 #[allow(clippy::type_complexity)]
 fn assemble(
     mesh: &TriMesh,
@@ -312,16 +325,19 @@ fn assemble(
 ) -> (Vec<usize>, Vec<usize>, Vec<f64>, Vec<f64>, CotanStats) {
     let n = mesh.n_vertices();
     let tris = &mesh.triangles;
-    let ((fw, shares, stats), (offsets, corners)) =
-        rayon::join(|| face_pass(mesh, floor, mass), || vertex_corners(n, tris));
-    let col_corners = |v: usize| &corners[offsets[v] as usize..offsets[v + 1] as usize];
+    let ((recs, shares, stats), (offsets, items)) =
+        rayon::join(|| face_pass(mesh, floor, mass), || vertex_corner_neighbours(n, tris));
+    let col_items = |v: usize| &items[offsets[v] as usize..offsets[v + 1] as usize];
     // Pass 1: column lengths (distinct neighbours + the diagonal).
     let mut col_ptr = vec![0usize; n + 1];
     col_ptr[1..].par_chunks_mut(COL_CHUNK).enumerate().for_each(|(c, lens)| {
-        let mut buf = Vec::with_capacity(32);
+        let mut buf: Vec<(u32, ())> = Vec::with_capacity(32);
         for (o, len) in lens.iter_mut().enumerate() {
-            let v = c * COL_CHUNK + o;
-            gather_column(v, tris, col_corners(v), None, &mut buf);
+            buf.clear();
+            for it in col_items(c * COL_CHUNK + o) {
+                buf.extend(it[..2].iter().filter(|&&r| r != u32::MAX).map(|&r| (r, ())));
+            }
+            sort_by_row(&mut buf);
             *len = 1 + buf.len() - buf.windows(2).filter(|w| w[0].0 == w[1].0).count();
         }
     });
@@ -346,20 +362,29 @@ fn assemble(
         .zip(split_lengths(&mut masses, &mass_lens))
         .enumerate()
         .collect();
+    let voronoi = mass == Some(VertexAreaKind::MixedVoronoi);
     parts.into_par_iter().for_each(|(c, ((ri, va), ma))| {
         let (c0, c1) = (c * COL_CHUNK, ((c + 1) * COL_CHUNK).min(n));
         let base = col_ptr[c0];
-        let mut buf = Vec::with_capacity(32);
+        let mut buf: Vec<(u32, f64)> = Vec::with_capacity(32);
         for v in c0..c1 {
-            let cc = col_corners(v);
-            if !ma.is_empty() {
-                let mut m = 0.0;
-                for &corner in cc {
-                    m += shares[(corner / 3) as usize][(corner % 3) as usize];
+            buf.clear();
+            let mut m = 0.0;
+            for &[nx, pv, corner] in col_items(v) {
+                let (f, i) = ((corner / 3) as usize, (corner % 3) as usize);
+                let rec = recs[f];
+                if nx != u32::MAX {
+                    buf.push((nx, rec[i]));
                 }
+                if pv != u32::MAX {
+                    buf.push((pv, rec[(i + 2) % 3]));
+                }
+                m += if voronoi { shares[f][i] } else { rec[3] };
+            }
+            if !ma.is_empty() {
                 ma[v - c0] = m;
             }
-            gather_column(v, tris, cc, Some(&fw), &mut buf);
+            sort_by_row(&mut buf);
             let mut k = col_ptr[v] - base;
             let mut diag = 0.0;
             let mut diag_at = None;
