@@ -8,7 +8,7 @@
 use crate::raster::triangle_row_spans;
 
 /// Covered texels of one chart: `w × h` bits, rows of `stride` words.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub(crate) struct Footprint {
     pub w: i64,
     pub h: i64,
@@ -17,12 +17,14 @@ pub(crate) struct Footprint {
 }
 
 /// A footprint grown by the gutter, as spans per row: row `k` is footprint row
-/// `y0 + k`; `need[k]` is the length of its longest span.
+/// `y0 + k`; `need[k]` is the length of its longest span; `by_need` lists the rows
+/// from the widest to the narrowest (ties by row).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Grown {
     pub y0: i64,
     pub rows: Vec<Vec<(i64, i64)>>,
     pub need: Vec<i64>,
+    pub by_need: Vec<u32>,
 }
 
 /// Sets bits `a..=b` of a row.
@@ -81,6 +83,11 @@ impl Footprint {
     fn empty(w: i64, h: i64) -> Self {
         let stride = (w as usize).div_ceil(64);
         Self { w, h, stride, bits: vec![0; stride * h as usize] }
+    }
+
+    /// A single texel.
+    pub fn single() -> Self {
+        Self { w: 1, h: 1, stride: 1, bits: vec![1] }
     }
 
     fn row(&self, y: i64) -> &[u64] {
@@ -183,7 +190,12 @@ impl Footprint {
         let which: Vec<usize> =
             ext.iter().map(|e| exts.binary_search(e).expect("listed")).collect();
         let n = h + 2 * g as usize;
-        let mut grown = Grown { y0: -g, rows: Vec::with_capacity(n), need: Vec::with_capacity(n) };
+        let mut grown = Grown {
+            y0: -g,
+            rows: Vec::with_capacity(n),
+            need: Vec::with_capacity(n),
+            by_need: Vec::new(),
+        };
         let mut acc = vec![0u64; sg];
         for k in 0..n as i64 {
             let y = k - g;
@@ -203,6 +215,8 @@ impl Footprint {
             grown.need.push(row.iter().map(|&(a, b)| b - a + 1).max().unwrap_or(0));
             grown.rows.push(row);
         }
+        grown.by_need = (0..n as u32).collect();
+        grown.by_need.sort_by_key(|&r| (std::cmp::Reverse(grown.need[r as usize]), r));
         grown
     }
 }

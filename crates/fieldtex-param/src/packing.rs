@@ -32,6 +32,7 @@ use crate::ParamError;
 use crate::chart_footprint::{Footprint, Grown};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::collections::HashMap;
 
 /// A chart ready for packing: 2-D points in any unit and triangles indexing them.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -163,20 +164,30 @@ impl Grid {
         self.max_free[y] = best;
     }
 
+    /// Rows an offset of a footprint `fh` texels tall may take, at least `oy_min` and at
+    /// most `oy_max`.
+    fn offset_rows(&self, fh: i64, oy_min: i64, oy_max: i64) -> (i64, i64) {
+        (self.margin.max(oy_min), (self.height - self.margin - fh).min(oy_max))
+    }
+
     /// Lowest-then-leftmost offset where `grown` (of a `fw × fh` footprint) fits, with
-    /// the offset's row at most `oy_max`.
-    fn find(&self, grown: &Grown, fw: i64, fh: i64, oy_max: i64) -> Option<(i64, i64)> {
+    /// the offset's row between `oy_min` and `oy_max`.
+    fn find(
+        &self,
+        grown: &Grown,
+        fw: i64,
+        fh: i64,
+        oy_min: i64,
+        oy_max: i64,
+    ) -> Option<(i64, i64)> {
         let (ox_lo, ox_hi) = (self.margin, self.size - self.margin - fw);
-        let (oy_lo, oy_hi) = (self.margin, (self.height - self.margin - fh).min(oy_max));
+        let (oy_lo, oy_hi) = self.offset_rows(fh, oy_min, oy_max);
         if ox_lo > ox_hi || oy_lo > oy_hi {
             return None;
         }
         let nrows = grown.rows.len() as i64;
-        // Widest rows first: in a fragmented atlas they are the likeliest to fail.
-        let mut by_need: Vec<i64> = (0..nrows).collect();
-        by_need.sort_by_key(|&r| (std::cmp::Reverse(grown.need[r as usize]), r));
-        let mut feasible: Vec<(i64, i64)> = Vec::new();
-        let mut scratch: Vec<(i64, i64)> = Vec::new();
+        let mut feasible: Vec<(i64, i64)> = Vec::with_capacity(16);
+        let mut scratch: Vec<(i64, i64)> = Vec::with_capacity(16);
         // Atlas row where the last test failed: the obstacle there usually blocks the
         // next offset too, one chart row lower.
         let mut hint_y = i64::MIN;
@@ -191,8 +202,9 @@ impl Grid {
             // Rows in any order give the same set; start at the last obstacle.
             let r0 = hint_y - (oy + grown.y0);
             let first = if (0..nrows).contains(&r0) { Some(r0) } else { None };
-            for r in first.into_iter().chain(by_need.iter().copied().filter(|&r| Some(r) != first))
-            {
+            // Then the widest rows: in a fragmented atlas they are the likeliest to fail.
+            let widest = grown.by_need.iter().map(|&r| r as i64).filter(|&r| Some(r) != first);
+            for r in first.into_iter().chain(widest) {
                 let y = oy + grown.y0 + r;
                 if y < 0 || y >= self.height {
                     continue;
@@ -284,6 +296,14 @@ fn try_pack(
         charts.len()
     ];
     let mut top = 0;
+    // Occupancy only grows, so a footprint that did not fit below some row never will:
+    // remember, per footprint shape, the lowest row still worth testing. Every chart
+    // contains a texel of its bottom row, so no chart fits below the lowest row where a
+    // single grown texel fits (`floor`).
+    let mut lowest: HashMap<Footprint, (std::rc::Rc<Grown>, i64)> = HashMap::new();
+    let probe = Footprint::single();
+    let probe_grown = probe.grow(g);
+    let mut floor = 0;
     for &c in order {
         let ch = &charts[c];
         let base = Footprint::rasterize(
@@ -303,8 +323,20 @@ fn try_pack(
             }
             // Only rows that could beat the best top edge so far.
             let oy_max = best.as_ref().map_or(i64::MAX, |(bk, _)| bk.0 - fp.h);
-            let grown = fp.grow(g);
-            if let Some((ox, oy)) = grid.find(&grown, fp.w, fp.h, oy_max) {
+            let (grown, seen) = match lowest.get(&fp) {
+                Some((gr, row)) => (gr.clone(), *row),
+                None => (std::rc::Rc::new(fp.grow(g)), 0),
+            };
+            let oy_min = floor.max(seen);
+            let (lo, hi) = grid.offset_rows(fp.h, oy_min, oy_max);
+            let found = grid.find(&grown, fp.w, fp.h, oy_min, oy_max);
+            let next = match found {
+                Some((_, oy)) => oy,
+                None if lo <= hi => hi + 1,
+                None => seen,
+            };
+            lowest.insert(fp.clone(), (grown, next));
+            if let Some((ox, oy)) = found {
                 let key = (oy + fp.h, oy, ox, k as u8);
                 if best.as_ref().is_none_or(|(bk, _)| key < *bk) {
                     best = Some((key, fp.clone()));
@@ -314,6 +346,7 @@ fn try_pack(
         let ((t, oy, ox, k), f) = best?;
         grid.place(&f, ox, oy);
         top = top.max(t);
+        floor = grid.find(&probe_grown, 1, 1, floor, i64::MAX).map_or(grid.height, |(_, y)| y);
         out[c] =
             Placement { offset: [ox, oy], rotation: k, origin: origins[c], size: [base.w, base.h] };
     }
