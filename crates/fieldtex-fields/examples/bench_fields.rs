@@ -13,6 +13,7 @@
 //!   removed again untimed (downdates);
 //! - `field_add_stroke_refactor`: the same with `rank1_update_limit = 0` (numeric
 //!   refactorisation with the kept symbolic analysis);
+//! - `field_add_short_stroke`: a ~40 px stroke (a few dozen edges: rank-1 updates);
 //! - `field_numeric_refactor`: the numeric factorisation alone;
 //! - `field_move_singularity_solve_only` / `field_sample_512`: the move split into
 //!   re-solve and pixel sampling.
@@ -121,6 +122,24 @@ fn main() {
         d.remove_stroke(sid).unwrap();
         d.refactor_if_needed().unwrap();
     }
+    // A short stroke (~40 px, a few dozen edges): rank-1 updates instead of a refactor.
+    let mut t_short = Vec::new();
+    let updates_short = d.rank1_update_count();
+    for k in 0..repeats {
+        let y = 150.0 + 10.0 * k as f64;
+        let t = Instant::now();
+        let sid = d.add_stroke(Stroke::from_pixels(&[[60.0, y], [100.0, y - 6.0]])).unwrap();
+        let f = d.solve().unwrap();
+        let px = sample_plane(&d, &f, size, size).unwrap();
+        t_short.push(ms(t));
+        assert_eq!(px.len(), size * size);
+        d.remove_stroke(sid).unwrap();
+        d.refactor_if_needed().unwrap();
+    }
+    println!(
+        "info: short strokes: {} rank-1 updates for {repeats} additions + removals",
+        d.rank1_update_count() - updates_short
+    );
     println!(
         "info: {} rank-1 updates for {repeats} stroke additions + removals, {} refactorisations in all",
         d.rank1_update_count() - updates_before,
@@ -162,5 +181,6 @@ fn main() {
     println!("BENCH field_sample_512 median_ms={:.2}", median(t_sample));
     println!("BENCH field_add_stroke median_ms={:.2}", median(t_stroke));
     println!("BENCH field_add_stroke_refactor median_ms={:.2}", median(t_stroke_refactor));
+    println!("BENCH field_add_short_stroke median_ms={:.2}", median(t_short));
     println!("BENCH field_numeric_refactor median_ms={:.2}", median(t_refactor));
 }

@@ -44,13 +44,14 @@
 //! solve factors it. Strokes change the diagonal of `A` by `Σ Δw_e e_e e_eᵀ`: small edits
 //! are rank-1 updates/downdates of the factor, larger ones a numeric refactorisation with
 //! the kept symbolic analysis ([`FieldDesign::refactor_if_needed`]; measured in
-//! `examples/bench_fields.rs`: a typical stroke touches ~240 edges, about break-even).
+//! `examples/bench_fields.rs`: one update ~1 ms, a refactorisation ~75–140 ms, a typical
+//! stroke ~240 edges — so only short strokes are updated).
 
 use std::sync::Arc;
 
 use fieldtex_core::Warnings;
 use fieldtex_core::vec3::{add, scale};
-use fieldtex_linalg::{Cholesky, SparseMatrix, SymbolicCholesky, UpdateSign};
+use fieldtex_linalg::{Cholesky, CholeskyOptions, SparseMatrix, SymbolicCholesky, UpdateSign};
 use fieldtex_mesh::TriMesh;
 
 use crate::FieldsError;
@@ -510,7 +511,12 @@ impl FieldDesign {
             }
         }
         let a = self.equations.matrix.add_diagonal(&d);
-        self.factor = Some(Cholesky::factor_with(&self.symbolic, &a)?);
+        // Stroke weights are of the order of the matrix diagonal (not 1e8 penalties), so a
+        // downdate loses nothing measurable: skip the forced refinement step after one;
+        // every solve still checks its residual and refines above 1e-11.
+        let options =
+            CholeskyOptions { refine_after_downdate: false, ..CholeskyOptions::default() };
+        self.factor = Some(Cholesky::factor_with(&self.symbolic, &a)?.with_options(options));
         self.factored_stroke_diag = d;
         self.refactor_count += 1;
         self.updates_since_factor = 0;

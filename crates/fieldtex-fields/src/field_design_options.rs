@@ -33,9 +33,10 @@ pub struct FieldDesignOptions {
     /// How singularities enter. Default [`SingularityModel::ModelField`].
     pub singularity_model: SingularityModel,
     /// Stroke edits touching at most this many edges update the factorisation by rank-1
-    /// updates instead of refactoring (0: always refactor). Default 100: on the 128² grid
-    /// one update costs about 1/250 of a numeric factorisation (bench_fields), and
-    /// solves after downdates take an extra refinement step.
+    /// updates instead of refactoring (0: always refactor). Default 32: on the 128² grid
+    /// (49K unknowns) one update cost ~1 ms against ~75–140 ms for a numeric
+    /// refactorisation on 2 loaded cores (`examples/bench_fields.rs`), so updates only
+    /// pay for short strokes (a typical stroke touches ~240 edges).
     pub rank1_update_limit: usize,
 }
 
@@ -48,7 +49,7 @@ impl Default for FieldDesignOptions {
             stroke_weight: 4.0,
             regularization: 1e-6,
             singularity_model: SingularityModel::ModelField,
-            rank1_update_limit: 100,
+            rank1_update_limit: 32,
         }
     }
 }
