@@ -22,10 +22,11 @@ use crate::packing::{PackChart, PackingOptions, pack_charts};
 use fieldtex_core::{Progress, Warning, Warnings};
 use fieldtex_mesh::{CornerUvs, MeshError, TriMesh};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Options of [`build_atlas`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct AtlasOptions {
     /// Atlas width and height in texels. Default 1024.
     pub resolution: u32,
@@ -48,8 +49,9 @@ impl Default for AtlasOptions {
     }
 }
 
-/// Quality of an atlas (DESIGN.md §6).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// Quality of an atlas (DESIGN.md §6). The distortion fields are NaN when no triangle
+/// has a non-zero area.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AtlasStats {
     /// Number of charts.
     pub charts: usize,

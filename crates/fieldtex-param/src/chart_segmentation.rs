@@ -40,12 +40,13 @@ use crate::chart_merging::merge_small_charts;
 use crate::chart_topology::{ChartMesh, split_in_two};
 use crate::face_graph::{FaceGraph, NONE};
 use fieldtex_core::vec3::{self, V3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// Options of [`segment_charts`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct SegmentationOptions {
     /// Largest angle in degrees between a triangle's normal and its chart's normal
     /// while growing. Default 70.

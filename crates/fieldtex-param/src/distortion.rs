@@ -15,10 +15,10 @@
 use crate::ParamError;
 use fieldtex_core::vec3;
 use fieldtex_mesh::TriMesh;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Summary of [`parameterization_distortion`].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DistortionStats {
     /// Area-weighted mean of `σ1/σ2`.
     pub angle_mean: f64,

@@ -31,7 +31,7 @@
 use crate::ParamError;
 use crate::chart_footprint::{Footprint, Grown};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// A chart ready for packing: 2-D points in any unit and triangles indexing them.
@@ -42,7 +42,8 @@ pub struct PackChart {
 }
 
 /// Options of [`pack_charts`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct PackingOptions {
     /// Atlas width and height in texels. Default 1024.
     pub resolution: u32,
