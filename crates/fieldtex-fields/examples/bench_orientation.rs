@@ -257,8 +257,7 @@ fn main() {
         }
     }
     let refactor_ms = median(refactor);
-    let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let chi = fieldtex_fields::surface_field_metrics::euler_characteristic(&mesh, &topo);
+    let chi = m.euler_characteristic;
     println!(
         "INFO steps={} constrained_vertices={constrained} first_factor_ms={factor_ms:.1} solve_median_ms={solve_ms:.2} \
          rank1_update_ms={per_rank1:.3} max_residual={:.1e} updated_vs_refactored_rel_diff={rel_diff:.1e}",

@@ -40,6 +40,7 @@ use fieldtex_core::{Progress, Warning};
 use fieldtex_mesh::TriMesh;
 use rand::RngExt;
 use rayon::prelude::*;
+use serde::Serialize;
 
 use crate::FieldsError;
 use crate::harmonic_diffusion::{
@@ -47,7 +48,7 @@ use crate::harmonic_diffusion::{
 };
 
 /// Eq. (1) for both orientations of one curve.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct OrientationScore {
     /// `Σ (π − θ)/(π + θ)`: consistency of the forward orientation.
     pub forward: f64,
@@ -91,7 +92,7 @@ pub fn orientation_score(tangents: &[V3], field: impl Fn(usize) -> Option<V3>) -
 }
 
 /// How curve orientations are chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 pub enum OrientationMode {
     /// Paper A §4.1 (module docs). Default.
     #[default]
@@ -101,7 +102,7 @@ pub enum OrientationMode {
 }
 
 /// Options of [`orient_curves`].
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct CurveOrientationOptions {
     /// Default [`OrientationMode::Greedy`].
     pub mode: OrientationMode,
@@ -118,7 +119,7 @@ pub struct CurveOrientationOptions {
 
 /// One orientation step (greedy), or the single step of the arbitrary mode
 /// (`curve = usize::MAX`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct OrientationStep {
     /// Input index of the curve oriented in this step.
     pub curve: usize,

@@ -46,6 +46,7 @@ use fieldtex_mesh::{
     CotanOptions, CurvatureOptions, MeshError, NormalWeighting, TriMesh, UnionFind,
     cotan_laplacian_with, principal_curvatures, vertex_normals,
 };
+use serde::Serialize;
 
 use crate::FieldsError;
 
@@ -53,7 +54,7 @@ use crate::FieldsError;
 const NONE: u32 = u32::MAX;
 
 /// What to do at a vertex that a second curve also constrains (module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 pub enum OverlapPolicy {
     /// Keep the tangent of the curve added first. Default.
     #[default]
@@ -63,7 +64,7 @@ pub enum OverlapPolicy {
 }
 
 /// Field of a connected component that no curve touches.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 pub enum UnconstrainedFallback {
     /// Direction of maximal principal curvature (Rusinkiewicz 2004 estimate; a line
     /// field, its sign is arbitrary). Default.
@@ -74,7 +75,7 @@ pub enum UnconstrainedFallback {
 }
 
 /// Options of [`CurveFieldSolver`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CurveFieldOptions {
     /// Penalty weight `α` of eq. (2). Default `1e8` (paper A). Must be finite and `> 0`.
     pub penalty: f64,
@@ -130,7 +131,7 @@ pub struct CurveConstraints {
 }
 
 /// How a vertex of a solved field was obtained.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum VertexFieldStatus {
     /// Diffused from the constraints of its component.
     Solved,
@@ -151,7 +152,7 @@ pub struct CurveField {
 }
 
 /// Cost of one [`CurveFieldSolver::add_constraints`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct AddReport {
     /// Vertices that received a penalty now.
     pub new_vertices: usize,
@@ -166,7 +167,7 @@ pub struct AddReport {
 }
 
 /// Cost and accuracy of one [`CurveFieldSolver::solve`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct SolveReport {
     /// Components re-solved (only those whose constraints changed).
     pub components_solved: usize,

@@ -35,11 +35,12 @@ use fieldtex_mesh::{
     CotanOptions, NormalWeighting, Topology, TriMesh, cotan_edge_weights, vertex_normals,
 };
 use rayon::prelude::*;
+use serde::Serialize;
 
 use crate::FieldsError;
 
 /// A face whose field index is not zero.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct FieldSingularity {
     pub face: usize,
     pub index: i32,
@@ -48,7 +49,7 @@ pub struct FieldSingularity {
 }
 
 /// Mean and largest angle between the field and constraint tangents.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct AlignmentError {
     pub mean_deg: f64,
     pub max_deg: f64,
@@ -57,11 +58,13 @@ pub struct AlignmentError {
 }
 
 /// All field quality measures of [`surface_field_metrics`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SurfaceFieldMetrics {
     pub singularities: Vec<FieldSingularity>,
     /// Sum of all face indices (`χ` for a closed surface when no face is undetermined).
     pub index_sum: i32,
+    /// `χ = V − E + F` of the mesh (used vertices only), to compare with `index_sum`.
+    pub euler_characteristic: i64,
     /// Faces without an index (a zero vector at a corner, opposite normals).
     pub undetermined_faces: usize,
     /// Transported Dirichlet energy (module docs).
@@ -349,6 +352,7 @@ pub fn surface_field_metrics(
         field_dirichlet_energy(mesh, &topology, &normals, field, &weights);
     Ok(SurfaceFieldMetrics {
         index_sum: singularities.iter().map(|s| s.index).sum(),
+        euler_characteristic: euler_characteristic(mesh, &topology),
         singularities,
         undetermined_faces,
         dirichlet_energy,

@@ -134,6 +134,7 @@ fn check_index_sum(mesh: &TriMesh, field: &[V3], chi: i32, what: &str) -> usize 
     let m = surface_field_metrics(mesh, field, &[]).unwrap();
     assert_eq!(m.undetermined_faces, 0, "{what}: undetermined faces");
     assert_eq!(m.index_sum, chi, "{what}: index sum {} (χ = {chi})", m.index_sum);
+    assert_eq!(m.euler_characteristic, i64::from(chi), "{what}");
     m.singularities.len()
 }
 
