@@ -35,6 +35,12 @@
 //! `b = w_s (Dᵀ⋆0⁻¹ S + d1ᵀ⋆2 C) − w_s β B ω* + ε diag ω* + (w_e t_e)` — the paper's
 //! `∗dS + ∗δC + ZᵀWU_Z` plus the two deviation terms (`ω* = 0` for `PointDelta` poles).
 //!
+//! Extra singularities: the model fields superpose, so where they cancel a zero appears —
+//! two poles side by side always have a saddle between them (as two sources do), and
+//! orientation designs with mutually inconsistent rotations can grow extra ±1/2 pairs;
+//! rotations from [`crate::zero_pole_angles`] avoid the latter (paper D, §5, notes the
+//! same limitation).
+//!
 //! Singularities enter only `b`. Deviation from the paper: there, a trisector is built
 //! from direction constraints on a vertex one-ring, which changes `A`; here every
 //! singularity keeps `A` fixed, so moving any singularity is one back-substitution (its

@@ -147,3 +147,47 @@ fn wedge_and_trisector_have_their_rotation() {
         }
     }
 }
+
+#[test]
+fn vector_singularities_on_the_plane() {
+    // Two designs whose model fields force no extra zeros: a source–sink dipole and a
+    // vortex–saddle pair. (Two poles side by side always have a saddle between them.)
+    let designs = [
+        vec![
+            Singularity::at_pixel(SingularityKind::Source, 80.3, 120.6),
+            Singularity::at_pixel(SingularityKind::Sink, 170.4, 140.8),
+        ],
+        vec![
+            Singularity::at_pixel(SingularityKind::Vortex, 90.2, 90.9),
+            Singularity::at_pixel(SingularityKind::Saddle, 160.7, 170.1).with_angle(0.3),
+        ],
+    ];
+    for designed in designs {
+        let mut d = FieldDesign::new(
+            Domain::Plane(PlaneGrid::with_cells(256.0, 256.0, 64)),
+            Symmetry::Vector,
+            FieldDesignOptions::default(),
+        )
+        .unwrap();
+        for s in &designed {
+            d.add_singularity(*s).unwrap();
+        }
+        let f = d.solve().unwrap();
+        let px = sample_plane(&d, &f, 256, 256).unwrap();
+        let found = detect_pixel_singularities(&px, 256, 256, Symmetry::Vector, 6.0).unwrap();
+        assert_matches(&found, &designed, 4.0, "vector design");
+        // Directions next to each singularity: a source points away, a sink towards it, a
+        // positive vortex turns from +x towards +y (clockwise on screen, y down).
+        let at = |x: f64, y: f64| px[y as usize * 256 + x as usize];
+        for s in &designed {
+            let v = at(s.position[0] + 10.0, s.position[1]);
+            match s.kind {
+                SingularityKind::Source => assert!(v[0] > 0.9, "source: {v:?}"),
+                SingularityKind::Sink => assert!(v[0] < -0.9, "sink: {v:?}"),
+                SingularityKind::Vortex => assert!(v[1] > 0.9, "vortex: {v:?}"),
+                // Saddle e^{−i(θ+α)}: at θ = 0 the direction is −α.
+                _ => assert!(((v[1] as f64).atan2(v[0] as f64) + 0.3).abs() < 0.1, "saddle: {v:?}"),
+            }
+        }
+    }
+}
