@@ -26,7 +26,7 @@ use crate::SynthError;
 use crate::exemplar_analysis::APPEARANCE_DIMS;
 
 /// Samples used to fit the PCA basis at most (rows are taken with a fixed stride).
-const MAX_PCA_SAMPLES: usize = 32_768;
+const MAX_PCA_SAMPLES: usize = 8_192;
 const NEIGHBOURHOOD_DIMS: usize = 75;
 
 /// Appearance vectors of one stack level: `width × height` entries each, row-major.
@@ -55,11 +55,13 @@ fn neighbourhood(l: Level<'_>, x: usize, y: usize, rotated: bool, out: &mut [f32
     let Level { stack, width, height, spacing } = l;
     let s = spacing as i64;
     let sign = if rotated { -1 } else { 1 };
+    let xs: [usize; 5] = std::array::from_fn(|i| {
+        (x as i64 + sign * (i as i64 - 2) * s).rem_euclid(width as i64) as usize
+    });
     let mut k = 0;
     for j in -2i64..=2 {
         let yy = (y as i64 + sign * j * s).rem_euclid(height as i64) as usize;
-        for i in -2i64..=2 {
-            let xx = (x as i64 + sign * i * s).rem_euclid(width as i64) as usize;
+        for &xx in &xs {
             out[k..k + 3].copy_from_slice(&stack[yy * width + xx]);
             k += 3;
         }
@@ -99,13 +101,31 @@ pub fn appearance_space(
     let kept: f64 = pca.variances.iter().sum();
     let explained_variance = if total > 0.0 { (kept / total).min(1.0) } else { 1.0 };
 
+    // Projection in f32 with the mean folded into an offset per component.
+    // Transposed: `comps[i][c]` = weight of input dimension i in component c.
+    let comps: Vec<[f32; APPEARANCE_DIMS]> = (0..NEIGHBOURHOOD_DIMS)
+        .map(|i| std::array::from_fn(|c| pca.components[c][i] as f32))
+        .collect();
+    let offsets: Vec<f32> = pca
+        .components
+        .iter()
+        .map(|c| c.iter().zip(&pca.mean).map(|(a, m)| a * m).sum::<f64>() as f32)
+        .collect();
     let project_all = |rotated: bool| -> Vec<[f32; APPEARANCE_DIMS]> {
         let mut out = vec![[0.0f32; APPEARANCE_DIMS]; n];
         out.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
             let mut buf = [0.0f32; NEIGHBOURHOOD_DIMS];
             for (x, o) in row.iter_mut().enumerate() {
                 neighbourhood(lv, x, y, rotated, &mut buf);
-                pca.project(&buf, o);
+                let mut acc = [0.0f32; APPEARANCE_DIMS];
+                for (a, row) in buf.iter().zip(&comps) {
+                    for (oc, w) in acc.iter_mut().zip(row) {
+                        *oc += a * w;
+                    }
+                }
+                for ((oc, a), off) in o.iter_mut().zip(&acc).zip(&offsets) {
+                    *oc = a - off;
+                }
             }
         });
         out

@@ -4,7 +4,8 @@
 //! Per Gaussian-stack level `c` (finest `c = 0`, spacing `h = 2^c`, `L = ⌈log₂ max(W,
 //! H)⌉` levels; Lefebvre & Hoppe 2005 §3.1): the stack image, the 8-D appearance vectors
 //! of the exemplar and of its 180° rotation (Lefebvre & Hoppe 2006 §3; paper D §4, see
-//! [`crate::appearance_space`]) and the k-coherence sets ([`crate::k_coherence`]).
+//! [`crate::appearance_space`]), 8-bit copies of both for the synthesis, and the
+//! k-coherence sets ([`crate::k_coherence`]).
 
 use std::time::Instant;
 
@@ -31,6 +32,14 @@ pub struct AnalysisOptions {
     /// (Chebyshev, toroidal); level `c` uses `max(radius, 2^c)` capped at a quarter of
     /// the shorter exemplar side. Default 3.
     pub coherence_radius: usize,
+    /// Pixels each k-coherence query examines at most (see [`crate::k_coherence`]);
+    /// `usize::MAX` makes the search exact. Default 256.
+    pub coherence_scan: usize,
+    /// Whether the exemplar tiles seamlessly. When false (the default: most photos do
+    /// not tile), level `c` keeps synthesised coordinates at least
+    /// `min(2^(c+1), min(W, H) / 8)` pixels from the exemplar border
+    /// ([`AnalysisLevel::margin`]), so the exemplar's edges never show as seams.
+    pub tileable: bool,
     /// Largest accepted exemplar side; larger exemplars are refused with
     /// [`SynthError::ExemplarTooLarge`]. Default 1024.
     pub max_size: usize,
@@ -38,7 +47,7 @@ pub struct AnalysisOptions {
 
 impl Default for AnalysisOptions {
     fn default() -> Self {
-        Self { k: 2, coherence_radius: 3, max_size: 1024 }
+        Self { k: 2, coherence_radius: 3, coherence_scan: 256, tileable: false, max_size: 1024 }
     }
 }
 
@@ -47,6 +56,8 @@ impl Default for AnalysisOptions {
 pub struct AnalysisLevel {
     /// Sampling spacing `h = 2^c` of the level, exemplar pixels.
     pub spacing: usize,
+    /// Border band (pixels) the synthesis avoids at this level; 0 for tileable exemplars.
+    pub margin: usize,
     /// Appearance of each pixel (`W × H`), unrotated exemplar (`Ẽ₀`).
     pub appearance: Vec<[f32; APPEARANCE_DIMS]>,
     /// Appearance of each pixel's 180°-rotated neighbourhood (`Ẽ₁`), at the unrotated
@@ -56,6 +67,28 @@ pub struct AnalysisLevel {
     pub coherence: Vec<u32>,
     /// Share of the 5×5-neighbourhood variance kept by the 8 components.
     pub explained_variance: f64,
+    /// `[appearance, appearance_rotated]` quantised to 8 bits (what the synthesis reads:
+    /// 8 bytes per vector keep its random lookups in cache).
+    pub appearance_q: QuantizedVectors,
+}
+
+/// Two sets of 8-D vectors quantised with one common scale: `value ≈ q / scale`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct QuantizedVectors {
+    pub scale: f32,
+    pub data: [Vec<[i8; APPEARANCE_DIMS]>; 2],
+}
+
+impl QuantizedVectors {
+    /// Quantises `a` and `b` with the scale `127 / max |component|` (1 if all zero).
+    pub fn new(a: &[[f32; APPEARANCE_DIMS]], b: &[[f32; APPEARANCE_DIMS]]) -> Self {
+        let max = a.iter().chain(b).flatten().fold(0.0f32, |m, v| m.max(v.abs()));
+        let scale = if max > 0.0 { 127.0 / max } else { 1.0 };
+        let q = |v: &[[f32; APPEARANCE_DIMS]]| -> Vec<[i8; APPEARANCE_DIMS]> {
+            v.iter().map(|x| x.map(|c| (c * scale).round().clamp(-127.0, 127.0) as i8)).collect()
+        };
+        Self { scale, data: [q(a), q(b)] }
+    }
 }
 
 /// The exemplar and its per-level analysis.
@@ -121,9 +154,23 @@ impl ExemplarAnalysis {
             let spacing = 1usize << c;
             let space = appearance_space(level_img, width, height, spacing, c)?;
             let radius = options.coherence_radius.max(spacing).min(width.min(height) / 4).max(1);
-            let coherence = k_coherence(&space.unrotated, width, height, options.k, radius);
+            let margin =
+                if options.tileable { 0 } else { (2 * spacing).min(width.min(height) / 8).max(1) };
+            let coherence = k_coherence(
+                &space.unrotated,
+                width,
+                height,
+                options.k,
+                radius,
+                options.coherence_scan,
+                margin,
+            );
+            let appearance_q = QuantizedVectors::new(&space.unrotated, &space.rotated);
             levels.push(AnalysisLevel {
                 spacing,
+                margin,
+                appearance_q,
+
                 appearance: space.unrotated,
                 appearance_rotated: space.rotated,
                 coherence,

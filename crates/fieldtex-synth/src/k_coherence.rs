@@ -5,37 +5,46 @@
 //! within toroidal Chebyshev distance `< radius` of `u` so that the candidates point
 //! to *other* places of the exemplar. Ties are broken by the smaller pixel index.
 //!
-//! The search is exact: pixels are sorted by their first principal component and each
-//! query scans outward in that order, stopping once the gap in the first component
-//! alone exceeds the current k-th best distance. Each query is independent, so the
-//! result does not depend on the thread count.
+//! Pixels are sorted by their first principal component (the direction of largest
+//! appearance variance) and each query examines the `max_scan` pixels nearest to it in
+//! that order (all pixels when `max_scan ≥ W·H`, which makes the search exact). This is
+//! the "coarse PCA-1 window" approximation: candidates far away in the first component
+//! are far in appearance. Each query is independent, so the result does not depend on
+//! the thread count.
 
 use rayon::prelude::*;
 
 use crate::exemplar_analysis::APPEARANCE_DIMS;
 
+/// Squared distance of two appearance vectors, summed in a fixed lane order (SIMD
+/// friendly and deterministic).
 #[inline]
-fn dist2(a: &[f32; APPEARANCE_DIMS], b: &[f32; APPEARANCE_DIMS]) -> f32 {
-    let mut s = 0.0f32;
-    for i in 0..APPEARANCE_DIMS {
-        let d = a[i] - b[i];
-        s += d * d;
+pub(crate) fn dist2(a: &[f32; APPEARANCE_DIMS], b: &[f32; APPEARANCE_DIMS]) -> f32 {
+    let mut l = [0.0f32; 4];
+    for i in 0..4 {
+        let d0 = a[i] - b[i];
+        let d1 = a[i + 4] - b[i + 4];
+        l[i] = d0 * d0 + d1 * d1;
     }
-    s
+    (l[0] + l[1]) + (l[2] + l[3])
 }
 
 /// The `k` most similar pixels of every pixel of the `width × height` appearance image
-/// `app`: `width × height × k` pixel indices, row-major, best first. A pixel with fewer
-/// than `k` eligible partners (tiny exemplars) repeats its best one, or itself.
+/// `app`: `width × height × k` pixel indices, row-major, best first. Only pixels at
+/// least `margin` pixels from the border are eligible partners (0: all). A pixel with
+/// fewer than `k` eligible partners (tiny exemplars) repeats its best one, or itself.
 pub fn k_coherence(
     app: &[[f32; APPEARANCE_DIMS]],
     width: usize,
     height: usize,
     k: usize,
     radius: usize,
+    max_scan: usize,
+    margin: usize,
 ) -> Vec<u32> {
     let n = width * height;
     assert_eq!(app.len(), n, "k_coherence: app must hold width × height vectors");
+    assert!(k <= 16, "k_coherence: k must be at most 16");
     if k == 0 {
         return Vec::new();
     }
@@ -45,58 +54,58 @@ pub fn k_coherence(
     for (r, &i) in order.iter().enumerate() {
         rank[i as usize] = r;
     }
-    let key: Vec<f32> = order.iter().map(|&i| app[i as usize][0]).collect();
-    let far = |a: usize, b: usize| -> bool {
-        let (ax, ay) = ((a % width) as i64, (a / width) as i64);
-        let (bx, by) = ((b % width) as i64, (b / width) as i64);
-        let dx = (ax - bx).rem_euclid(width as i64);
-        let dy = (ay - by).rem_euclid(height as i64);
-        let dx = dx.min(width as i64 - dx);
-        let dy = dy.min(height as i64 - dy);
-        dx.max(dy) >= radius as i64
-    };
+    // The appearance vectors and pixel positions in sort order, for sequential scans.
+    let sorted: Vec<[f32; APPEARANCE_DIMS]> = order.iter().map(|&i| app[i as usize]).collect();
+    let pos: Vec<[i32; 2]> =
+        order.iter().map(|&i| [(i as usize % width) as i32, (i as usize / width) as i32]).collect();
+    let (wi, he, ri) = (width as i32, height as i32, radius as i32);
+    let mi = margin as i32;
+    let inside = |p: [i32; 2]| p[0] >= mi && p[1] >= mi && p[0] < wi - mi && p[1] < he - mi;
+    let window = max_scan.min(n);
     let mut out = vec![0u32; n * k];
-    out.par_chunks_mut(k).enumerate().for_each(|(i, slot)| {
-        // Sorted list of the best (distance, index), ascending.
-        let mut best: Vec<(f32, u32)> = Vec::with_capacity(k + 1);
-        let q = &app[i];
-        let worst =
-            |best: &Vec<(f32, u32)>| if best.len() < k { f32::INFINITY } else { best[k - 1].0 };
-        let consider = |j: u32, best: &mut Vec<(f32, u32)>| {
-            if !far(i, j as usize) {
-                return;
+    out.par_chunks_mut(k).enumerate().for_each_init(
+        || vec![0.0f32; window],
+        |dists, (i, slot)| {
+            let r = rank[i];
+            let q = sorted[r];
+            let qp = pos[r];
+            // A window of `max_scan` pixels around the query in sort order.
+            let lo = r.saturating_sub(window / 2).min(n - window);
+            // Pass 1: all distances (branch-free, vectorisable).
+            for (d, v) in dists.iter_mut().zip(&sorted[lo..lo + window]) {
+                *d = dist2(&q, v);
             }
-            let d = dist2(q, &app[j as usize]);
-            if best.len() == k && (d, j) >= best[k - 1] {
-                return;
+            // Pass 2: the k best eligible (distance, pixel), ascending.
+            let mut best = [(f32::INFINITY, u32::MAX); 16];
+            let best = &mut best[..k];
+            for (o, &d) in dists.iter().enumerate() {
+                if d > best[k - 1].0 {
+                    continue;
+                }
+                let t = lo + o;
+                let j = order[t];
+                if t == r || (d == best[k - 1].0 && j >= best[k - 1].1) {
+                    continue;
+                }
+                let dx = (pos[t][0] - qp[0]).abs();
+                let dy = (pos[t][1] - qp[1]).abs();
+                if dx.min(wi - dx).max(dy.min(he - dy)) < ri || !inside(pos[t]) {
+                    continue;
+                }
+                let mut at = k - 1;
+                while at > 0 && (d < best[at - 1].0 || (d == best[at - 1].0 && j < best[at - 1].1))
+                {
+                    best[at] = best[at - 1];
+                    at -= 1;
+                }
+                best[at] = (d, j);
             }
-            let pos = best.partition_point(|&e| e < (d, j));
-            best.insert(pos, (d, j));
-            best.truncate(k);
-        };
-        let r = rank[i];
-        let qk = key[r];
-        let (mut up, mut down) = (r + 1, r);
-        loop {
-            let w = worst(&best);
-            let gu = if up < n { (key[up] - qk) * (key[up] - qk) } else { f32::INFINITY };
-            let gd =
-                if down > 0 { (key[down - 1] - qk) * (key[down - 1] - qk) } else { f32::INFINITY };
-            if gu > w && gd > w || (up >= n && down == 0) {
-                break;
+            let first = if best[0].1 == u32::MAX { i as u32 } else { best[0].1 };
+            for (s, b) in slot.iter_mut().zip(best.iter()) {
+                *s = if b.1 == u32::MAX { first } else { b.1 };
             }
-            if gu <= gd {
-                consider(order[up], &mut best);
-                up += 1;
-            } else {
-                down -= 1;
-                consider(order[down], &mut best);
-            }
-        }
-        for (t, s) in slot.iter_mut().enumerate() {
-            *s = best.get(t).or(best.first()).map_or(i as u32, |e| e.1);
-        }
-    });
+        },
+    );
     out
 }
 
@@ -117,7 +126,7 @@ mod tests {
             })
             .collect();
         let (k, radius) = (3, 2);
-        let fast = k_coherence(&app, w, h, k, radius);
+        let fast = k_coherence(&app, w, h, k, radius, usize::MAX, 0);
         for i in 0..w * h {
             let mut all: Vec<(f32, u32)> = (0..(w * h) as u32)
                 .filter(|&j| {

@@ -41,6 +41,10 @@ use rayon::prelude::*;
 
 use crate::domain::check_jacobian;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
+
+/// Corner offsets `Δ` of the four-corner neighbourhood; bit 0 of the index is the x
+/// sign (0 = −1), bit 1 the y sign.
+const CORNERS: [[i32; 2]; 4] = [[-1, -1], [1, -1], [-1, 1], [1, 1]];
 use crate::{SynthError, SynthesisDomain};
 
 /// Options of [`synthesize`].
@@ -94,9 +98,10 @@ pub struct SynthesisResult {
 }
 
 const NONE: u32 = u32::MAX;
+/// Largest k-coherence count the engine uses (the analysis may store more).
+const MAX_K: usize = 8;
 /// Neighbour offsets in angular order (angle `k · 45°` from +x, y down).
 const OFFS8: [[i32; 2]; 8] = [[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1]];
-const CORNERS: [[f32; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [-1.0, 1.0], [1.0, 1.0]];
 
 /// One domain level, tabulated.
 struct LevelTables {
@@ -104,6 +109,20 @@ struct LevelTables {
     jac: Vec<[f32; 4]>,
     classes: Vec<Vec<u32>>,
     parent: Vec<(u32, [f32; 2])>,
+    /// Per sample and corner `Δ`, the neighbour (index into [`OFFS8`]) whose direction is
+    /// closest to the warped corner offset `J⁻¹ Δ`; the corner averages that neighbour's
+    /// prediction and those of its two angular neighbours.
+    corner_dir: Vec<[u8; 4]>,
+}
+
+/// The [`LevelTables::corner_dir`] entry of Jacobian `j`.
+fn corner_directions(j: &[f32; 4]) -> [u8; 4] {
+    let jinv = inverse(j);
+    CORNERS.map(|cd| {
+        let phi = mat_vec(&jinv, [cd[0] as f32, cd[1] as f32]);
+        let oct = (phi[1].atan2(phi[0]) / std::f32::consts::FRAC_PI_4).round() as i32;
+        oct.rem_euclid(8) as u8
+    })
 }
 
 fn tabulate(
@@ -162,10 +181,12 @@ fn tabulate(
         jac: Vec::with_capacity(n),
         classes: vec![Vec::new(); subpasses],
         parent: Vec::with_capacity(n),
+        corner_dir: Vec::with_capacity(n),
     };
     for (i, r) in rows.into_iter().enumerate() {
         let (nb, j, class, parent) = r?;
         t.nbr.push(nb);
+        t.corner_dir.push(corner_directions(&j));
         t.jac.push(j);
         t.classes[class as usize].push(i as u32);
         t.parent.push(parent);
@@ -177,6 +198,19 @@ fn tabulate(
 #[inline]
 fn mat_vec(j: &[f32; 4], v: [f32; 2]) -> [f32; 2] {
     [j[0] * v[0] + j[1] * v[1], j[2] * v[0] + j[3] * v[1]]
+}
+
+/// Squared distance between a quantised vector and a target in quantised units, summed
+/// in a fixed lane order.
+#[inline]
+fn dist_q(a: &[i8; APPEARANCE_DIMS], t: &[f32; APPEARANCE_DIMS]) -> f32 {
+    let mut l = [0.0f32; 4];
+    for i in 0..4 {
+        let d0 = a[i] as f32 - t[i];
+        let d1 = a[i + 4] as f32 - t[i + 4];
+        l[i] = d0 * d0 + d1 * d1;
+    }
+    (l[0] + l[1]) + (l[2] + l[3])
 }
 
 #[inline]
@@ -196,27 +230,90 @@ struct ExemplarLevel<'a> {
     h: usize,
     wf: f32,
     hf: f32,
-    app: [&'a [[f32; APPEARANCE_DIMS]]; 2],
+    /// Quantised appearance `[Ẽ₀, Ẽ₁]`.
+    app: [&'a [[i8; APPEARANCE_DIMS]]; 2],
     coherence: &'a [u32],
     k_store: usize,
+    /// Valid pixel range `[margin, W − margin) × [margin, H − margin)`.
+    x_lo: usize,
+    x_hi: usize,
+    y_lo: usize,
+    y_hi: usize,
+    /// `(x − h) mod W` and `(x + h) mod W` per column; rows likewise (`h` = spacing).
+    cols: Vec<[u32; 2]>,
+    rows: Vec<[u32; 2]>,
 }
 
-impl ExemplarLevel<'_> {
+#[inline]
+fn wrap1(v: f32, size: f32) -> f32 {
+    let r = if v < 0.0 {
+        v + size
+    } else if v >= size {
+        v - size
+    } else {
+        return v;
+    };
+    if (0.0..size).contains(&r) {
+        return r;
+    }
+    let r = v.rem_euclid(size);
+    if r >= size || r.is_nan() { 0.0 } else { r }
+}
+
+impl<'a> ExemplarLevel<'a> {
+    fn new(analysis: &'a ExemplarAnalysis, level: usize) -> Self {
+        let an = analysis.level(level);
+        let (w, h) = (analysis.width(), analysis.height());
+        let sp = an.spacing as i64;
+        let table = |n: usize| -> Vec<[u32; 2]> {
+            (0..n as i64)
+                .map(|i| {
+                    [(i - sp).rem_euclid(n as i64) as u32, (i + sp).rem_euclid(n as i64) as u32]
+                })
+                .collect()
+        };
+        Self {
+            w,
+            h,
+            wf: w as f32,
+            hf: h as f32,
+            app: [&an.appearance_q.data[0], &an.appearance_q.data[1]],
+            coherence: &an.coherence,
+            k_store: analysis.k(),
+            x_lo: an.margin.min(w / 2),
+            x_hi: w - an.margin.min(w / 2),
+            y_lo: an.margin.min(h / 2),
+            y_hi: h - an.margin.min(h / 2),
+            cols: table(w),
+            rows: table(h),
+        }
+    }
+
     #[inline]
     fn wrap(&self, u: [f32; 2]) -> [f32; 2] {
-        let f = |v: f32, s: f32| {
-            let r = v.rem_euclid(s);
-            if r >= s || r.is_nan() { 0.0 } else { r }
-        };
-        [f(u[0], self.wf), f(u[1], self.hf)]
+        [wrap1(u[0], self.wf), wrap1(u[1], self.hf)]
+    }
+
+    /// Column and row of a wrapped coordinate.
+    #[inline]
+    fn cell(&self, u: [f32; 2]) -> (usize, usize) {
+        ((u[0] as usize).min(self.w - 1), (u[1] as usize).min(self.h - 1))
     }
 
     /// Pixel of a wrapped coordinate.
     #[inline]
     fn pixel(&self, u: [f32; 2]) -> usize {
-        let x = (u[0] as usize).min(self.w - 1);
-        let y = (u[1] as usize).min(self.h - 1);
+        let (x, y) = self.cell(u);
         y * self.w + x
+    }
+
+    /// Pixel at corner `c` (index into [`CORNERS`]) of cell `(x, y)`, the corner
+    /// offset `± h` negated when `flip`.
+    #[inline]
+    fn corner(&self, x: usize, y: usize, c: usize, flip: bool) -> usize {
+        let sx = (c & 1) ^ flip as usize;
+        let sy = (c >> 1) ^ flip as usize;
+        self.rows[y][sy] as usize * self.w + self.cols[x][sx] as usize
     }
 }
 
@@ -259,68 +356,73 @@ impl Pass<'_> {
             valid[k] = true;
         }
         // Four-corner neighbourhood of p, averaged over three predictions per corner.
-        let jinv = inverse(&jp);
         let mut target = [[0.0f32; APPEARANCE_DIMS]; 4];
-        let mut weight = [0.0f32; 4];
-        for (ci, cd) in CORNERS.iter().enumerate() {
-            let phi = mat_vec(&jinv, *cd);
-            let oct = (phi[1].atan2(phi[0]) / std::f32::consts::FRAC_PI_4).round() as i32;
+        let mut weight = [false; 4];
+        for (ci, &dir) in self.t.corner_dir[p].iter().enumerate() {
             let mut count = 0.0f32;
-            for t in [oct - 1, oct, oct + 1] {
-                let t = t.rem_euclid(8) as usize;
+            for t in [dir + 7, dir, dir + 1] {
+                let t = (t % 8) as usize;
                 if !valid[t] {
                     continue;
                 }
                 let (u, a, _) = pred[t];
-                let sg = if a { -h } else { h };
-                let look = ex.wrap([u[0] + sg * cd[0], u[1] + sg * cd[1]]);
-                let v = &ex.app[a as usize][ex.pixel(look)];
-                for (o, x) in target[ci].iter_mut().zip(v) {
-                    *o += x;
+                let (x, y) = ex.cell(u);
+                let v = &ex.app[a as usize][ex.corner(x, y, ci, a)];
+                for (o, &x) in target[ci].iter_mut().zip(v) {
+                    *o += x as f32;
                 }
                 count += 1.0;
             }
             if count > 0.0 {
                 let inv = 1.0 / count;
                 target[ci].iter_mut().for_each(|x| *x *= inv);
-                weight[ci] = 1.0;
+                weight[ci] = true;
             }
         }
-        let score = |u: [f32; 2], b: bool| -> f32 {
-            let sg = if b { -h } else { h };
+        // Candidates are compared over the known corners (all four away from the domain
+        // border). The score depends only on the candidate's pixel and flip: each
+        // distinct (pixel, flip) is evaluated once; ties keep the earlier candidate.
+        let mut seen = [(u32::MAX, false); 1 + 8 * (1 + MAX_K)];
+        let mut n_seen = 0usize;
+        let mut best = (s[p], fl[p] && self.rosy);
+        let mut best_d = f32::INFINITY;
+        let mut consider = |u: [f32; 2], b: bool, best: &mut ([f32; 2], bool)| {
+            let (x, y) = ex.cell(u);
+            if x < ex.x_lo || x >= ex.x_hi || y < ex.y_lo || y >= ex.y_hi {
+                return;
+            }
+            let pix = y * ex.w + x;
+            let key = (pix as u32, b);
+            if seen[..n_seen].contains(&key) {
+                return;
+            }
+            seen[n_seen] = key;
+            n_seen += 1;
             let app = ex.app[b as usize];
             let mut total = 0.0f32;
-            for (ci, cd) in CORNERS.iter().enumerate() {
-                if weight[ci] == 0.0 {
-                    continue;
+            for ci in 0..4 {
+                if weight[ci] {
+                    total += dist_q(&app[ex.corner(x, y, ci, b)], &target[ci]);
                 }
-                let v = &app[ex.pixel(ex.wrap([u[0] + sg * cd[0], u[1] + sg * cd[1]]))];
-                let mut d2 = 0.0f32;
-                for (x, y) in v.iter().zip(&target[ci]) {
-                    let e = x - y;
-                    d2 += e * e;
-                }
-                total += d2;
             }
-            total
+            if total < best_d {
+                best_d = total;
+                *best = (u, b);
+            }
         };
-        let mut best = (s[p], fl[p] && self.rosy);
-        let mut best_d = score(best.0, best.1);
+        consider(best.0, best.1, &mut best);
         for k in 0..8 {
             if !valid[k] {
                 continue;
             }
             let (u, a, fq) = pred[k];
-            let d = score(u, a);
-            if d < best_d {
-                best_d = d;
-                best = (u, a);
-            }
+            consider(u, a, &mut best);
             if self.k == 0 {
                 continue;
             }
             let sq = s[nb[k] as usize];
-            let frac = [sq[0] - sq[0].floor(), sq[1] - sq[1].floor()];
+            // Coordinates are wrapped (non-negative): truncation is the floor.
+            let frac = [sq[0] - (sq[0] as u32) as f32, sq[1] - (sq[1] as u32) as f32];
             let base = ex.pixel(sq) * ex.k_store;
             let dd = OFFS8[k];
             let off = mat_vec(&fq, [dd[0] as f32 * h, dd[1] as f32 * h]);
@@ -330,11 +432,7 @@ impl Pass<'_> {
                     (v % ex.w) as f32 + frac[0] - off[0],
                     (v / ex.w) as f32 + frac[1] - off[1],
                 ]);
-                let d = score(c, a);
-                if d < best_d {
-                    best_d = d;
-                    best = (c, a);
-                }
+                consider(c, a, &mut best);
             }
         }
         best
@@ -356,8 +454,12 @@ fn validate(options: &SynthesisOptions, analysis: &ExemplarAnalysis) -> Result<(
             "must be in [0, 4] (fraction of the level spacing)",
         );
     }
-    if options.k > analysis.k() {
-        return bad("k", options.k as f64, "must not exceed the k of the exemplar analysis");
+    if options.k > analysis.k().min(MAX_K) {
+        return bad(
+            "k",
+            options.k as f64,
+            "must not exceed the k of the exemplar analysis (nor 8)",
+        );
     }
     if !(options.scale.is_finite() && options.scale > 0.0) {
         return bad("scale", options.scale as f64, "must be a positive finite number");
@@ -394,13 +496,14 @@ pub fn synthesize(
     // Initialisation level: random coordinates, no flips.
     let mut parent_tables = tabulate(domain, levels, options.scale, 1, false)?;
     let n_init = domain.sample_count(levels);
+    let m = analysis.level(levels - 1).margin.min(w.min(h) / 2) as f64;
     let mut s: Vec<[f32; 2]> = (0..n_init)
         .map(|i| {
             let i = i as u64;
-            [
-                (hash_unit(options.seed, "synthesis-init", 2 * i) * w as f64) as f32 % wf,
-                (hash_unit(options.seed, "synthesis-init", 2 * i + 1) * h as f64) as f32 % hf,
-            ]
+            let ux = m + hash_unit(options.seed, "synthesis-init", 2 * i) * (w as f64 - 2.0 * m);
+            let uy =
+                m + hash_unit(options.seed, "synthesis-init", 2 * i + 1) * (h as f64 - 2.0 * m);
+            [(ux as f32).min(wf.next_down()), (uy as f32).min(hf.next_down())]
         })
         .collect();
     let mut fl = vec![false; n_init];
@@ -410,15 +513,7 @@ pub fn synthesize(
         let start = Instant::now();
         let tables = tabulate(domain, level, options.scale, options.subpasses, true)?;
         let an = analysis.level(level);
-        let ex = ExemplarLevel {
-            w,
-            h,
-            wf,
-            hf,
-            app: [&an.appearance, &an.appearance_rotated],
-            coherence: &an.coherence,
-            k_store: analysis.k(),
-        };
+        let ex = ExemplarLevel::new(analysis, level);
         let spacing = an.spacing as f32;
         let n = tables.jac.len();
         // 1. Upsampling with the parent's effective frame; 2. jitter.
