@@ -2,7 +2,8 @@
 //!
 //! Dart throwing (Cook 1986, "Stochastic sampling in computer graphics"; on surfaces e.g.
 //! Cline, Jeschke, White, Razdan & Wonka 2009): a fixed, dense sequence of uniform
-//! candidates (area-weighted triangle choice, uniform barycentric coordinates) is scanned
+//! candidates (area-weighted triangle choice through Walker's alias table, uniform
+//! barycentric coordinates) is scanned
 //! in order and a candidate is accepted when no accepted sample lies closer than `r`
 //! (Euclidean distance in space, checked exactly through a hash grid with cells of side
 //! `r`). So **every pair of samples is at least `r` apart**, and with the default
@@ -76,11 +77,16 @@ const CHUNK: usize = 4096;
 const CHUNKS_PER_BATCH: usize = 32;
 
 /// Open-addressing hash grid of accepted samples: cell → first sample, `next` links.
+///
+/// Cell coordinates are packed into 21 bits each (wrapping; points of far-apart cells
+/// that share a key only cost a distance test, never a wrong answer), and the slot is a
+/// *linear* function of the cell so that the 27 neighbours of a cell fall on few cache
+/// lines.
 struct HashGrid {
     origin: V3,
     inv_cell: f64,
-    keys: Vec<[i64; 3]>,
-    heads: Vec<u32>,
+    /// `(packed cell key, first sample)`; `EMPTY` heads mark free slots.
+    slots: Vec<(u64, u32)>,
     mask: usize,
     next: Vec<u32>,
     points: Vec<V3>,
@@ -88,8 +94,10 @@ struct HashGrid {
 }
 
 const EMPTY: u32 = u32::MAX;
+const KEY_BITS: u32 = 21;
+const KEY_MASK: i64 = (1 << KEY_BITS) - 1;
 
-/// The 27 cell offsets, the cell itself first.
+/// The 27 cell offsets, the cell itself first, then `x` fastest.
 const NEIGHBOUR_ORDER: [[i64; 3]; 27] = {
     let mut out = [[0i64; 3]; 27];
     let mut k = 1;
@@ -111,8 +119,7 @@ impl HashGrid {
         Self {
             origin,
             inv_cell: 1.0 / cell,
-            keys: vec![[0; 3]; cap],
-            heads: vec![EMPTY; cap],
+            slots: vec![(0, EMPTY); cap],
             mask: cap - 1,
             next: Vec::new(),
             points: Vec::new(),
@@ -126,14 +133,20 @@ impl HashGrid {
     }
 
     #[inline]
-    fn slot(&self, key: [i64; 3]) -> usize {
-        let h = fieldtex_core::rng::mix64(
-            (key[0] as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                ^ (key[1] as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
-                ^ (key[2] as u64).wrapping_mul(0x1656_67B1_9E37_79F9),
-        );
+    fn key(c: [i64; 3]) -> u64 {
+        ((c[0] & KEY_MASK) | (c[1] & KEY_MASK) << KEY_BITS | (c[2] & KEY_MASK) << (2 * KEY_BITS))
+            as u64
+    }
+
+    /// Slot of cell `c`: the one holding its key, or the free slot where it would go.
+    #[inline]
+    fn slot(&self, c: [i64; 3]) -> usize {
+        let key = Self::key(c);
+        let h = (c[0] as u64)
+            .wrapping_add((c[1] as u64).wrapping_mul(0x9E37_79B1))
+            .wrapping_add((c[2] as u64).wrapping_mul(0x85EB_CA77_C2B2_AE63));
         let mut i = h as usize & self.mask;
-        while self.heads[i] != EMPTY && self.keys[i] != key {
+        while self.slots[i].1 != EMPTY && self.slots[i].0 != key {
             i = (i + 1) & self.mask;
         }
         i
@@ -144,7 +157,7 @@ impl HashGrid {
         let c = self.cell(p);
         // Own cell first: near saturation most candidates are rejected there.
         NEIGHBOUR_ORDER.iter().any(|d| {
-            let mut s = self.heads[self.slot([c[0] + d[0], c[1] + d[1], c[2] + d[2]])];
+            let mut s = self.slots[self.slot([c[0] + d[0], c[1] + d[1], c[2] + d[2]])].1;
             while s != EMPTY {
                 if vec3::norm2(vec3::sub(self.points[s as usize], p)) < r2 {
                     return true;
@@ -156,61 +169,104 @@ impl HashGrid {
     }
 
     fn insert(&mut self, p: V3) {
-        if 2 * (self.used + 1) > self.heads.len() {
+        if 2 * (self.used + 1) > self.slots.len() {
             self.grow();
         }
-        let key = self.cell(p);
-        let i = self.slot(key);
-        if self.heads[i] == EMPTY {
-            self.keys[i] = key;
+        let c = self.cell(p);
+        let i = self.slot(c);
+        if self.slots[i].1 == EMPTY {
+            self.slots[i].0 = Self::key(c);
             self.used += 1;
         }
-        self.next.push(self.heads[i]);
-        self.heads[i] = self.points.len() as u32;
+        self.next.push(self.slots[i].1);
+        self.slots[i].1 = self.points.len() as u32;
         self.points.push(p);
     }
 
     fn grow(&mut self) {
-        let cap = 2 * self.heads.len();
-        let (keys, heads) = (std::mem::take(&mut self.keys), std::mem::take(&mut self.heads));
-        self.keys = vec![[0; 3]; cap];
-        self.heads = vec![EMPTY; cap];
-        self.mask = cap - 1;
-        for (k, h) in keys.into_iter().zip(heads) {
-            if h != EMPTY {
-                let i = self.slot(k);
-                self.keys[i] = k;
-                self.heads[i] = h;
+        let old = std::mem::replace(&mut self.slots, vec![(0, EMPTY); 2 * self.mask + 2]);
+        self.mask = self.slots.len() - 1;
+        for (_, head) in old {
+            if head != EMPTY {
+                // Any point of the bucket gives its cell.
+                let i = self.slot(self.cell(self.points[head as usize]));
+                self.slots[i] = (Self::key(self.cell(self.points[head as usize])), head);
             }
         }
+    }
+}
+
+/// Walker's alias table (Vose's construction): `O(1)` area-weighted triangle choice.
+struct AliasTable {
+    prob: Vec<f64>,
+    alias: Vec<u32>,
+}
+
+impl AliasTable {
+    /// Table for non-negative `weights` with a positive sum (deterministic).
+    fn new(weights: &[f64], total: f64) -> Self {
+        let n = weights.len();
+        let mut prob: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
+        let mut alias: Vec<u32> = (0..n as u32).collect();
+        let (mut small, mut large): (Vec<u32>, Vec<u32>) =
+            (0..n as u32).partition(|&i| prob[i as usize] < 1.0);
+        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+            small.pop();
+            alias[s as usize] = l;
+            prob[l as usize] -= 1.0 - prob[s as usize];
+            if prob[l as usize] < 1.0 {
+                large.pop();
+                small.push(l);
+            }
+        }
+        // Leftovers (rounding): keep their own index with certainty, unless they have no
+        // area at all (then defer to a triangle that has some).
+        let fallback = weights.iter().position(|&w| w > 0.0).unwrap_or(0) as u32;
+        for i in small.into_iter().chain(large) {
+            if weights[i as usize] > 0.0 {
+                prob[i as usize] = 1.0;
+            } else {
+                prob[i as usize] = 0.0;
+                alias[i as usize] = fallback;
+            }
+        }
+        Self { prob, alias }
+    }
+
+    #[inline]
+    fn pick(&self, u: f64, v: f64) -> usize {
+        let n = self.prob.len();
+        let i = ((u * n as f64) as usize).min(n - 1);
+        if v < self.prob[i] { i } else { self.alias[i] as usize }
     }
 }
 
 /// One dart-throwing pass with radius `r` over `n_candidates` candidates.
 fn throw(
     mesh: &TriMesh,
-    cdf: &[f64],
+    table: &AliasTable,
+    total: f64,
     r: f64,
     n_candidates: usize,
     seed: u64,
 ) -> Vec<SurfaceSample> {
-    let total = *cdf.last().unwrap_or(&0.0);
     let origin = mesh.bounding_box().map_or([0.0; 3], |b| b.min);
     let expected = (0.7 * total / (r * r)).min(n_candidates as f64) as usize;
     let mut grid = HashGrid::new(origin, r, expected);
     let mut samples = Vec::with_capacity(expected);
     let n_chunks = n_candidates.div_ceil(CHUNK);
     let r2 = r * r;
-    for batch in (0..n_chunks).step_by(CHUNKS_PER_BATCH) {
-        let chunks: Vec<Vec<SurfaceSample>> = (batch..(batch + CHUNKS_PER_BATCH).min(n_chunks))
+    let generate = |batch: usize| -> Vec<Vec<SurfaceSample>> {
+        (batch..(batch + CHUNKS_PER_BATCH).min(n_chunks))
             .into_par_iter()
             .map(|k| {
                 let mut rng = fieldtex_core::stream(seed, "poisson-disk-candidates", k as u64);
                 let len = CHUNK.min(n_candidates - k * CHUNK);
                 (0..len)
                     .map(|_| {
-                        let (a, b, c): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
-                        let f = cdf.partition_point(|&x| x <= a * total).min(cdf.len() - 1);
+                        let (a, a2): (f64, f64) = (rng.random(), rng.random());
+                        let (b, c): (f64, f64) = (rng.random(), rng.random());
+                        let f = table.pick(a, a2);
                         let s = b.sqrt();
                         let bary = [1.0 - s, s * (1.0 - c), s * c];
                         let p = mesh.triangle_positions(f);
@@ -220,13 +276,28 @@ fn throw(
                     })
                     .collect()
             })
-            .collect();
-        for cand in chunks.into_iter().flatten() {
-            if !grid.has_neighbour(cand.position, r2) {
-                grid.insert(cand.position);
-                samples.push(cand);
-            }
-        }
+            .collect()
+    };
+    // Accept batch k while batch k + 1 is generated (acceptance is sequential).
+    let mut current = generate(0);
+    let mut batch = 0;
+    while batch < n_chunks {
+        let next_batch = batch + CHUNKS_PER_BATCH;
+        let cands = std::mem::take(&mut current);
+        let (grid, samples) = (&mut grid, &mut samples);
+        let ((), next) = rayon::join(
+            move || {
+                for cand in cands.into_iter().flatten() {
+                    if !grid.has_neighbour(cand.position, r2) {
+                        grid.insert(cand.position);
+                        samples.push(cand);
+                    }
+                }
+            },
+            || if next_batch < n_chunks { generate(next_batch) } else { Vec::new() },
+        );
+        current = next;
+        batch = next_batch;
     }
     samples
 }
@@ -257,13 +328,7 @@ pub fn poisson_disk_sampling(
             }
         })
         .collect();
-    let mut cdf = Vec::with_capacity(areas.len());
-    let mut acc = 0.0;
-    for a in &areas {
-        acc += a;
-        cdf.push(acc);
-    }
-    let total = acc;
+    let total: f64 = areas.iter().sum();
     let radius_for = |count: usize| (0.7 * total / count as f64).sqrt();
     let mut r = match (options.radius, options.target_count) {
         (Some(r), _) if r > 0.0 && r.is_finite() => r,
@@ -293,7 +358,8 @@ pub fn poisson_disk_sampling(
         }
         (want.ceil() as usize).clamp(1, options.max_candidates.max(1))
     };
-    let mut samples = throw(mesh, &cdf, r, candidates_for(r, &mut warnings), options.seed);
+    let table = AliasTable::new(&areas, total);
+    let mut samples = throw(mesh, &table, total, r, candidates_for(r, &mut warnings), options.seed);
     if options.radius.is_none() {
         let target = options.target_count.unwrap_or(1) as f64;
         for _ in 0..4 {
@@ -302,10 +368,29 @@ pub fn poisson_disk_sampling(
                 break;
             }
             r *= ratio.sqrt();
-            samples = throw(mesh, &cdf, r, candidates_for(r, &mut warnings), options.seed);
+            samples = throw(mesh, &table, total, r, candidates_for(r, &mut warnings), options.seed);
         }
     }
     Ok((PoissonDiskSamples { samples, radius: r }, warnings))
+}
+
+#[cfg(test)]
+#[test]
+fn alias_table_reproduces_the_weights() {
+    let w = [0.0, 1.0, 3.0, 0.0, 4.0, 2.0];
+    let table = AliasTable::new(&w, 10.0);
+    let mut counts = [0usize; 6];
+    let n = 200;
+    for i in 0..n {
+        for j in 0..n {
+            counts[table.pick((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64)] += 1;
+        }
+    }
+    for k in 0..6 {
+        let p = counts[k] as f64 / (n * n) as f64;
+        assert!((p - w[k] / 10.0).abs() < 0.01, "{k}: {p}");
+    }
+    assert_eq!(counts[0] + counts[3], 0);
 }
 
 #[cfg(test)]
