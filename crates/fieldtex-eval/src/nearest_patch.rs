@@ -203,71 +203,120 @@ fn scan_offset_impl(q: &PatchGrid, db: &PatchGrid, dx: isize, dy: isize, st: &mu
     s[lpx..].fill(0.0);
     let offs = &mut offs[..n];
     let h_offs = &h_offs[..n];
-    for r in 0..ny + n - 1 {
-        let py = y_lo + r;
-        let dby = (py as isize + dy) as usize;
-        // Per-pixel squared colour differences.
-        match q.channels {
-            3 => {
-                let (a0, a1, a2) =
-                    (q.span(0, py, x_lo, lpx), q.span(1, py, x_lo, lpx), q.span(2, py, x_lo, lpx));
-                let (b0, b1, b2) = (
-                    db.span(0, dby, dbx, lpx),
-                    db.span(1, dby, dbx, lpx),
-                    db.span(2, dby, dbx, lpx),
-                );
-                let a = a0.iter().zip(a1).zip(a2);
-                let b = b0.iter().zip(b1).zip(b2);
-                for (si, (((a0, a1), a2), ((b0, b1), b2))) in s.iter_mut().zip(a.zip(b)) {
-                    let (d0, d1, d2) = (a0 - b0, a1 - b1, a2 - b2);
-                    *si = d0 * d0 + d1 * d1 + d2 * d2;
+    let rows = ny + n - 1;
+    // Per row: squared differences of row r, then the vertical sums of the window
+    // ending at row r − 1, then the horizontal sums of row r. Doing the vertical pass in
+    // between keeps the unaligned reads of `s` away from the stores just made to it
+    // (store-to-load forwarding fails on partially overlapping reads).
+    for r in 0..=rows {
+        if r < rows {
+            let py = y_lo + r;
+            let dby = (py as isize + dy) as usize;
+            // Per-pixel squared colour differences.
+            match q.channels {
+                3 => {
+                    let (a0, a1, a2) = (
+                        q.span(0, py, x_lo, lpx),
+                        q.span(1, py, x_lo, lpx),
+                        q.span(2, py, x_lo, lpx),
+                    );
+                    let (b0, b1, b2) = (
+                        db.span(0, dby, dbx, lpx),
+                        db.span(1, dby, dbx, lpx),
+                        db.span(2, dby, dbx, lpx),
+                    );
+                    let a = a0.iter().zip(a1).zip(a2);
+                    let b = b0.iter().zip(b1).zip(b2);
+                    for (si, (((a0, a1), a2), ((b0, b1), b2))) in s.iter_mut().zip(a.zip(b)) {
+                        let (d0, d1, d2) = (a0 - b0, a1 - b1, a2 - b2);
+                        *si = d0 * d0 + d1 * d1 + d2 * d2;
+                    }
                 }
-            }
-            1 => {
-                let (a, b) = (q.span(0, py, x_lo, lpx), db.span(0, dby, dbx, lpx));
-                for (si, (a, b)) in s.iter_mut().zip(a.iter().zip(b)) {
-                    let d = a - b;
-                    *si = d * d;
-                }
-            }
-            _ => {
-                s[..lpx].fill(0.0);
-                for ch in 0..q.channels {
-                    let (a, b) = (q.span(ch, py, x_lo, lpx), db.span(ch, dby, dbx, lpx));
+                1 => {
+                    let (a, b) = (q.span(0, py, x_lo, lpx), db.span(0, dby, dbx, lpx));
                     for (si, (a, b)) in s.iter_mut().zip(a.iter().zip(b)) {
                         let d = a - b;
-                        *si += d * d;
+                        *si = d * d;
+                    }
+                }
+                _ => {
+                    s[..lpx].fill(0.0);
+                    for ch in 0..q.channels {
+                        let (a, b) = (q.span(ch, py, x_lo, lpx), db.span(ch, dby, dbx, lpx));
+                        for (si, (a, b)) in s.iter_mut().zip(a.iter().zip(b)) {
+                            let d = a - b;
+                            *si += d * d;
+                        }
                     }
                 }
             }
         }
-        // Horizontal window sums into the ring slot of this row.
-        let slot = r % n;
-        shifted_sums(s, h_offs, &mut ring[slot * nxp..(slot + 1) * nxp]);
-        if r + 1 < n {
-            continue;
+        if r >= n {
+            vertical_and_minima(
+                r - 1,
+                n,
+                nx,
+                nxp,
+                x_lo,
+                y_lo,
+                dy,
+                dbx,
+                q,
+                db,
+                ring,
+                offs,
+                v,
+                q_min,
+                db_min,
+            );
         }
-        // Vertical window sum over the last n rows, oldest first.
-        let mut slot = (r + 1 - n) % n;
-        for o in offs.iter_mut() {
-            *o = slot * nxp;
-            slot = if slot + 1 == n { 0 } else { slot + 1 };
+        if r < rows {
+            let slot = r % n;
+            shifted_sums(s, h_offs, &mut ring[slot * nxp..(slot + 1) * nxp]);
         }
-        let v = &mut v[..nxp];
-        shifted_sums(ring, offs, v);
-        let v = &v[..nx];
-        let qy = py + 1 - n;
-        if !q_min.is_empty() {
-            let qrow = &mut q_min[qy * q.cols + x_lo..qy * q.cols + x_lo + nx];
-            for (m, d) in qrow.iter_mut().zip(v) {
-                *m = if *d < *m { *d } else { *m };
-            }
+    }
+}
+
+/// Vertical window sums of the `n` rows ending at pixel row `r` (oldest first) and the
+/// running minima of the output row they complete.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn vertical_and_minima(
+    r: usize,
+    n: usize,
+    nx: usize,
+    nxp: usize,
+    x_lo: usize,
+    y_lo: usize,
+    dy: isize,
+    dbx: usize,
+    q: &PatchGrid,
+    db: &PatchGrid,
+    ring: &[f32],
+    offs: &mut [usize],
+    v: &mut [f32],
+    q_min: &mut [f32],
+    db_min: &mut [f32],
+) {
+    let mut slot = (r + 1 - n) % n;
+    for o in offs.iter_mut() {
+        *o = slot * nxp;
+        slot = if slot + 1 == n { 0 } else { slot + 1 };
+    }
+    let v = &mut v[..nxp];
+    shifted_sums(ring, offs, v);
+    let v = &v[..nx];
+    let qy = y_lo + r + 1 - n;
+    if !q_min.is_empty() {
+        let qrow = &mut q_min[qy * q.cols + x_lo..qy * q.cols + x_lo + nx];
+        for (m, d) in qrow.iter_mut().zip(v) {
+            *m = if *d < *m { *d } else { *m };
         }
-        if !db_min.is_empty() {
-            let dbrow = (qy as isize + dy) as usize * db.cols + dbx;
-            for (m, d) in db_min[dbrow..dbrow + nx].iter_mut().zip(v) {
-                *m = if *d < *m { *d } else { *m };
-            }
+    }
+    if !db_min.is_empty() {
+        let dbrow = (qy as isize + dy) as usize * db.cols + dbx;
+        for (m, d) in db_min[dbrow..dbrow + nx].iter_mut().zip(v) {
+            *m = if *d < *m { *d } else { *m };
         }
     }
 }
