@@ -37,6 +37,11 @@ pub enum EvalError {
     TooSmall { what: &'static str, width: usize, height: usize, min: usize },
     #[error("{what}: value {value} at index {index} is not finite; clean the data (NaN/Inf) first")]
     NonFinite { what: &'static str, index: usize, value: f32 },
+    #[error(
+        "{what}: {pairs} patch pairs to compare exceed the limit of {limit}; \
+         compare smaller images (downsample or crop) or raise the limit (max_pairs)"
+    )]
+    TooLarge { what: &'static str, pairs: u64, limit: u64 },
     #[error("option {name} = {value} is invalid: {reason}")]
     InvalidOption { name: &'static str, value: String, reason: &'static str },
 }

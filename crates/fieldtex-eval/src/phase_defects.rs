@@ -44,7 +44,7 @@ use std::f64::consts::PI;
 /// Options of [`phase_defects`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PhaseDefectOptions {
-    /// Stripe period in pixels; `None` = [`estimate_stripe_period`].
+    /// Stripe period in pixels, in `[2.5, 256]`; `None` = [`estimate_stripe_period`].
     pub period_px: Option<f64>,
     /// Normal-direction bins of the Gabor bank over 180°. Default 16.
     pub directions: usize,
@@ -170,12 +170,12 @@ fn mean_gabor_amplitude(l0: &[f32], w: usize, h: usize, normal: &[f32], t: f64) 
 /// gradient energy to signal energy (`k² = Σ|∇f|² / Σf²` for a sinusoid), refined by
 /// picking, among periods from half to twice the guess, the one whose oriented Gabor
 /// filters respond most (harmonics of non-sinusoidal stripes inflate the first guess).
-/// Clamped to `[3, min(width, height)/3]`.
+/// Clamped to `[3, min(width, height)/3]` and to at most 64 pixels.
 pub fn estimate_stripe_period(image: &ImageView) -> Result<f64, EvalError> {
     check_image(image, 16)?;
     let (w, h) = (image.width, image.height);
     let luma = image.luminance();
-    let t_max = (w.min(h) as f64 / 3.0).max(3.0);
+    let t_max = (w.min(h) as f64 / 3.0).clamp(3.0, 64.0);
     let ratio_period = |sigma: f64| -> f64 {
         let l0 = detrend(&luma, w, h, sigma);
         let (gx, gy) = gradient(&l0, w, h);
@@ -229,12 +229,12 @@ pub fn phase_defects(
     }
     let (w, h) = (image.width, image.height);
     let t = match options.period_px {
-        Some(p) if p.is_finite() && p >= 2.5 => p,
+        Some(p) if p.is_finite() && (2.5..=256.0).contains(&p) => p,
         Some(p) => {
             return Err(EvalError::InvalidOption {
                 name: "period_px",
                 value: p.to_string(),
-                reason: "must be a finite period of at least 2.5 pixels",
+                reason: "must be a period in [2.5, 256] pixels",
             });
         }
         None => estimate_stripe_period(image)?,

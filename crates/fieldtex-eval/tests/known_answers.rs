@@ -274,6 +274,10 @@ fn bad_inputs_are_errors_not_panics() {
         Err(EvalError::TooSmall { .. })
     ));
     assert!(coherence(&t, &t, &PatchDistanceOptions::default().with_patch_size(0)).is_err());
+    let e = exemplar(40, 36);
+    let ev = ImageView::new(&e, 40, 36, 3).unwrap();
+    let capped = PatchDistanceOptions { max_pairs: 1000, ..Default::default() };
+    assert!(matches!(coherence(&ev, &ev, &capped), Err(EvalError::TooLarge { .. })));
     let grey1 = [0.5f32; 16];
     let g = ImageView::new(&grey1, 4, 4, 1).unwrap();
     assert!(matches!(

@@ -248,7 +248,7 @@ impl<'a> Scene<'a> {
 /// Camera, quality and look of a render. Validated (clamped) once in `render`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
-    /// Output width and height in pixels (square). Default 800; clamped to 1..=8192.
+    /// Output width and height in pixels (square). Default 800; clamped to 1..=4096.
     pub size: usize,
     /// `(azimuth°, elevation°)` of the camera around the up axis. Default `(35, 25)`,
     /// a three-quarter view from the front right and slightly above. Elevation is
@@ -258,7 +258,9 @@ pub struct RenderOptions {
     pub up: UpAxis,
     /// Vertical (= horizontal) field of view in degrees. Default 30; clamped to 1..=120.
     pub fov_deg: f64,
-    /// Samples per pixel along each axis (box-filtered down). Default 2; clamped 1..=4.
+    /// Samples per pixel along each axis (box-filtered down). Default 2; clamped to
+    /// 1..=4 and so that `size · supersample ≤ 4096` (bounded memory: ~20 bytes per
+    /// sample).
     pub supersample: usize,
     /// Default [`Shading::Smooth`].
     pub shading: Shading,
@@ -339,11 +341,11 @@ impl RenderOptions {
             *c = finf(*c, dc).clamp(0.0, 1.0);
         }
         Self {
-            size: self.size.clamp(1, 8192),
+            size: self.size.clamp(1, 4096),
             view: (fin(self.view.0, d.view.0), fin(self.view.1, d.view.1).clamp(-89.5, 89.5)),
             up: self.up,
             fov_deg: fin(self.fov_deg, d.fov_deg).clamp(1.0, 120.0),
-            supersample: self.supersample.clamp(1, 4),
+            supersample: self.supersample.clamp(1, 4).min((4096 / self.size.clamp(1, 4096)).max(1)),
             shading: self.shading,
             light: self.light,
             ambient: finf(self.ambient, d.ambient).clamp(0.0, 1.0),
