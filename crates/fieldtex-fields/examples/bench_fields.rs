@@ -13,7 +13,7 @@
 //!   removed again untimed (downdates);
 //! - `field_add_stroke_refactor`: the same with `rank1_update_limit = 0` (numeric
 //!   refactorisation with the kept symbolic analysis);
-//! - `field_add_short_stroke`: a ~40 px stroke (a few dozen edges: rank-1 updates);
+//! - `field_add_short_stroke`: a ~18 px stroke (about 20 edges: rank-1 updates);
 //! - `field_numeric_refactor`: the numeric factorisation alone;
 //! - `field_move_singularity_solve_only` / `field_sample_512`: the move split into
 //!   re-solve and pixel sampling.
@@ -122,13 +122,13 @@ fn main() {
         d.remove_stroke(sid).unwrap();
         d.refactor_if_needed().unwrap();
     }
-    // A short stroke (~40 px, a few dozen edges): rank-1 updates instead of a refactor.
+    // A short stroke (~18 px, about 20 edges): rank-1 updates instead of a refactor.
     let mut t_short = Vec::new();
     let updates_short = d.rank1_update_count();
     for k in 0..repeats {
         let y = 150.0 + 10.0 * k as f64;
         let t = Instant::now();
-        let sid = d.add_stroke(Stroke::from_pixels(&[[60.0, y], [100.0, y - 6.0]])).unwrap();
+        let sid = d.add_stroke(Stroke::from_pixels(&[[60.0, y], [78.0, y - 3.0]])).unwrap();
         let f = d.solve().unwrap();
         let px = sample_plane(&d, &f, size, size).unwrap();
         t_short.push(ms(t));
