@@ -3,7 +3,7 @@
 //!
 //! - [`coherence()`] / [`completeness()`]: exact nearest-patch distances output → exemplar
 //!   and back, per pixel and channel;
-//! - [`color_sliced_wasserstein`]: distance between colour distributions;
+//! - [`color_sliced_wasserstein()`]: distance between colour distributions;
 //! - [`orientation_error`]: structure-tensor feature direction vs a guidance field;
 //! - [`singularities()`]: ±1/2 singularities of an orientation map;
 //! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px.

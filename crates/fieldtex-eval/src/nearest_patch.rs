@@ -16,6 +16,15 @@
 //!
 //! Exact: every pair is compared; the minimum of floats is order-independent, so the
 //! result is bit-identical for any thread count, and identical patches give exactly 0.
+//! The inner loops are compiled twice (baseline and AVX2, chosen at run time); both
+//! perform the same IEEE operations per lane, so results do not depend on the CPU.
+//!
+//! Cost measured with `bench_eval` (512² output vs 128² exemplar, 7×7 RGB patches,
+//! 3.8·10⁹ pairs): about 3 ns per pair per core, i.e. 11–13 CPU-seconds, on the shared
+//! 2-core development VM while other builds ran; expect 5–7 s wall on two idle cores.
+//! [`coherence_and_completeness`] gets both directions for the price of one scan.
+//! Not implemented: a pruned or approximate search (an earlier PCA + kd-tree exact
+//! search was data-dependent: 15 s on a patchwork output, minutes on noise).
 
 use crate::EvalError;
 use crate::image_view::ImageView;
