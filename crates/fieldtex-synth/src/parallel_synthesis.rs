@@ -200,17 +200,16 @@ fn mat_vec(j: &[f32; 4], v: [f32; 2]) -> [f32; 2] {
     [j[0] * v[0] + j[1] * v[1], j[2] * v[0] + j[3] * v[1]]
 }
 
-/// Squared distance between a quantised vector and a target in quantised units, summed
-/// in a fixed lane order.
+/// Squared distance between a quantised vector `a` and a target `t` given in units of
+/// `a / 6` (exact integer arithmetic: `|6a − t| ≤ 1524`, the sum fits `i32` easily).
 #[inline]
-fn dist_q(a: &[i8; APPEARANCE_DIMS], t: &[f32; APPEARANCE_DIMS]) -> f32 {
-    let mut l = [0.0f32; 4];
-    for i in 0..4 {
-        let d0 = a[i] as f32 - t[i];
-        let d1 = a[i + 4] as f32 - t[i + 4];
-        l[i] = d0 * d0 + d1 * d1;
+fn dist_q(a: &[i8; APPEARANCE_DIMS], t: &[i16; APPEARANCE_DIMS]) -> i32 {
+    let mut acc = 0i32;
+    for i in 0..APPEARANCE_DIMS {
+        let d = (a[i] as i16 * 6 - t[i]) as i32;
+        acc += d * d;
     }
-    (l[0] + l[1]) + (l[2] + l[3])
+    acc
 }
 
 #[inline]
@@ -232,7 +231,8 @@ struct ExemplarLevel<'a> {
     hf: f32,
     /// Quantised appearance `[Ẽ₀, Ẽ₁]`.
     app: [&'a [[i8; APPEARANCE_DIMS]]; 2],
-    coherence: &'a [u32],
+    /// k-coherence targets as pixel coordinates (`W × H × k_store`).
+    coherence: Vec<[f32; 2]>,
     k_store: usize,
     /// Valid pixel range `[margin, W − margin) × [margin, H − margin)`.
     x_lo: usize,
@@ -278,7 +278,11 @@ impl<'a> ExemplarLevel<'a> {
             wf: w as f32,
             hf: h as f32,
             app: [&an.appearance_q.data[0], &an.appearance_q.data[1]],
-            coherence: &an.coherence,
+            coherence: an
+                .coherence
+                .iter()
+                .map(|&v| [(v as usize % w) as f32, (v as usize / w) as f32])
+                .collect(),
             k_store: analysis.k(),
             x_lo: an.margin.min(w / 2),
             x_hi: w - an.margin.min(w / 2),
@@ -297,7 +301,9 @@ impl<'a> ExemplarLevel<'a> {
     /// Column and row of a wrapped coordinate.
     #[inline]
     fn cell(&self, u: [f32; 2]) -> (usize, usize) {
-        ((u[0] as usize).min(self.w - 1), (u[1] as usize).min(self.h - 1))
+        // `u` is wrapped (non-negative, finite): the i32 conversion is the floor and a
+        // single instruction, unlike the one to usize.
+        ((u[0] as i32 as usize).min(self.w - 1), (u[1] as i32 as usize).min(self.h - 1))
     }
 
     /// Pixel of a wrapped coordinate.
@@ -356,10 +362,12 @@ impl Pass<'_> {
             valid[k] = true;
         }
         // Four-corner neighbourhood of p, averaged over three predictions per corner.
-        let mut target = [[0.0f32; APPEARANCE_DIMS]; 4];
+        // Targets are kept as 6 × the mean (6 = lcm of the possible counts 1, 2, 3), so
+        // the whole comparison is exact integer arithmetic.
+        let mut target = [[0i16; APPEARANCE_DIMS]; 4];
         let mut weight = [false; 4];
         for (ci, &dir) in self.t.corner_dir[p].iter().enumerate() {
-            let mut count = 0.0f32;
+            let mut count = 0i16;
             for t in [dir + 7, dir, dir + 1] {
                 let t = (t % 8) as usize;
                 if !valid[t] {
@@ -369,48 +377,58 @@ impl Pass<'_> {
                 let (x, y) = ex.cell(u);
                 let v = &ex.app[a as usize][ex.corner(x, y, ci, a)];
                 for (o, &x) in target[ci].iter_mut().zip(v) {
-                    *o += x as f32;
+                    *o += x as i16;
                 }
-                count += 1.0;
+                count += 1;
             }
-            if count > 0.0 {
-                let inv = 1.0 / count;
-                target[ci].iter_mut().for_each(|x| *x *= inv);
+            if count > 0 {
+                let f = 6 / count;
+                target[ci].iter_mut().for_each(|x| *x *= f);
                 weight[ci] = true;
             }
         }
         // Candidates are compared over the known corners (all four away from the domain
         // border). The score depends only on the candidate's pixel and flip: each
         // distinct (pixel, flip) is evaluated once; ties keep the earlier candidate.
-        let mut seen = [(u32::MAX, false); 1 + 8 * (1 + MAX_K)];
+        let mut seen = [u32::MAX; 1 + 8 * (1 + MAX_K)];
         let mut n_seen = 0usize;
         let mut best = (s[p], fl[p] && self.rosy);
-        let mut best_d = f32::INFINITY;
-        let mut consider = |u: [f32; 2], b: bool, best: &mut ([f32; 2], bool)| {
+        let mut best_d = i32::MAX;
+        // Returns the best distance so far.
+        let mut consider = |u: [f32; 2], b: bool, best: &mut ([f32; 2], bool)| -> i32 {
             let (x, y) = ex.cell(u);
             if x < ex.x_lo || x >= ex.x_hi || y < ex.y_lo || y >= ex.y_hi {
-                return;
+                return best_d;
             }
             let pix = y * ex.w + x;
-            let key = (pix as u32, b);
+            let key = (pix as u32) << 1 | b as u32;
             if seen[..n_seen].contains(&key) {
-                return;
+                return best_d;
             }
             seen[n_seen] = key;
             n_seen += 1;
             let app = ex.app[b as usize];
-            let mut total = 0.0f32;
+            let mut total = 0i32;
             for ci in 0..4 {
                 if weight[ci] {
                     total += dist_q(&app[ex.corner(x, y, ci, b)], &target[ci]);
+                    // Partial distances only grow: stop once this one cannot win.
+                    if total >= best_d {
+                        return best_d;
+                    }
                 }
             }
             if total < best_d {
                 best_d = total;
                 *best = (u, b);
             }
+            best_d
         };
-        consider(best.0, best.1, &mut best);
+        if consider(best.0, best.1, &mut best) == 0 {
+            // p's neighbourhood is exactly its exemplar neighbourhood (inside a coherent
+            // patch): no candidate can beat it, skip the search.
+            return best;
+        }
         for k in 0..8 {
             if !valid[k] {
                 continue;
@@ -422,16 +440,13 @@ impl Pass<'_> {
             }
             let sq = s[nb[k] as usize];
             // Coordinates are wrapped (non-negative): truncation is the floor.
-            let frac = [sq[0] - (sq[0] as u32) as f32, sq[1] - (sq[1] as u32) as f32];
+            let frac = [sq[0] - (sq[0] as i32) as f32, sq[1] - (sq[1] as i32) as f32];
             let base = ex.pixel(sq) * ex.k_store;
             let dd = OFFS8[k];
             let off = mat_vec(&fq, [dd[0] as f32 * h, dd[1] as f32 * h]);
             for i in 0..self.k {
-                let v = ex.coherence[base + i] as usize;
-                let c = ex.wrap([
-                    (v % ex.w) as f32 + frac[0] - off[0],
-                    (v / ex.w) as f32 + frac[1] - off[1],
-                ]);
+                let v = ex.coherence[base + i];
+                let c = ex.wrap([v[0] + frac[0] - off[0], v[1] + frac[1] - off[1]]);
                 consider(c, a, &mut best);
             }
         }
