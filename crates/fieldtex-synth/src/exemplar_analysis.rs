@@ -13,7 +13,7 @@ use fieldtex_core::{Image, Progress};
 
 use crate::SynthError;
 use crate::appearance_space::appearance_space;
-use crate::gaussian_stack::gaussian_stack;
+use crate::gaussian_stack::next_stack_level;
 use crate::k_coherence::k_coherence;
 
 /// Dimension of the appearance space (Lefebvre & Hoppe 2006 use 8).
@@ -58,17 +58,14 @@ pub struct AnalysisLevel {
     pub spacing: usize,
     /// Border band (pixels) the synthesis avoids at this level; 0 for tileable exemplars.
     pub margin: usize,
-    /// Appearance of each pixel (`W × H`), unrotated exemplar (`Ẽ₀`).
-    pub appearance: Vec<[f32; APPEARANCE_DIMS]>,
-    /// Appearance of each pixel's 180°-rotated neighbourhood (`Ẽ₁`), at the unrotated
-    /// coordinate.
-    pub appearance_rotated: Vec<[f32; APPEARANCE_DIMS]>,
     /// k-coherence sets, `W × H × k` pixel indices, best first (valid for both copies).
     pub coherence: Vec<u32>,
     /// Share of the 5×5-neighbourhood variance kept by the 8 components.
     pub explained_variance: f64,
-    /// `[appearance, appearance_rotated]` quantised to 8 bits (what the synthesis reads:
-    /// 8 bytes per vector keep its random lookups in cache).
+    /// Appearance of each pixel (`W × H`) for the unrotated exemplar (`Ẽ₀`, `data[0]`)
+    /// and for each pixel's 180°-rotated neighbourhood stored at the unrotated
+    /// coordinate (`Ẽ₁`, `data[1]`), quantised to 8 bits: 8 bytes per vector keep the
+    /// synthesis' random lookups in cache and the analysis of a 1024² exemplar small.
     pub appearance_q: QuantizedVectors,
 }
 
@@ -77,6 +74,13 @@ pub struct AnalysisLevel {
 pub struct QuantizedVectors {
     pub scale: f32,
     pub data: [Vec<[i8; APPEARANCE_DIMS]>; 2],
+}
+
+impl QuantizedVectors {
+    /// Vector `i` of set `set` (0 or 1), de-quantised.
+    pub fn get(&self, set: usize, i: usize) -> [f32; APPEARANCE_DIMS] {
+        self.data[set][i].map(|q| q as f32 / self.scale)
+    }
 }
 
 impl QuantizedVectors {
@@ -148,11 +152,14 @@ impl ExemplarAnalysis {
         let rgb: Vec<[f32; 3]> = exemplar.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let n_levels = (width.max(height) as f64).log2().ceil() as usize;
         progress.stage("exemplar analysis", n_levels as u64);
-        let stack = gaussian_stack(&rgb, width, height, n_levels);
         let mut levels = Vec::with_capacity(n_levels);
-        for (c, level_img) in stack.iter().enumerate() {
+        let mut level_img = rgb;
+        for c in 0..n_levels {
+            if c > 0 {
+                level_img = next_stack_level(&level_img, width, height, c);
+            }
             let spacing = 1usize << c;
-            let space = appearance_space(level_img, width, height, spacing, c)?;
+            let space = appearance_space(&level_img, width, height, spacing, c)?;
             let radius = options.coherence_radius.max(spacing).min(width.min(height) / 4).max(1);
             let margin =
                 if options.tileable { 0 } else { (2 * spacing).min(width.min(height) / 8).max(1) };
@@ -171,8 +178,6 @@ impl ExemplarAnalysis {
                 margin,
                 appearance_q,
 
-                appearance: space.unrotated,
-                appearance_rotated: space.rotated,
                 coherence,
                 explained_variance: space.explained_variance,
             });

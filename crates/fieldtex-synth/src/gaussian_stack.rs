@@ -24,13 +24,19 @@ pub fn gaussian_stack(
     assert_eq!(colors.len(), width * height, "gaussian_stack: colors must hold width × height");
     let mut stack = vec![colors.to_vec()];
     for c in 1..levels.max(1) {
-        let spacing = 1usize << (c - 1);
-        let prev = &stack[c - 1];
-        let horizontal = blur_rows(prev, width, height, spacing);
-        let both = blur_columns(&horizontal, width, height, spacing);
-        stack.push(both);
+        let next = next_stack_level(&stack[c - 1], width, height, c);
+        stack.push(next);
     }
     stack
+}
+
+/// Stack level `c ≥ 1` from level `c − 1` (`width × height` RGB each), for callers that
+/// keep one level at a time.
+pub fn next_stack_level(prev: &[[f32; 3]], width: usize, height: usize, c: usize) -> Vec<[f32; 3]> {
+    assert!(c >= 1 && prev.len() == width * height, "next_stack_level: c ≥ 1, W × H pixels");
+    let spacing = 1usize << (c - 1).min(40);
+    let horizontal = blur_rows(prev, width, height, spacing);
+    blur_columns(&horizontal, width, height, spacing)
 }
 
 fn blur_rows(src: &[[f32; 3]], width: usize, height: usize, spacing: usize) -> Vec<[f32; 3]> {

@@ -273,3 +273,37 @@ fn bad_exemplars_and_options_are_refused() {
     }
     assert!(ImageDomain::new(2, 2, vec![[0.0; 4]; 4]).is_err());
 }
+
+fn load_exemplar(name: &str) -> Image {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/exemplars")
+        .join(name);
+    let img = image::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba32f();
+    let (w, h) = img.dimensions();
+    Image { width: w as usize, height: h as usize, pixels: img.pixels().map(|p| p.0).collect() }
+}
+
+#[test]
+fn real_non_power_of_two_exemplar_follows_the_field() {
+    // stripes_Fabric071 is 116×116, not tileable (default analysis options).
+    let ex = load_exemplar("stripes_Fabric071.png");
+    assert_eq!((ex.width, ex.height), (116, 116));
+    let an = ExemplarAnalysis::new(&ex, &AnalysisOptions::default(), &NoProgress).unwrap();
+    assert_eq!(an.level_count(), 7);
+    let margin = an.level(0).margin as f32;
+    let deg = 30.0f32;
+    let dom = ImageDomain::constant(96, 96, deg.to_radians(), 1.0).unwrap();
+    let r = synthesize(&an, &dom, &SynthesisOptions::default(), &NoProgress).unwrap();
+    let (theta, coherence) = stripe_orientation(&r.colors);
+    let err = angle_diff_mod_pi(theta, deg.to_radians()).to_degrees();
+    eprintln!("real stripes: error {err}°, coherence {coherence}");
+    assert!(
+        err < 5.0 && coherence > 0.6,
+        "stripes at {}°, coherence {coherence}",
+        theta.to_degrees()
+    );
+    // Almost every coordinate keeps clear of the (non-tileable) exemplar border.
+    let inside =
+        r.coords.iter().filter(|u| u.iter().all(|&v| v >= margin && v < 116.0 - margin)).count();
+    assert!(inside as f32 > 0.99 * r.coords.len() as f32, "{inside} of {}", r.coords.len());
+}
