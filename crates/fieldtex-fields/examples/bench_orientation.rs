@@ -4,13 +4,15 @@
 //! ```text
 //! cargo run --release -p fieldtex-fields --example bench_orientation -- \
 //!     [MESH.obj|.ply] [--refine] [--curves C.obj | --sharp] [--seeds 20] [--runs 3]
-//!     [--batch 0.9] [--name NAME]
+//!     [--crest-before-refine] [--batch 0.9] [--name NAME]
 //! ```
 //! Default mesh: `shared/data/meshes/fandisk.obj`. Curves: the polylines (`l` elements)
 //! of `--curves`; with `--sharp`, plain sharp-edge chains (dihedral angle > 30°, broken
 //! at turns > 60°, more than 3 edges; a private stand-in kept for comparison); otherwise
 //! every crest line of `fieldtex_features::crest_lines` with default options (timed
-//! separately, not part of the orientation time).
+//! separately, not part of the orientation time). `--crest-before-refine` detects the
+//! curves on the input mesh and orients them on the refined one (midpoint subdivision
+//! does not change the shape, but its flat triangles add spurious curvature extrema).
 //!
 //! Prints `BENCH orient_<name>_{greedy,arbitrary}_{singularities,dirichlet} value=..`
 //! (arbitrary: median over the seeds), `BENCH orient_<name>_total median_ms=..` (whole
@@ -154,12 +156,14 @@ fn main() {
     let (mut refine, mut curves_path, mut seeds, mut runs, mut name) =
         (false, None, 20u64, 3, None);
     let mut sharp = false;
+    let mut crest_before_refine = false;
     let mut batch = 0.9;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
             "--refine" => refine = true,
             "--sharp" => sharp = true,
+            "--crest-before-refine" => crest_before_refine = true,
             "--curves" => {
                 i += 1;
                 curves_path = Some(PathBuf::from(&args[i]));
@@ -191,22 +195,32 @@ fn main() {
         mesh_path.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().replace('-', "_"))
     });
     let mut mesh = fieldtex_io::read_mesh(&mesh_path).expect("read mesh").mesh;
+    let detect = |mesh: &TriMesh| {
+        let t_curves = Instant::now();
+        let (curves, source) = match &curves_path {
+            Some(p) => (read_obj_polylines(p), "file"),
+            None if sharp => (sharp_edge_chains(mesh, 30.0, 60.0, 3), "sharp-edge chains"),
+            None => {
+                let crest = fieldtex_features::crest_lines(
+                    mesh,
+                    &fieldtex_features::CrestOptions::default(),
+                )
+                .expect("crest lines");
+                (crest.lines.into_iter().map(|l| l.points).collect(), "crest lines")
+            }
+        };
+        (curves, source, 1e3 * t_curves.elapsed().as_secs_f64())
+    };
+    let mut detected = None;
     if refine {
+        if crest_before_refine {
+            detected = Some(detect(&mesh));
+            name.push_str("_coarse_crest");
+        }
         mesh = subdivide_midpoint(&mesh);
         name.push_str("_refined");
     }
-    let t_curves = Instant::now();
-    let (curves, source) = match &curves_path {
-        Some(p) => (read_obj_polylines(p), "file"),
-        None if sharp => (sharp_edge_chains(&mesh, 30.0, 60.0, 3), "sharp-edge chains"),
-        None => {
-            let crest =
-                fieldtex_features::crest_lines(&mesh, &fieldtex_features::CrestOptions::default())
-                    .expect("crest lines");
-            (crest.lines.into_iter().map(|l| l.points).collect(), "crest lines")
-        }
-    };
-    let curves_ms = 1e3 * t_curves.elapsed().as_secs_f64();
+    let (curves, source, curves_ms) = detected.unwrap_or_else(|| detect(&mesh));
     println!(
         "INFO mesh={name} vertices={} triangles={} curves={} ({source}, {curves_ms:.0} ms) threads={}",
         mesh.n_vertices(),
