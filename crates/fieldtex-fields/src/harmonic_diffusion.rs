@@ -79,10 +79,11 @@ pub enum UnconstrainedFallback {
 pub struct CurveFieldOptions {
     /// Penalty weight `α` of eq. (2). Default `1e8` (paper A). Must be finite and `> 0`.
     pub penalty: f64,
-    /// Curve resampling step, in mean edge lengths. Default `0.5`. Must be `> 0`.
+    /// Curve resampling step, in mean edge lengths. Default `0.5`. Must lie in
+    /// `(0.001, 1000]`.
     pub sample_spacing: f64,
     /// Largest distance from a curve sample to its vertex, in mean edge lengths; farther
-    /// samples are dropped as off the mesh. Default `2.0`. Must be `> 0`.
+    /// samples are dropped as off the mesh. Default `2.0`. Must lie in `(0, 1000]`.
     pub max_distance: f64,
     /// Vertices constrained by several curves. Default [`OverlapPolicy::KeepFirst`].
     pub overlap: OverlapPolicy,
@@ -104,16 +105,23 @@ impl Default for CurveFieldOptions {
 
 impl CurveFieldOptions {
     fn validate(&self) -> Result<(), FieldsError> {
-        let check = |name, value: f64| {
-            if value.is_finite() && value > 0.0 {
+        let check = |name, value: f64, lo: f64, hi: f64, expected| {
+            if value.is_finite() && value > lo && value <= hi {
                 Ok(())
             } else {
-                Err(FieldsError::InvalidOption { name, value, expected: "a finite number > 0" })
+                Err(FieldsError::InvalidOption { name, value, expected })
             }
         };
-        check("penalty", self.penalty)?;
-        check("sample_spacing", self.sample_spacing)?;
-        check("max_distance", self.max_distance)
+        check("penalty", self.penalty, 0.0, f64::MAX, "a finite number > 0 (paper: 1e8)")?;
+        let spacing = "a number of mean edge lengths in (0.001, 1000]";
+        check("sample_spacing", self.sample_spacing, 1e-3, 1e3, spacing)?;
+        check(
+            "max_distance",
+            self.max_distance,
+            0.0,
+            1e3,
+            "a number of mean edge lengths in (0, 1000]",
+        )
     }
 }
 
@@ -189,6 +197,8 @@ struct Block {
 /// Uniform grid over vertex positions for nearest-vertex queries.
 struct VertexGrid {
     origin: V3,
+    /// Upper corner of the bounding box of the gridded vertices.
+    upper: V3,
     cell: f64,
     dims: [usize; 3],
     offsets: Vec<u32>,
@@ -215,7 +225,8 @@ impl VertexGrid {
             }
             cell *= 1.5;
         };
-        let mut g = Self { origin: lo, cell, dims, offsets: Vec::new(), items: Vec::new() };
+        let mut g =
+            Self { origin: lo, upper: hi, cell, dims, offsets: Vec::new(), items: Vec::new() };
         let pairs: Vec<(u32, u32)> =
             pts().map(|(v, p)| (g.cell_index(g.coords(*p)) as u32, v as u32)).collect();
         let csr = fieldtex_mesh::Csr::from_pairs(dims[0] * dims[1] * dims[2], pairs.into_iter());
@@ -233,6 +244,26 @@ impl VertexGrid {
 
     fn cell_index(&self, c: [usize; 3]) -> usize {
         (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+    }
+
+    /// Parameter range `[t0, t1] ⊂ [0, 1]` of the segment `a → b` inside the bounding
+    /// box grown by `radius` (slab method), or `None` when it misses the box.
+    fn clip(&self, a: V3, b: V3, radius: f64) -> Option<(f64, f64)> {
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for k in 0..3 {
+            let (lo, hi) = (self.origin[k] - radius, self.upper[k] + radius);
+            let d = b[k] - a[k];
+            if d == 0.0 {
+                if a[k] < lo || a[k] > hi {
+                    return None;
+                }
+                continue;
+            }
+            let (u, v) = ((lo - a[k]) / d, (hi - a[k]) / d);
+            t0 = t0.max(u.min(v));
+            t1 = t1.min(u.max(v));
+        }
+        (t0 <= t1).then_some((t0, t1))
     }
 
     /// Nearest vertex within `radius` of `p` (ties: lower index).
@@ -427,12 +458,19 @@ impl<'m> CurveFieldSolver<'m> {
             if let Some(a) = prev {
                 let d = vec3::sub(q, a);
                 let len = vec3::norm(d);
-                if len > 0.0 {
+                // Only the part near the mesh is sampled (bounds the work for far or
+                // huge segments); an overflowing length counts as off the mesh.
+                let span = if len.is_finite() { self.grid.clip(a, q, radius) } else { None };
+                if len > 0.0 && span.is_none() {
+                    out.dropped_samples += 1;
+                }
+                if let (true, Some((t0, t1))) = (len > 0.0, span) {
                     let dir = vec3::scale(d, 1.0 / len);
-                    let k = (len / step).ceil().max(1.0) as usize;
-                    let w = len / k as f64;
+                    let k = (len * (t1 - t0) / step).ceil().max(1.0) as usize;
+                    let w = len * (t1 - t0) / k as f64;
                     for s in 0..k {
-                        let x = vec3::lerp(a, q, (s as f64 + 0.5) / k as f64);
+                        let t = t0 + (t1 - t0) * (s as f64 + 0.5) / k as f64;
+                        let x = vec3::lerp(a, q, t);
                         let Some(v) = self.grid.nearest(&self.mesh.positions, x, radius) else {
                             out.dropped_samples += 1;
                             continue;

@@ -213,15 +213,21 @@ fn bad_input_gives_errors_or_warnings() {
     let g = grid(10, 10, 1.0, 1.0);
     let bad = CurveFieldOptions { penalty: -1.0, ..Default::default() };
     assert!(CurveFieldSolver::new(&g, &bad).is_err());
-    let bad = CurveFieldOptions { sample_spacing: f64::NAN, ..Default::default() };
-    assert!(CurveFieldSolver::new(&g, &bad).is_err());
+    for (spacing, distance) in [(f64::NAN, 2.0), (1e-9, 2.0), (0.5, 1e9), (0.5, 0.0)] {
+        let bad = CurveFieldOptions {
+            sample_spacing: spacing,
+            max_distance: distance,
+            ..Default::default()
+        };
+        assert!(CurveFieldSolver::new(&g, &bad).is_err(), "{spacing} {distance}");
+    }
 
     // A grid plus a second grid far away, a component of coincident points and an
     // unreferenced vertex.
     let mut mesh = grid(10, 10, 1.0, 1.0);
     let far = grid(4, 4, 1.0, 1.0);
     let off = mesh.n_vertices() as u32;
-    mesh.positions.extend(far.positions.iter().map(|p| [p[0] + 5.0, p[1], p[2]]));
+    mesh.positions.extend(far.positions.iter().map(|p| [p[0] + 5.0, p[1] + 5.0, p[2]]));
     mesh.triangles.extend(far.triangles.iter().map(|t| t.map(|i| i + off)));
     let d = mesh.n_vertices() as u32;
     mesh.positions.extend([[9.0, 9.0, 9.0]; 4]);
@@ -234,6 +240,9 @@ fn bad_input_gives_errors_or_warnings() {
         vec![[0.5, 0.5, 0.0]],                       // a single point
         vec![[f64::NAN, 0.0, 0.0], [f64::INFINITY, 1.0, 0.0]],
         line([9.0, 9.0, 9.0], [9.0, 9.0, 9.0], 3), // zero length, on the degenerate part
+        vec![[1e6, 0.5, 0.0], [-1e6, 0.5, 0.0]],   // long: only the part near the mesh
+        vec![[1.7e308, 0.0, 0.0], [-1.7e308, 0.0, 0.0]], // the length overflows
+        vec![[1e300, 0.5, 0.0], [-1e300, 0.5, 1e-300]], // beyond f64 resolution: no hang
     ];
     for mode in [
         fieldtex_fields::OrientationMode::Greedy,
@@ -241,7 +250,11 @@ fn bad_input_gives_errors_or_warnings() {
     ] {
         let options = CurveOrientationOptions { mode, ..Default::default() };
         let r = orient_curves(&mesh, &curves, &options, &fieldtex_core::NoProgress).unwrap();
-        assert_eq!(r.signs[1..], [0, 0, 0, 0, 0]);
+        assert_eq!(r.signs[1..6], [0, 0, 0, 0, 0]);
+        assert_ne!(r.signs[6], 0, "the huge segment crosses the grid at y = 0.5");
+        assert_eq!(r.signs[7], 0);
+        // It crosses the first grid, plus up to 2 mean edge lengths beyond its ends.
+        assert!((1.0..1.8).contains(&r.curves[6].length), "{}", r.curves[6].length);
         assert_ne!(r.signs[0], 0);
         let codes: Vec<&str> = r.warnings.iter().map(|w| w.code.as_str()).collect();
         for c in [
