@@ -4,8 +4,10 @@
 //! Vertex properties, in order: `x y z` (`float`), `nx ny nz` (`float`, when the mesh has
 //! normals), `red green blue alpha` (`uchar`, sRGB as stored, when it has colours), then
 //! each extra property (`float`) in the order given. Faces: `list uchar int
-//! vertex_indices`. Values are stored as 32-bit floats (PLY's most widely read type);
-//! per-corner UVs are not written (PLY has no standard for them).
+//! vertex_indices`, then, when the mesh has per-corner UVs, `list uchar float texcoord`
+//! with `u0 v0 u1 v1 u2 v2` per triangle (MeshLab's convention, read back by
+//! [`crate::read_mesh`]). Values are stored as 32-bit floats (PLY's most widely read
+//! type).
 
 use crate::{IoError, atomic_write};
 use fieldtex_mesh::TriMesh;
@@ -70,7 +72,22 @@ pub fn encode_ply(
         let _ = writeln!(h, "property {ty} {n}");
     }
     let _ = writeln!(h, "element face {}", mesh.n_triangles());
-    h.push_str("property list uchar int vertex_indices\nend_header\n");
+    h.push_str("property list uchar int vertex_indices\n");
+    if mesh.uvs.is_some() {
+        h.push_str("property list uchar float texcoord\n");
+    }
+    h.push_str("end_header\n");
+    let corner_uv = |f: usize| -> [f32; 6] {
+        let mut c = [0.0f32; 6];
+        if let Some(uv) = &mesh.uvs {
+            for k in 0..3 {
+                let t = uv.values[uv.indices[f][k] as usize];
+                c[2 * k] = t[0] as f32;
+                c[2 * k + 1] = t[1] as f32;
+            }
+        }
+        c
+    };
     let q = |c: f32| if c.is_nan() { 0 } else { (c.clamp(0.0, 1.0) * 255.0).round() as u8 };
     let mut out = h.into_bytes();
     if binary {
@@ -91,10 +108,16 @@ pub fn encode_ply(
                 out.extend_from_slice(&values[v].to_le_bytes());
             }
         }
-        for t in &mesh.triangles {
+        for (f, t) in mesh.triangles.iter().enumerate() {
             out.push(3);
             for i in t {
                 out.extend_from_slice(&(*i as i32).to_le_bytes());
+            }
+            if mesh.uvs.is_some() {
+                out.push(6);
+                for x in corner_uv(f) {
+                    out.extend_from_slice(&x.to_le_bytes());
+                }
             }
         }
     } else {
@@ -115,8 +138,13 @@ pub fn encode_ply(
             }
             s.push('\n');
         }
-        for t in &mesh.triangles {
-            let _ = writeln!(s, "3 {} {} {}", t[0], t[1], t[2]);
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            let _ = write!(s, "3 {} {} {}", t[0], t[1], t[2]);
+            if mesh.uvs.is_some() {
+                let c = corner_uv(f);
+                let _ = write!(s, " 6 {} {} {} {} {} {}", c[0], c[1], c[2], c[3], c[4], c[5]);
+            }
+            s.push('\n');
         }
         out.extend_from_slice(s.as_bytes());
     }

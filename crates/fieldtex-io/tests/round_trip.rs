@@ -73,6 +73,17 @@ fn ply_binary_and_ascii_with_extra_properties() {
         assert_eq!(back.mesh.vertex_normals, m.vertex_normals);
         let c = back.mesh.vertex_colors.unwrap();
         assert!((c[4][0] - m.vertex_colors.as_ref().unwrap()[4][0]).abs() <= 0.5 / 255.0);
+        // Per-corner UVs travel as face `texcoord` lists.
+        assert!(header.contains("property list uchar float texcoord"), "{header}");
+        let (a, b) = (back.mesh.uvs.expect("uvs read back"), m.uvs.as_ref().unwrap());
+        for f in 0..m.n_triangles() {
+            for k in 0..3 {
+                let (ua, ub) =
+                    (a.values[a.indices[f][k] as usize], b.values[b.indices[f][k] as usize]);
+                let close = (ua[0] - ub[0]).abs() < 1e-7 && (ua[1] - ub[1]).abs() < 1e-7;
+                assert!(close, "face {f} corner {k}: {ua:?} vs {ub:?}");
+            }
+        }
     }
     let p = dir("ply").join("dup.ply");
     assert!(write_ply(&p, &m, &[("nx", &fx)], true).is_err());
