@@ -1,11 +1,15 @@
 //! Geometry benchmarks (procedural by default; no files needed).
 //!
-//! `cargo run --release -p fieldtex-mesh --example bench_geometry -- [MESH.obj] [--refine N]`
+//! `cargo run --release -p fieldtex-mesh --example bench_geometry -- [MESH.obj] [--refine N]
+//! [--rays-only] [--threads N]`
 //!
 //! Without a path the workload is a torus refined once by 1→4 subdivision to
 //! 388,128 triangles (the size of the refined horse of the benchmark suite). With a
 //! path, the OBJ's `v`/`f` lines are read (polygons fanned) and refined `N` times
-//! (default 0). Prints `BENCH name key=value` lines.
+//! (default 0). `--rays-only` runs only the BVH entries, `--threads` sets the pool size
+//! (default 2). Prints `BENCH name key=value` lines; ray entries also give `cpu_value`,
+//! the rate per CPU-second of this process times the thread count (Linux only), which
+//! is less sensitive to other processes loading the machine than the wall-clock rate.
 
 use fieldtex_core::rng::hash_unit;
 use fieldtex_core::vec3;
@@ -45,17 +49,40 @@ fn parse_obj(text: &str) -> TriMesh {
     TriMesh::new(positions, triangles)
 }
 
-fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
+fn median_ms(runs: usize, f: impl FnMut()) -> f64 {
+    median_ms_cpu(runs, f).0
+}
+
+/// CPU seconds (user + system) used by this process so far; `None` off Linux.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which is in parentheses and may contain spaces).
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0) // USER_HZ is 100 on Linux
+}
+
+/// Median wall-clock milliseconds and median CPU milliseconds of `runs` runs.
+fn median_ms_cpu(runs: usize, mut f: impl FnMut()) -> (f64, Option<f64>) {
     f(); // warm-up
-    let mut t: Vec<f64> = (0..runs)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
+    let mut t = Vec::with_capacity(runs);
+    let mut c = Vec::with_capacity(runs);
+    for _ in 0..runs {
+        let (s, cs) = (Instant::now(), cpu_seconds());
+        f();
+        t.push(s.elapsed().as_secs_f64() * 1e3);
+        c.push(cpu_seconds().zip(cs).map(|(b, a)| (b - a) * 1e3));
+    }
     t.sort_by(f64::total_cmp);
-    t[runs / 2]
+    let mut c: Option<Vec<f64>> = c.into_iter().collect();
+    (
+        t[runs / 2],
+        c.as_mut().map(|c| {
+            c.sort_by(f64::total_cmp);
+            c[runs / 2]
+        }),
+    )
 }
 
 /// Rays from a sphere of 1.5 bounding-box diagonals around the mesh towards random points
@@ -84,11 +111,19 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut path = None;
     let mut refine = 0usize;
+    let mut threads = 2usize;
+    let mut rays_only = false;
     let mut i = 0;
     while i < args.len() {
         if args[i] == "--refine" {
             refine = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(1);
             i += 2;
+        } else if args[i] == "--threads" {
+            threads = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(2);
+            i += 2;
+        } else if args[i] == "--rays-only" {
+            rays_only = true;
+            i += 1;
         } else {
             path = Some(args[i].clone());
             i += 1;
@@ -103,18 +138,18 @@ fn main() {
     }
     mesh.validate().expect("invalid mesh");
     println!("mesh: {} vertices, {} triangles", mesh.n_vertices(), mesh.n_triangles());
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-    pool.install(|| {
-        let ms = median_ms(11, || {
-            let (l, m, _) = cotan_laplacian_and_mass(
-                &mesh,
-                &CotanOptions::default(),
-                VertexAreaKind::Barycentric,
-            )
-            .unwrap();
-            std::hint::black_box((l, SparseMatrix::from_diagonal(&m)));
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    let rate = |n: usize, (ms, cpu): (f64, Option<f64>)| {
+        let wall = n as f64 / (ms * 1e-3);
+        let cpu = cpu.map_or(String::new(), |c| {
+            format!(" cpu_value={:.0}", n as f64 * threads as f64 / (c.max(1.0) * 1e-3))
         });
-        println!("BENCH cotan_mass_388k median_ms={ms:.2}");
+        format!("value={wall:.0}{cpu}")
+    };
+    pool.install(|| {
+        if !rays_only {
+            bench_other(&mesh);
+        }
         let ms = median_ms(5, || {
             std::hint::black_box(Bvh::build(&mesh).unwrap());
         });
@@ -122,23 +157,39 @@ fn main() {
         let bvh = Bvh::build(&mesh).unwrap();
         let rays = random_rays(&mesh, 1_000_000);
         let mut hits = 0;
-        let ms = median_ms(3, || {
+        let m = median_ms_cpu(3, || {
             hits = bvh.intersect_many(&rays).iter().filter(|h| h.is_some()).count();
         });
         println!("hit fraction {:.3}", hits as f64 / rays.len() as f64);
-        println!("BENCH rays_per_s value={:.0}", rays.len() as f64 / (ms * 1e-3));
-        let ms = median_ms(3, || {
+        println!("BENCH rays_per_s {}", rate(rays.len(), m));
+        let m = median_ms_cpu(3, || {
             std::hint::black_box(bvh.occluded_many(&rays));
         });
-        println!("BENCH any_hit_rays_per_s value={:.0}", rays.len() as f64 / (ms * 1e-3));
-        // About 100K samples.
-        let r = (0.7 * total_area(&mesh) / 100_000.0).sqrt();
-        let opts = PoissonDiskOptions { radius: Some(r), seed: 1, ..Default::default() };
-        let mut count = 0;
-        let ms = median_ms(3, || {
-            count = poisson_disk_sampling(&mesh, &opts).unwrap().0.samples.len();
-        });
-        println!("poisson samples {count}");
-        println!("BENCH poisson_disk median_ms={ms:.2}");
+        println!("BENCH any_hit_rays_per_s {}", rate(rays.len(), m));
+        if !rays_only {
+            bench_poisson(&mesh);
+        }
     });
+}
+
+fn bench_other(mesh: &TriMesh) {
+    let ms = median_ms(11, || {
+        let (l, m, _) =
+            cotan_laplacian_and_mass(mesh, &CotanOptions::default(), VertexAreaKind::Barycentric)
+                .unwrap();
+        std::hint::black_box((l, SparseMatrix::from_diagonal(&m)));
+    });
+    println!("BENCH cotan_mass_388k median_ms={ms:.2}");
+}
+
+fn bench_poisson(mesh: &TriMesh) {
+    // About 100K samples.
+    let r = (0.7 * total_area(mesh) / 100_000.0).sqrt();
+    let opts = PoissonDiskOptions { radius: Some(r), seed: 1, ..Default::default() };
+    let mut count = 0;
+    let ms = median_ms(3, || {
+        count = poisson_disk_sampling(mesh, &opts).unwrap().0.samples.len();
+    });
+    println!("poisson samples {count}");
+    println!("BENCH poisson_disk median_ms={ms:.2}");
 }

@@ -19,6 +19,11 @@
 //! Known limit: obvhs's `f32` slab test may miss an exactly axis-parallel ray lying in a
 //! face plane of the mesh's bounding box (grazing the outermost boundary).
 //!
+//! **Batches.** [`Bvh::intersect_many`] and [`Bvh::occluded_many`] answer large batches
+//! in a cache-coherent order (rays sorted by box entry point and direction, module
+//! `bvh_ray_order`) over fixed chunks in parallel; every ray is still answered alone, so
+//! results equal the single-ray queries for any thread count.
+//!
 //! **Conventions.** `t` is the ray parameter: hit point `origin + t · dir` (a distance
 //! when `dir` is unit). Barycentric coordinates `[b0, b1, b2]` weight the triangle's
 //! corners in order. Triangles with a non-finite corner are left out (counted in
@@ -87,6 +92,8 @@ pub struct Bvh {
     nodes2: Vec<Bvh2Node>,
     prim_ids2: Vec<u32>,
     centre: V3,
+    /// Inverse half extents of the mesh box (finite, positive), for ray ordering.
+    inv_half: V3,
     /// `f64` corners of every mesh triangle (untranslated).
     corners: Vec<[V3; 3]>,
     /// Slack added to `f32` boxes in closest-point pruning.
@@ -181,6 +188,13 @@ impl Bvh {
     pub fn build(mesh: &TriMesh) -> Result<Self, MeshError> {
         crate::checks::check_indices(mesh)?;
         let centre = mesh.bounding_box().map_or([0.0; 3], |b| b.center());
+        let inv_half = mesh.bounding_box().map_or([1.0; 3], |b| {
+            let d = b.diagonal();
+            [0, 1, 2].map(|k| {
+                let h = 1.0 / (0.5 * (b.max[k] - b.min[k])).max(1e-9 * d);
+                if h.is_finite() { h } else { 1.0 }
+            })
+        });
         let extent = mesh.bounding_box().map_or(1.0, |b| b.diagonal().max(f64::MIN_POSITIVE));
         let corners: Vec<[V3; 3]> = mesh
             .triangles
@@ -232,6 +246,7 @@ impl Bvh {
             nodes2,
             prim_ids2,
             centre,
+            inv_half,
             corners,
             box_slack: 1e-6 * extent,
             n_skipped,
@@ -330,12 +345,12 @@ impl Bvh {
 
     /// [`Bvh::intersect`] for many rays, in parallel (deterministic).
     pub fn intersect_many(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
-        rays.par_iter().with_min_len(256).map(|r| self.intersect(r)).collect()
+        bvh_ray_order::map_coherent(rays, self.centre, self.inv_half, |r| self.intersect(r))
     }
 
     /// [`Bvh::occluded`] for many rays, in parallel (deterministic).
     pub fn occluded_many(&self, rays: &[Ray]) -> Vec<bool> {
-        rays.par_iter().with_min_len(256).map(|r| self.occluded(r)).collect()
+        bvh_ray_order::map_coherent(rays, self.centre, self.inv_half, |r| self.occluded(r))
     }
 
     /// The closest surface point to `p` (ties to the lower triangle index); `None` for an
@@ -510,6 +525,9 @@ pub fn closest_point_on_triangle(p: V3, c: [V3; 3]) -> (V3, [f64; 3]) {
     }
     best
 }
+
+#[path = "bvh_ray_order.rs"]
+mod bvh_ray_order;
 
 #[cfg(test)]
 #[path = "bvh_tests.rs"]

@@ -193,3 +193,34 @@ fn watertight_on_shared_edges_and_vertices() {
     }
     assert_eq!(n, 225);
 }
+
+#[test]
+fn batches_in_coherent_order_match_single_queries() {
+    // Large enough to take the sorted path of `bvh_ray_order`, with odd rays mixed in.
+    let m = torus(2.0, 0.7, 40, 16);
+    let bvh = Bvh::build(&m).unwrap();
+    let mut rs = rays(&m, 12_000);
+    for (i, r) in rs.iter_mut().enumerate().step_by(97) {
+        match i % 6 {
+            0 => r.dir = [0.0; 3],
+            1 => r.origin[1] = f64::NAN,
+            2 => *r = r.with_range(5.0, 1.0),
+            3 => r.origin = [0.1, 2.0, 0.05], // inside the box
+            4 => r.dir = [0.0, 0.0, -1.0],    // axis-parallel
+            _ => r.dir = [f64::INFINITY, 0.0, 0.0],
+        }
+    }
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| (bvh.intersect_many(&rs), bvh.occluded_many(&rs)))
+    };
+    let (hits, occ) = run(2);
+    assert_eq!((hits.clone(), occ.clone()), run(1));
+    let mut n_hits = 0;
+    for (i, r) in rs.iter().enumerate() {
+        assert_eq!(hits[i], bvh.intersect(r), "ray {i}");
+        assert_eq!(occ[i], bvh.occluded(r), "ray {i}");
+        n_hits += usize::from(occ[i]);
+    }
+    assert!(n_hits > 3000 && n_hits < 11_000, "{n_hits}");
+}
