@@ -104,6 +104,11 @@ enum Command {
         /// Disable the 2-RoSy fix of paper D §4 (ablation).
         #[arg(long)]
         no_rosy_fix: bool,
+        /// Disk-topology mesh patch: parameterise it (LSCM), design the field on it and
+        /// synthesise in parameter space; also writes model.glb. Plane designs and
+        /// presets are laid on the patch's UV bounding box.
+        #[arg(long)]
+        mesh: Option<PathBuf>,
         #[arg(long)]
         out: PathBuf,
     },
@@ -263,6 +268,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             grid,
             scale,
             no_rosy_fix,
+            mesh,
             out,
         } => {
             let source = match (design, preset, field) {
@@ -282,10 +288,12 @@ fn run(cli: Cli) -> Result<(), Error> {
             opts.scale = scale;
             opts.rosy_fix = !no_rosy_fix;
             opts.seed = g.seed;
+            let model = if mesh.is_some() { "model.glb, " } else { "" };
+            opts.mesh = mesh;
             let report = fieldtex::orient(&out, &opts, &progress)?;
             print_warnings(&report.warnings, g.quiet);
             say(&format!(
-                "wrote {}/texture.png, field.npy, preview.png, report.json",
+                "wrote {}/{model}texture.png, field.npy, preview.png, report.json",
                 out.display()
             ));
         }

@@ -6,6 +6,7 @@ pub mod eval;
 pub mod field;
 pub mod inspect;
 pub mod orient;
+pub(crate) mod orient_patch;
 pub mod render;
 pub(crate) mod synthesis;
 

@@ -5,6 +5,10 @@
 //! guided by the field's Jacobian with the 2-RoSy fix (`fieldtex-synth`) → texture,
 //! `field.npy`, a preview with the designed singularities marked, and a report with
 //! the metrics of `eval` plus singularity and phase-defect comparisons.
+//!
+//! With [`OrientOptions::mesh`] (a disk-topology patch) the work moves to
+//! [`super::orient_patch`]: the patch is parameterised, the field is designed on the
+//! mesh and the texture is synthesised in parameter space (paper D §4, curved patches).
 
 use crate::outputs::{prepare_out_dir, write_report};
 use crate::pipelines::eval::image_metrics;
@@ -39,11 +43,22 @@ pub struct OrientOptions {
     /// The 2-RoSy fix of paper D §4 (off only for the ablation). Default true.
     pub rosy_fix: bool,
     pub seed: u64,
+    /// A disk-topology mesh patch to texture (`--mesh`); `None` = the plane. Default None.
+    pub mesh: Option<PathBuf>,
 }
 
 impl OrientOptions {
     pub fn new(source: FieldSource, exemplar: PathBuf) -> Self {
-        Self { source, exemplar, size: 512, grid: 128, scale: 1.0, rosy_fix: true, seed: 1 }
+        Self {
+            source,
+            exemplar,
+            size: 512,
+            grid: 128,
+            scale: 1.0,
+            rosy_fix: true,
+            seed: 1,
+            mesh: None,
+        }
     }
 }
 
@@ -55,7 +70,7 @@ pub struct DesignedSingularity {
     pub index: f64,
 }
 
-fn kind_index(k: SingularityKind) -> f64 {
+pub(crate) fn kind_index(k: SingularityKind) -> f64 {
     match k {
         SingularityKind::Wedge => 0.5,
         SingularityKind::Trisector => -0.5,
@@ -147,6 +162,9 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
             format!("--scale must be in (0, 16], got {}", options.scale),
         ));
     }
+    if let Some(mesh) = &options.mesh {
+        return super::orient_patch::orient_patch(out_dir, options, mesh, progress);
+    }
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
     let exemplar = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
@@ -182,7 +200,10 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
 
 /// The texture with designed singularities marked: wedges (+1/2) as red discs,
 /// trisectors (−1/2) as blue triangles, other kinds as squares.
-fn preview_with_singularities(texture: &Image, designed: &[DesignedSingularity]) -> Image {
+pub(crate) fn preview_with_singularities(
+    texture: &Image,
+    designed: &[DesignedSingularity],
+) -> Image {
     use fieldtex_render::{
         ImageOverlay, ImageOverlayOptions, Marker2, MarkerShape, render_image_overlay,
     };
