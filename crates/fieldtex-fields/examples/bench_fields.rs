@@ -2,18 +2,22 @@
 //!
 //! `cargo run --release -p fieldtex-fields --example bench_fields [-- REPEATS]`
 //!
-//! Prints medians as `BENCH <name> median_ms=<value>` lines:
+//! Every interactive timing is what a front end sees: the edit, the re-solve and the
+//! 512² pixel sample into a kept buffer (`sample_plane_into`). Prints medians as
+//! `BENCH <name> median_ms=<value>` lines:
 //! - `field_factor`: from nothing to a factored design: DEC operators, assembly, symbolic
-//!   analysis, the preset's strokes, numeric factorisation (once per domain/stroke set);
+//!   analysis, the preset's strokes, numeric factorisation (once per domain);
 //! - `field_full_solve`: design → pixel field on the factored design: every singularity
-//!   re-placed (all model fields recomputed), right-hand side, solve, sample 512²;
-//! - `field_move_singularity`: move one wedge, re-solve (right-hand side only), sample 512²;
-//! - `field_add_stroke`: add one stroke (rank-1 factor updates per changed edge, see
-//!   `FieldDesignOptions::rank1_update_limit`), solve, sample 512²; the stroke is
-//!   removed again untimed (downdates);
-//! - `field_add_stroke_refactor`: the same with `rank1_update_limit = 0` (numeric
+//!   re-placed (all model fields recomputed), solve, sample 512²;
+//! - `field_move_singularity`: move one wedge, re-solve (right-hand side only), sample;
+//! - `field_add_stroke`: add one ~250 px stroke (rank-1 factor updates per changed edge,
+//!   see `FieldDesignOptions::rank1_update_limit`), solve, sample;
+//! - `field_move_stroke`: move that stroke by 2–6 px (`set_stroke`: updates for the
+//!   edges that change, downdates for those it leaves), solve, sample;
+//! - `field_remove_stroke`: remove it (downdates), solve, sample;
+//! - `field_add_stroke_refactor`: add with `rank1_update_limit = 0` (numeric
 //!   refactorisation with the kept symbolic analysis);
-//! - `field_add_short_stroke`: a ~18 px stroke (about 20 edges: rank-1 updates);
+//! - `field_add_short_stroke`: a ~18 px stroke (about 20 edges);
 //! - `field_numeric_refactor`: the numeric factorisation alone;
 //! - `field_move_singularity_solve_only` / `field_sample_512`: the move split into
 //!   re-solve and pixel sampling.
@@ -23,7 +27,7 @@
 
 use std::time::Instant;
 
-use fieldtex_fields::orientation_field::sample_plane;
+use fieldtex_fields::orientation_field::sample_plane_into;
 use fieldtex_fields::presets::preset;
 use fieldtex_fields::{Domain, FieldDesign, Stroke};
 
@@ -62,6 +66,7 @@ fn main() {
     let mut d = design.unwrap();
     println!("info: {} unknowns (edges), matrix nnz {}", d.dec().n_edges(), d.base_matrix().nnz());
     let singularities = file.singularity_list().unwrap();
+    let mut buf: Vec<[f32; 2]> = Vec::new();
     let ids: Vec<_> = singularities.iter().map(|s| d.add_singularity(*s).unwrap()).collect();
 
     let mut t_full = Vec::new();
@@ -71,9 +76,9 @@ fn main() {
             d.set_singularity(*id, *s).unwrap();
         }
         let f = d.solve().unwrap();
-        let px = sample_plane(&d, &f, size, size).unwrap();
+        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
         t_full.push(ms(t));
-        assert_eq!(px.len(), size * size);
+        assert_eq!(buf.len(), size * size);
     }
 
     let mut t_move = Vec::new();
@@ -87,9 +92,9 @@ fn main() {
         let t = Instant::now();
         d.move_singularity(ids[0], p).unwrap();
         let f = d.solve().unwrap();
-        let px = sample_plane(&d, &f, size, size).unwrap();
+        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
         t_move.push(ms(t));
-        assert_eq!(px.len(), size * size);
+        assert_eq!(buf.len(), size * size);
     }
 
     let mut t_solve_only = Vec::new();
@@ -101,27 +106,49 @@ fn main() {
         let f = d.solve().unwrap();
         t_solve_only.push(ms(t));
         let t = Instant::now();
-        let px = sample_plane(&d, &f, size, size).unwrap();
+        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
         t_sample.push(ms(t));
-        assert_eq!(px.len(), size * size);
+        assert_eq!(buf.len(), size * size);
     }
 
     let stroke_at = |k: usize| {
         let y = 150.0 + 10.0 * k as f64;
         Stroke::from_pixels(&[[60.0, y], [200.0, y - 20.0], [300.0, y + 10.0]])
     };
-    let mut t_stroke = Vec::new();
+    let (mut t_stroke, mut t_move_stroke, mut t_remove_stroke) =
+        (Vec::new(), Vec::new(), Vec::new());
     let updates_before = d.rank1_update_count();
+    let refactors_before = d.refactor_count();
     for k in 0..repeats {
         let t = Instant::now();
         let sid = d.add_stroke(stroke_at(k)).unwrap();
         let f = d.solve().unwrap();
-        let px = sample_plane(&d, &f, size, size).unwrap();
+        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
         t_stroke.push(ms(t));
-        assert_eq!(px.len(), size * size);
+        // Drag it by a few pixels (a front end re-solves on every mouse event).
+        let dy = 2.0 + (k % 3) as f64 * 2.0;
+        let moved = Stroke::from_pixels(&[
+            [60.0, 150.0 + 10.0 * k as f64 + dy],
+            [200.0, 130.0 + 10.0 * k as f64 + dy],
+            [300.0, 160.0 + 10.0 * k as f64 + dy],
+        ]);
+        let t = Instant::now();
+        d.set_stroke(sid, moved).unwrap();
+        let f = d.solve().unwrap();
+        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        t_move_stroke.push(ms(t));
+        let t = Instant::now();
         d.remove_stroke(sid).unwrap();
-        d.refactor_if_needed().unwrap();
+        let f = d.solve().unwrap();
+        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        t_remove_stroke.push(ms(t));
+        assert_eq!(buf.len(), size * size);
     }
+    println!(
+        "info: long strokes: {} rank-1 updates and {} refactorisations for {repeats} additions + moves + removals",
+        d.rank1_update_count() - updates_before,
+        d.refactor_count() - refactors_before
+    );
     // A short stroke (~18 px, about 20 edges): rank-1 updates instead of a refactor.
     let mut t_short = Vec::new();
     let updates_short = d.rank1_update_count();
@@ -130,9 +157,9 @@ fn main() {
         let t = Instant::now();
         let sid = d.add_stroke(Stroke::from_pixels(&[[60.0, y], [78.0, y - 3.0]])).unwrap();
         let f = d.solve().unwrap();
-        let px = sample_plane(&d, &f, size, size).unwrap();
+        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
         t_short.push(ms(t));
-        assert_eq!(px.len(), size * size);
+        assert_eq!(buf.len(), size * size);
         d.remove_stroke(sid).unwrap();
         d.refactor_if_needed().unwrap();
     }
@@ -140,11 +167,7 @@ fn main() {
         "info: short strokes: {} rank-1 updates for {repeats} additions + removals",
         d.rank1_update_count() - updates_short
     );
-    println!(
-        "info: {} rank-1 updates for {repeats} stroke additions + removals, {} refactorisations in all",
-        d.rank1_update_count() - updates_before,
-        d.refactor_count()
-    );
+    println!("info: {} refactorisations in all", d.refactor_count());
 
     let mut refactoring = FieldDesign::new(
         Domain::Plane(grid),
@@ -165,9 +188,9 @@ fn main() {
         let t = Instant::now();
         let sid = refactoring.add_stroke(stroke_at(k)).unwrap();
         let f = refactoring.solve().unwrap();
-        let px = sample_plane(&refactoring, &f, size, size).unwrap();
+        sample_plane_into(&refactoring, &f, size, size, &mut buf).unwrap();
         t_stroke_refactor.push(ms(t));
-        assert_eq!(px.len(), size * size);
+        assert_eq!(buf.len(), size * size);
         refactoring.remove_stroke(sid).unwrap();
         let t = Instant::now();
         refactoring.refactor_if_needed().unwrap();
@@ -180,6 +203,8 @@ fn main() {
     println!("BENCH field_move_singularity_solve_only median_ms={:.2}", median(t_solve_only));
     println!("BENCH field_sample_512 median_ms={:.2}", median(t_sample));
     println!("BENCH field_add_stroke median_ms={:.2}", median(t_stroke));
+    println!("BENCH field_move_stroke median_ms={:.2}", median(t_move_stroke));
+    println!("BENCH field_remove_stroke median_ms={:.2}", median(t_remove_stroke));
     println!("BENCH field_add_stroke_refactor median_ms={:.2}", median(t_stroke_refactor));
     println!("BENCH field_add_short_stroke median_ms={:.2}", median(t_short));
     println!("BENCH field_numeric_refactor median_ms={:.2}", median(t_refactor));

@@ -50,8 +50,10 @@
 //! solve factors it. Strokes change the diagonal of `A` by `Σ Δw_e e_e e_eᵀ`: small edits
 //! are rank-1 updates/downdates of the factor, larger ones a numeric refactorisation with
 //! the kept symbolic analysis ([`FieldDesign::refactor_if_needed`]; measured in
-//! `examples/bench_fields.rs`: one update ~1 ms, a refactorisation ~75–140 ms, a typical
-//! stroke ~240 edges — so only short strokes are updated).
+//! `examples/bench_fields.rs` on the 128² grid: one update ~0.27 ms, one downdate
+//! ~0.4–0.8 ms, a refactorisation ~90–140 ms, a typical stroke ~240 edges — so short
+//! strokes are updated and longer edits, beyond
+//! [`FieldDesignOptions::rank1_update_limit`], are refactored).
 
 use std::sync::Arc;
 
@@ -59,6 +61,7 @@ use fieldtex_core::Warnings;
 use fieldtex_core::vec3::{add, scale};
 use fieldtex_linalg::{Cholesky, CholeskyOptions, SparseMatrix, SymbolicCholesky, UpdateSign};
 use fieldtex_mesh::TriMesh;
+use rayon::prelude::*;
 
 use crate::FieldsError;
 use crate::dec::Dec;
@@ -96,7 +99,8 @@ pub struct SolvedField {
     pub one_form: Vec<f64>,
     /// `#F` Whitney vectors at the barycentres (3-D, tangent).
     pub face_vectors: Vec<[f64; 3]>,
-    /// Relative residual of the linear solve.
+    /// Relative residual of the linear solve (of the deviation from the model fields
+    /// where [`FieldDesign::solve`] solves for it; 0 when no solve was needed).
     pub residual: f64,
 }
 
@@ -475,8 +479,9 @@ impl FieldDesign {
     }
 
     /// Brings the numeric factorisation up to date with the strokes (no-op when it is;
-    /// the first call makes it). A stroke edit changes `A` by `Σ Δw_e e_e e_eᵀ`: when at
-    /// most [`FieldDesignOptions::rank1_update_limit`] edges change, the factor gets one
+    /// the first call makes it). A stroke edit changes `A` by `Σ Δw_e e_e e_eᵀ`: when
+    /// `updates + 2 × downdates` is at most [`FieldDesignOptions::rank1_update_limit`]
+    /// (edges gaining and losing weight), the factor gets one
     /// rank-1 update per edge (`Cholesky::update`, Davis & Hager 1999; additions first,
     /// then removals as downdates); otherwise, if a downdate is refused, or after
     /// `16 ×` that many updates since the last factorisation (to bound rounding drift),
@@ -495,7 +500,9 @@ impl FieldDesign {
                 .filter(|(_, (a, b))| a != b)
                 .map(|(e, (a, b))| (e, a - b))
                 .collect();
-            if changes.len() <= limit && self.updates_since_factor + changes.len() <= 16 * limit {
+            let n_down = changes.iter().filter(|c| c.1 < 0.0).count();
+            let cost = changes.len() + n_down;
+            if cost <= limit && self.updates_since_factor + changes.len() <= 16 * limit {
                 let ups = changes.iter().filter(|c| c.1 > 0.0);
                 let downs = changes.iter().filter(|c| c.1 < 0.0);
                 let mut ok = true;
@@ -536,14 +543,17 @@ impl FieldDesign {
         self.refactor_if_needed()
     }
 
-    /// The right-hand side `b` (`#E`) for the current singularities and strokes.
-    pub fn right_hand_side(&mut self) -> Vec<f64> {
+    /// Model 1-forms summed (`ω*`, `None` without model singularities), point divergence
+    /// (`#V`) and point curl (`#F`) of `PointDelta` poles, and whether there are any of
+    /// the latter. Model fields of new or moved singularities are computed (in parallel
+    /// over edges) and cached; the others are reused.
+    fn singular_terms(&mut self) -> (Option<Vec<f64>>, Vec<f64>, Vec<f64>, bool) {
         let ne = self.dec.n_edges();
         let floor = 1e-3 * self.dec.mean_edge_length;
-        let mut model = vec![0.0; ne];
-        let mut any_model = false;
+        let mut model: Option<Vec<f64>> = None;
         let mut s_point = vec![0.0; self.dec.n_vertices()];
         let mut c_point = vec![0.0; self.dec.n_faces()];
+        let mut any_point = false;
         let point = self.options.singularity_model == SingularityModel::PointDelta;
         for i in 0..self.singularities.len() {
             let Some(entry) = &self.singularities[i] else { continue };
@@ -556,6 +566,7 @@ impl FieldDesign {
                     s_point[self.dec.triangles[f][k] as usize] += two_pi * c[0] * b[k];
                 }
                 c_point[f] += two_pi * c[1];
+                any_point = true;
                 continue;
             }
             let one_form = match &entry.one_form {
@@ -573,27 +584,76 @@ impl FieldDesign {
                     w
                 }
             };
-            any_model = true;
-            for (a, b) in model.iter_mut().zip(one_form.iter()) {
-                *a += b;
+            match &mut model {
+                Some(sum) => {
+                    for (a, b) in sum.iter_mut().zip(one_form.iter()) {
+                        *a += b;
+                    }
+                }
+                None => model = Some(one_form.to_vec()),
             }
         }
+        (model, s_point, c_point, any_point)
+    }
+
+    /// The right-hand side `b` (`#E`) of `A ω = b` for the current singularities and
+    /// strokes (the full normal equations; [`FieldDesign::solve`] solves the cheaper
+    /// deviation system where it can, see there).
+    pub fn right_hand_side(&mut self) -> Vec<f64> {
+        let (model, s_point, c_point, _) = self.singular_terms();
         self.equations.right_hand_side(
             &self.dec,
-            any_model.then_some(&model[..]),
+            model.as_deref(),
             &s_point,
             &c_point,
             self.strokes.iter().flatten().map(|(_, cs)| &cs[..]),
         )
     }
 
-    /// Solves the design: refactors if strokes changed, rebuilds the right-hand side
-    /// (recomputing only the model fields of edited singularities), back-substitutes.
+    /// Solves the design: refactors (or rank-1 updates) if strokes changed, rebuilds the
+    /// right-hand side (recomputing only the model fields of edited singularities),
+    /// back-substitutes.
+    ///
+    /// Without `PointDelta` poles the normal equations read `A ω = A₀ ω* + W t` (`A₀`:
+    /// the stroke-free matrix, `W`, `t`: stroke weights and targets), so the deviation
+    /// `δ = ω − ω*` solves `A δ = W (t − ω*)`, whose right-hand side lives on the stroke
+    /// edges only: no sparse products, and no solve at all without strokes (`δ = 0`).
+    /// `residual` is then the relative residual of the deviation system. With point
+    /// poles the full `b` of [`FieldDesign::right_hand_side`] is solved.
     pub fn solve(&mut self) -> Result<SolvedField, FieldsError> {
         self.refactor_if_needed()?;
-        let b = self.right_hand_side();
+        let (model, s_point, c_point, any_point) = self.singular_terms();
         let factor = self.factor.as_ref().expect("refactor_if_needed made the factor");
-        let (one_form, residual) = factor.solve_with_residual(&b)?;
+        let (one_form, residual) = match model {
+            Some(model) if !any_point => {
+                let mut b = vec![0.0; self.dec.n_edges()];
+                let mut any = false;
+                for (_, cs) in self.strokes.iter().flatten() {
+                    for &(e, w, wt) in cs {
+                        b[e] += wt - w * model[e];
+                        any = true;
+                    }
+                }
+                if any {
+                    let (delta, residual) = factor.solve_with_residual(&b)?;
+                    let mut omega = model;
+                    omega.par_iter_mut().zip(delta.par_iter()).for_each(|(o, d)| *o += d);
+                    (omega, residual)
+                } else {
+                    (model, 0.0)
+                }
+            }
+            model => {
+                let b = self.equations.right_hand_side(
+                    &self.dec,
+                    model.as_deref(),
+                    &s_point,
+                    &c_point,
+                    self.strokes.iter().flatten().map(|(_, cs)| &cs[..]),
+                );
+                factor.solve_with_residual(&b)?
+            }
+        };
         let face_vectors = self.dec.face_vectors(&one_form);
         Ok(SolvedField { symmetry: self.symmetry, one_form, face_vectors, residual })
     }

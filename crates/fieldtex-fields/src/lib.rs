@@ -36,7 +36,7 @@
 //! design.move_singularity(core, [s.position[0] + 8.0, s.position[1], 0.0])?; // b only
 //! let extra = design.add_singularity(Singularity::at_pixel(SingularityKind::Wedge, 60.5, 70.5))?;
 //! design.remove_singularity(extra)?;
-//! let stroke = design.add_stroke(Stroke::from_pixels(&[[20.0, 200.0], [230.0, 210.0]]))?; // refactor
+//! let stroke = design.add_stroke(Stroke::from_pixels(&[[20.0, 200.0], [230.0, 210.0]]))?; // rank-1 updates
 //! let field = design.solve()?;
 //! # let _ = (field, stroke);
 //! # Ok::<(), fieldtex_fields::FieldsError>(())

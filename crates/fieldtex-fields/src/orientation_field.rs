@@ -140,13 +140,31 @@ pub fn vertex_directions(design: &FieldDesign, field: &SolvedField) -> Vec<[f64;
 /// Samples a plane design on a `width × height` pixel grid covering the domain
 /// rectangle (pixel `(c, r)` at domain point `((c+½)·W/width, (r+½)·H/height)`):
 /// barycentric interpolation of the per-vertex doubled vectors, then the N-RoSy root.
-/// Errors for mesh domains.
+/// Errors for mesh domains. See [`sample_plane_into`] to reuse the output buffer.
 pub fn sample_plane(
     design: &FieldDesign,
     field: &SolvedField,
     width: usize,
     height: usize,
 ) -> Result<Vec<[f32; 2]>, FieldsError> {
+    let mut out = Vec::new();
+    sample_plane_into(design, field, width, height, &mut out)?;
+    Ok(out)
+}
+
+/// [`sample_plane`] into a caller-kept buffer (resized to `width · height`), for
+/// interactive re-sampling without a fresh 2 MB allocation per frame (512²).
+///
+/// Point location is separable on the regular grid: each column's cell and `u`, and
+/// each row's cell and `v`, are computed once; rows are sampled in parallel (disjoint
+/// outputs, so the result does not depend on the thread count).
+pub fn sample_plane_into(
+    design: &FieldDesign,
+    field: &SolvedField,
+    width: usize,
+    height: usize,
+    out: &mut Vec<[f32; 2]>,
+) -> Result<(), FieldsError> {
     let grid = *design.plane().ok_or(FieldsError::InvalidOption {
         name: "sample_plane domain",
         value: 0.0,
@@ -158,17 +176,23 @@ pub fn sample_plane(
     let zv = vertex_complex(design, field);
     let symmetry = field.symmetry;
     let (nx, ny) = (grid.nx, grid.ny);
-    // Pixel → grid coordinates: g = (pixel + ½) · (cells / pixels).
-    let (kx, ky) = (nx as f64 / width as f64, ny as f64 / height as f64);
-    let mut out = vec![[0.0f32; 2]; width * height];
-    out.par_chunks_mut(width).enumerate().for_each(|(r, row)| {
-        let gy = (r as f64 + 0.5) * ky;
-        let j = (gy as usize).min(ny - 1);
-        let v = (gy - j as f64).clamp(0.0, 1.0);
-        for (c, px) in row.iter_mut().enumerate() {
-            let gx = (c as f64 + 0.5) * kx;
-            let i = (gx as usize).min(nx - 1);
-            let u = (gx - i as f64).clamp(0.0, 1.0);
+    // Pixel → grid coordinates: g = (pixel + ½) · (cells / pixels); cell index and the
+    // local coordinate in [0, 1], per column and per row.
+    let axis = |pixels: usize, cells: usize| -> Vec<(usize, f64)> {
+        let k = cells as f64 / pixels as f64;
+        (0..pixels)
+            .map(|p| {
+                let g = (p as f64 + 0.5) * k;
+                let i = (g as usize).min(cells - 1);
+                (i, (g - i as f64).clamp(0.0, 1.0))
+            })
+            .collect()
+    };
+    let (cols, rows) = (axis(width, nx), axis(height, ny));
+    out.clear();
+    out.resize(width * height, [0.0; 2]);
+    out.par_chunks_mut(width).zip(rows.par_iter()).for_each(|(row, &(j, v))| {
+        for (px, &(i, u)) in row.iter_mut().zip(&cols) {
             // Cell corners a=(i,j) b=(i+1,j) c=(i+1,j+1) d=(i,j+1); triangles as in
             // PlaneGrid::locate.
             let a = j * (nx + 1) + i;
@@ -191,7 +215,7 @@ pub fn sample_plane(
             *px = nrosy_root_f32(z, symmetry);
         }
     });
-    Ok(out)
+    Ok(())
 }
 
 /// Singularities of the solved field on the design mesh (per-vertex index of the
