@@ -414,3 +414,133 @@ fn field_greedy_beats_arbitrary_on_fandisk() {
     assert!(res[0].0 <= res[1].0, "singularities greedy {} vs arbitrary {}", res[0].0, res[1].0);
     assert!(res[0].1 <= res[1].1, "energy greedy {} vs arbitrary {}", res[0].1, res[1].1);
 }
+
+/// A bumpy spherical cap (disk topology) as OBJ text: `rings` rings of the unit disk
+/// lifted onto a sphere of radius 1.5 with a gentle bump, y up.
+fn bumpy_cap_obj(rings: usize) -> String {
+    let mut m = fieldtex::crates::fields::disk_mesh(1.0, rings);
+    for p in &mut m.positions {
+        let (x, y) = (p[0], p[1]);
+        let h = (2.25 - x * x - y * y).sqrt() - 1.25f64.sqrt()
+            + 0.06 * (3.0 * x).sin() * (2.0 * y).cos();
+        *p = [x, h, -y];
+    }
+    let mut s = String::new();
+    for p in &m.positions {
+        s.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    for t in &m.triangles {
+        s.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    s
+}
+
+/// `orient --mesh` on a curved disk patch: every output, byte-identical for 1 and 2
+/// threads (report too, timings aside), and a model.glb the Khronos validator accepts.
+#[test]
+fn orient_patch_outputs_determinism_and_valid_glb() {
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let work = tmp("orient-patch");
+    let cap = work.join("cap.obj");
+    std::fs::write(&cap, bumpy_cap_obj(14)).unwrap();
+    let (a, b) = (work.join("t1"), work.join("t2"));
+    for (dir, t) in [(&a, "1"), (&b, "2")] {
+        let o = run(
+            &[
+                "orient",
+                "--preset",
+                "right-loop",
+                "--exemplar",
+                ex.to_str().unwrap(),
+                "--mesh",
+                cap.to_str().unwrap(),
+                "--size",
+                "128",
+                "--out",
+                dir.to_str().unwrap(),
+                "--threads",
+                t,
+                "--quiet",
+            ],
+            Duration::from_secs(300),
+        );
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+    }
+    for f in ["texture.png", "field.npy", "preview.png", "model.glb"] {
+        let x = std::fs::read(a.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        assert!(x == std::fs::read(b.join(f)).unwrap(), "{f} differs between 1 and 2 threads");
+    }
+    let r = report_without_timings(&a);
+    assert_eq!(r, report_without_timings(&b));
+    assert_eq!(r["metrics"]["designed_singularities"].as_array().unwrap().len(), 2);
+    // A sanity bound; the 10° target is tested at 160² in crates/fieldtex/tests.
+    let err = r["metrics"]["chart_orientation_error"]["mean_error_deg"].as_f64().unwrap();
+    assert!(err <= 12.0, "chart orientation error {err}°");
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
+    assert!(
+        validator.join("node_modules/gltf-validator").is_dir(),
+        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
+    );
+    let o = Command::new("node")
+        .arg(validator.join("validate.js"))
+        .arg(a.join("model.glb"))
+        .output()
+        .expect("node runs");
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    assert_eq!(
+        report["issues"]["numErrors"].as_u64(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+}
+
+/// `orient --mesh` refuses meshes that are not one disk (a closed torus, a patch with
+/// a hole) with exit 2 and a message naming the topology.
+#[test]
+fn orient_patch_refuses_non_disk_meshes() {
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let work = tmp("orient-patch-non-disk");
+    // A 6×6 grid with its middle 2×2 cells missing: one component, two boundary loops.
+    let mut holed = String::new();
+    for j in 0..=6 {
+        for i in 0..=6 {
+            holed.push_str(&format!("v {i} {j} 0\n"));
+        }
+    }
+    for j in 0..6 {
+        for i in 0..6 {
+            if (2..4).contains(&i) && (2..4).contains(&j) {
+                continue;
+            }
+            let v = |i: usize, j: usize| j * 7 + i + 1;
+            holed.push_str(&format!("f {} {} {}\n", v(i, j), v(i + 1, j), v(i + 1, j + 1)));
+            holed.push_str(&format!("f {} {} {}\n", v(i, j), v(i + 1, j + 1), v(i, j + 1)));
+        }
+    }
+    let holed_path = work.join("holed.obj");
+    std::fs::write(&holed_path, holed).unwrap();
+    let torus = shared().join("meshes/torus.obj");
+    for (mesh, loops) in [(torus, "0 boundary loop"), (holed_path, "2 boundary loop")] {
+        let o = run(
+            &[
+                "orient",
+                "--preset",
+                "arch",
+                "--exemplar",
+                ex.to_str().unwrap(),
+                "--mesh",
+                mesh.to_str().unwrap(),
+                "--size",
+                "64",
+                "--out",
+                work.join("out").to_str().unwrap(),
+            ],
+            Duration::from_secs(120),
+        );
+        assert_eq!(code(&o), 2, "{}: {}", mesh.display(), stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("disk") && e.contains(loops), "{e}");
+        assert!(!e.contains("panicked"), "{e}");
+    }
+}
