@@ -76,6 +76,8 @@ fn main() {
     let mut kind = "swirl".to_string();
     let (mut size, mut runs, mut seed, mut rosy) = (512usize, 5usize, 1u64, true);
     let mut opts = SynthesisOptions::default();
+    let mut aopts = AnalysisOptions::default();
+    let mut out_dir = PathBuf::from("/tmp");
     while let Some(a) = args.next() {
         match a.as_str() {
             "--size" => size = args.next().and_then(|v| v.parse().ok()).expect("--size N"),
@@ -89,6 +91,19 @@ fn main() {
                 opts.correction_passes =
                     args.next().and_then(|v| v.parse().ok()).expect("--passes N")
             }
+            "--unjittered" => {
+                opts.unjittered_levels =
+                    args.next().and_then(|v| v.parse().ok()).expect("--unjittered N")
+            }
+            "--out" => out_dir = args.next().map(PathBuf::from).expect("--out DIR"),
+            "--scan" => {
+                aopts.coherence_scan = args.next().and_then(|v| v.parse().ok()).expect("--scan N")
+            }
+            "--tileable" => aopts.tileable = true,
+            "--k" => {
+                aopts.k = args.next().and_then(|v| v.parse().ok()).expect("--k N");
+                opts.k = aopts.k;
+            }
             "--no-rosy-fix" => rosy = false,
             s if s.ends_with(".png") => exemplar = PathBuf::from(s),
             s => kind = s.to_string(),
@@ -101,8 +116,7 @@ fn main() {
     let mut analysis = None;
     for _ in 0..runs.max(1) {
         let t = Instant::now();
-        analysis =
-            Some(ExemplarAnalysis::new(&ex, &AnalysisOptions::default(), &NoProgress).unwrap());
+        analysis = Some(ExemplarAnalysis::new(&ex, &aopts, &NoProgress).unwrap());
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
     let analysis = analysis.unwrap();
@@ -128,7 +142,7 @@ fn main() {
     let levels: Vec<String> = result.level_timings_ms.iter().map(|t| format!("{t:.0}")).collect();
     println!("BENCH synth_{size} median_ms={:.1} levels_ms=[{}]", median(times), levels.join(","));
     let tag = if rosy { "" } else { "_norosy" };
-    let out = PathBuf::from(format!("/tmp/synth_{name}_{kind}{tag}.png"));
+    let out = out_dir.join(format!("synth_{name}_{kind}{tag}.png"));
     save(&result.colors, &out);
     let (w, h) = (analysis.width() as f32, analysis.height() as f32);
     let coords = Image {

@@ -59,6 +59,11 @@ pub struct SynthesisOptions {
     pub subpasses: usize,
     /// Jitter amplitude as a fraction of the level spacing. Default 0.4.
     pub jitter: f32,
+    /// Number of finest levels synthesised without jitter (level `c` is jittered when
+    /// `c ≥ unjittered_levels`). Jitter at the finest levels breaks pixel-exact
+    /// coherence that the correction passes then only partly restore. Default 0.
+    #[serde(default = "default_unjittered_levels")]
+    pub unjittered_levels: usize,
     /// k-coherence candidates used per neighbour (at most the analysis' k). Default 2.
     pub k: usize,
     /// Multiplier of every domain Jacobian (exemplar pixels per domain sample on top
@@ -76,11 +81,16 @@ impl Default for SynthesisOptions {
             correction_passes: 2,
             subpasses: 4,
             jitter: 0.4,
+            unjittered_levels: default_unjittered_levels(),
             k: 2,
             scale: 1.0,
             rosy_fix: true,
         }
     }
+}
+
+fn default_unjittered_levels() -> usize {
+    0
 }
 
 /// Result of [`synthesize`]: per finest-level sample (row-major over
@@ -115,13 +125,27 @@ struct LevelTables {
     corner_dir: Vec<[u8; 4]>,
 }
 
-/// The [`LevelTables::corner_dir`] entry of Jacobian `j`.
+/// Unit vectors of [`OFFS8`] (angle `k · 45°`).
+const DIRS8: [[f32; 2]; 8] = {
+    const R: f32 = std::f32::consts::FRAC_1_SQRT_2;
+    [[1.0, 0.0], [R, R], [0.0, 1.0], [-R, R], [-1.0, 0.0], [-R, -R], [0.0, -1.0], [R, -R]]
+};
+
+/// The [`LevelTables::corner_dir`] entry of Jacobian `j`: per corner, the direction of
+/// [`OFFS8`] with the largest dot product with `J⁻¹ Δ` (the angularly nearest; the
+/// lowest index on exact ties).
 fn corner_directions(j: &[f32; 4]) -> [u8; 4] {
     let jinv = inverse(j);
     CORNERS.map(|cd| {
         let phi = mat_vec(&jinv, [cd[0] as f32, cd[1] as f32]);
-        let oct = (phi[1].atan2(phi[0]) / std::f32::consts::FRAC_PI_4).round() as i32;
-        oct.rem_euclid(8) as u8
+        let mut best = (f32::NEG_INFINITY, 0u8);
+        for (k, d) in DIRS8.iter().enumerate() {
+            let dot = d[0] * phi[0] + d[1] * phi[1];
+            if dot > best.0 {
+                best = (dot, k as u8);
+            }
+        }
+        best.1
     })
 }
 
@@ -200,14 +224,19 @@ fn mat_vec(j: &[f32; 4], v: [f32; 2]) -> [f32; 2] {
     [j[0] * v[0] + j[1] * v[1], j[2] * v[0] + j[3] * v[1]]
 }
 
-/// Squared distance between a quantised vector `a` and a target `t` given in units of
-/// `a / 6` (exact integer arithmetic: `|6a − t| ≤ 1524`, the sum fits `i32` easily).
+/// Lanes of a four-corner neighbourhood vector: 4 corners × [`APPEARANCE_DIMS`].
+const NV: usize = 4 * APPEARANCE_DIMS;
+
+/// Squared distance between a quantised neighbourhood vector `a` and a target `t` given
+/// in units of `a / 6`, over the lanes whose mask is `−1` (exact integer arithmetic:
+/// `|6a − t| ≤ 1524`, 32 squares fit `i32` easily). Written so that it vectorises
+/// (`pmaddwd`).
 #[inline]
-fn dist_q(a: &[i8; APPEARANCE_DIMS], t: &[i16; APPEARANCE_DIMS]) -> i32 {
+fn dist_nv(a: &[i8; NV], t: &[i16; NV], mask: &[i16; NV]) -> i32 {
     let mut acc = 0i32;
-    for i in 0..APPEARANCE_DIMS {
-        let d = (a[i] as i16 * 6 - t[i]) as i32;
-        acc += d * d;
+    for i in 0..NV {
+        let d = ((a[i] as i16) * 6 - t[i]) & mask[i];
+        acc += d as i32 * d as i32;
     }
     acc
 }
@@ -224,13 +253,15 @@ fn inverse(j: &[f32; 4]) -> [f32; 4] {
 }
 
 /// The exemplar side of one level.
-struct ExemplarLevel<'a> {
+struct ExemplarLevel {
     w: usize,
     h: usize,
     wf: f32,
     hf: f32,
-    /// Quantised appearance `[Ẽ₀, Ẽ₁]`.
-    app: [&'a [[i8; APPEARANCE_DIMS]]; 2],
+    /// Four-corner neighbourhood vectors of every pixel for `[Ẽ₀, Ẽ₁]`: `nv[f][pix]`
+    /// holds, for corner `ci` of [`CORNERS`] in lanes `8 ci .. 8 ci + 8`, the quantised
+    /// appearance `Ẽ_f[pix + (−1)^f h Δ_ci]` (toroidal). One 32-byte load per candidate.
+    nv: [Vec<[i8; NV]>; 2],
     /// k-coherence targets as pixel coordinates (`W × H × k_store`).
     coherence: Vec<[f32; 2]>,
     k_store: usize,
@@ -239,9 +270,6 @@ struct ExemplarLevel<'a> {
     x_hi: usize,
     y_lo: usize,
     y_hi: usize,
-    /// `(x − h) mod W` and `(x + h) mod W` per column; rows likewise (`h` = spacing).
-    cols: Vec<[u32; 2]>,
-    rows: Vec<[u32; 2]>,
 }
 
 #[inline]
@@ -260,24 +288,35 @@ fn wrap1(v: f32, size: f32) -> f32 {
     if r >= size || r.is_nan() { 0.0 } else { r }
 }
 
-impl<'a> ExemplarLevel<'a> {
-    fn new(analysis: &'a ExemplarAnalysis, level: usize) -> Self {
+impl ExemplarLevel {
+    fn new(analysis: &ExemplarAnalysis, level: usize, rosy: bool) -> Self {
         let an = analysis.level(level);
         let (w, h) = (analysis.width(), analysis.height());
         let sp = an.spacing as i64;
-        let table = |n: usize| -> Vec<[u32; 2]> {
-            (0..n as i64)
-                .map(|i| {
-                    [(i - sp).rem_euclid(n as i64) as u32, (i + sp).rem_euclid(n as i64) as u32]
-                })
-                .collect()
+        let wrap_i = |v: i64, n: usize| v.rem_euclid(n as i64) as usize;
+        // Neighbourhood vectors (the flipped copy only when the 2-RoSy fix needs it).
+        let nv_of = |f: usize| -> Vec<[i8; NV]> {
+            let app = &an.appearance_q.data[f];
+            let sign = if f == 1 { -1 } else { 1 };
+            let mut out = vec![[0i8; NV]; w * h];
+            out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                for (x, o) in row.iter_mut().enumerate() {
+                    for (ci, c) in CORNERS.iter().enumerate() {
+                        let cx = wrap_i(x as i64 + sign * c[0] as i64 * sp, w);
+                        let cy = wrap_i(y as i64 + sign * c[1] as i64 * sp, h);
+                        o[ci * APPEARANCE_DIMS..(ci + 1) * APPEARANCE_DIMS]
+                            .copy_from_slice(&app[cy * w + cx]);
+                    }
+                }
+            });
+            out
         };
         Self {
             w,
             h,
             wf: w as f32,
             hf: h as f32,
-            app: [&an.appearance_q.data[0], &an.appearance_q.data[1]],
+            nv: [nv_of(0), if rosy { nv_of(1) } else { Vec::new() }],
             coherence: an
                 .coherence
                 .iter()
@@ -288,8 +327,6 @@ impl<'a> ExemplarLevel<'a> {
             x_hi: w - an.margin.min(w / 2),
             y_lo: an.margin.min(h / 2),
             y_hi: h - an.margin.min(h / 2),
-            cols: table(w),
-            rows: table(h),
         }
     }
 
@@ -312,20 +349,11 @@ impl<'a> ExemplarLevel<'a> {
         let (x, y) = self.cell(u);
         y * self.w + x
     }
-
-    /// Pixel at corner `c` (index into [`CORNERS`]) of cell `(x, y)`, the corner
-    /// offset `± h` negated when `flip`.
-    #[inline]
-    fn corner(&self, x: usize, y: usize, c: usize, flip: bool) -> usize {
-        let sx = (c & 1) ^ flip as usize;
-        let sy = (c >> 1) ^ flip as usize;
-        self.rows[y][sy] as usize * self.w + self.cols[x][sx] as usize
-    }
 }
 
 /// Per-level synthesis context.
 struct Pass<'a> {
-    ex: ExemplarLevel<'a>,
+    ex: ExemplarLevel,
     t: &'a LevelTables,
     spacing: f32,
     k: usize,
@@ -339,8 +367,9 @@ impl Pass<'_> {
         let h = self.spacing;
         let jp = self.t.jac[p];
         let nb = &self.t.nbr[p];
-        // Predictions of p's coordinate by each neighbour.
-        let mut pred = [([0.0f32; 2], false, [0.0f32; 4]); 8];
+        // Predictions of p's coordinate by each neighbour: (coordinate, flip, the
+        // neighbour's effective offset h F(q) δ).
+        let mut pred = [([0.0f32; 2], false, [0.0f32; 2]); 8];
         let mut valid = [false; 8];
         for k in 0..8 {
             let q = nb[k];
@@ -358,15 +387,18 @@ impl Pass<'_> {
             };
             let d = OFFS8[k];
             let off = mat_vec(&fq, [d[0] as f32 * h, d[1] as f32 * h]);
-            pred[k] = (ex.wrap([s[q][0] - off[0], s[q][1] - off[1]]), alpha, fq);
+            pred[k] = (ex.wrap([s[q][0] - off[0], s[q][1] - off[1]]), alpha, off);
             valid[k] = true;
         }
         // Four-corner neighbourhood of p, averaged over three predictions per corner.
         // Targets are kept as 6 × the mean (6 = lcm of the possible counts 1, 2, 3), so
-        // the whole comparison is exact integer arithmetic.
-        let mut target = [[0i16; APPEARANCE_DIMS]; 4];
-        let mut weight = [false; 4];
+        // the whole comparison is exact integer arithmetic. Corners without any
+        // prediction (domain border) are masked out.
+        let mut target = [0i16; NV];
+        let mut mask = [0i16; NV];
         for (ci, &dir) in self.t.corner_dir[p].iter().enumerate() {
+            let lanes = ci * APPEARANCE_DIMS..(ci + 1) * APPEARANCE_DIMS;
+            let tc = &mut target[lanes.clone()];
             let mut count = 0i16;
             for t in [dir + 7, dir, dir + 1] {
                 let t = (t % 8) as usize;
@@ -374,53 +406,32 @@ impl Pass<'_> {
                     continue;
                 }
                 let (u, a, _) = pred[t];
-                let (x, y) = ex.cell(u);
-                let v = &ex.app[a as usize][ex.corner(x, y, ci, a)];
-                for (o, &x) in target[ci].iter_mut().zip(v) {
+                let v = &ex.nv[a as usize][ex.pixel(u)][lanes.clone()];
+                for (o, &x) in tc.iter_mut().zip(v) {
                     *o += x as i16;
                 }
                 count += 1;
             }
             if count > 0 {
                 let f = 6 / count;
-                target[ci].iter_mut().for_each(|x| *x *= f);
-                weight[ci] = true;
+                tc.iter_mut().for_each(|x| *x *= f);
+                mask[lanes].fill(-1);
             }
         }
-        // Candidates are compared over the known corners (all four away from the domain
-        // border). The score depends only on the candidate's pixel and flip: each
-        // distinct (pixel, flip) is evaluated once; ties keep the earlier candidate.
-        let mut seen = [u32::MAX; 1 + 8 * (1 + MAX_K)];
-        let mut n_seen = 0usize;
+        // The candidate with the smallest distance wins; ties keep the earlier one (so
+        // repeated candidates change nothing). Coordinates outside the level's margin
+        // band are not eligible.
         let mut best = (s[p], fl[p] && self.rosy);
         let mut best_d = i32::MAX;
         // Returns the best distance so far.
         let mut consider = |u: [f32; 2], b: bool, best: &mut ([f32; 2], bool)| -> i32 {
             let (x, y) = ex.cell(u);
-            if x < ex.x_lo || x >= ex.x_hi || y < ex.y_lo || y >= ex.y_hi {
-                return best_d;
-            }
-            let pix = y * ex.w + x;
-            let key = (pix as u32) << 1 | b as u32;
-            if seen[..n_seen].contains(&key) {
-                return best_d;
-            }
-            seen[n_seen] = key;
-            n_seen += 1;
-            let app = ex.app[b as usize];
-            let mut total = 0i32;
-            for ci in 0..4 {
-                if weight[ci] {
-                    total += dist_q(&app[ex.corner(x, y, ci, b)], &target[ci]);
-                    // Partial distances only grow: stop once this one cannot win.
-                    if total >= best_d {
-                        return best_d;
-                    }
+            if x >= ex.x_lo && x < ex.x_hi && y >= ex.y_lo && y < ex.y_hi {
+                let d = dist_nv(&ex.nv[b as usize][y * ex.w + x], &target, &mask);
+                if d < best_d {
+                    best_d = d;
+                    *best = (u, b);
                 }
-            }
-            if total < best_d {
-                best_d = total;
-                *best = (u, b);
             }
             best_d
         };
@@ -433,7 +444,7 @@ impl Pass<'_> {
             if !valid[k] {
                 continue;
             }
-            let (u, a, fq) = pred[k];
+            let (u, a, off) = pred[k];
             consider(u, a, &mut best);
             if self.k == 0 {
                 continue;
@@ -442,10 +453,7 @@ impl Pass<'_> {
             // Coordinates are wrapped (non-negative): truncation is the floor.
             let frac = [sq[0] - (sq[0] as i32) as f32, sq[1] - (sq[1] as i32) as f32];
             let base = ex.pixel(sq) * ex.k_store;
-            let dd = OFFS8[k];
-            let off = mat_vec(&fq, [dd[0] as f32 * h, dd[1] as f32 * h]);
-            for i in 0..self.k {
-                let v = ex.coherence[base + i];
+            for v in &ex.coherence[base..base + self.k] {
                 let c = ex.wrap([v[0] + frac[0] - off[0], v[1] + frac[1] - off[1]]);
                 consider(c, a, &mut best);
             }
@@ -528,11 +536,11 @@ pub fn synthesize(
         let start = Instant::now();
         let tables = tabulate(domain, level, options.scale, options.subpasses, true)?;
         let an = analysis.level(level);
-        let ex = ExemplarLevel::new(analysis, level);
+        let ex = ExemplarLevel::new(analysis, level, options.rosy_fix);
         let spacing = an.spacing as f32;
         let n = tables.jac.len();
         // 1. Upsampling with the parent's effective frame; 2. jitter.
-        let amp = options.jitter * spacing;
+        let amp = if level < options.unjittered_levels { 0.0 } else { options.jitter * spacing };
         let seed = options.seed;
         let (ps, pf, pj) = (&s, &fl, &parent_tables.jac);
         let rosy = options.rosy_fix;
