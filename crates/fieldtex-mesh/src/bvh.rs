@@ -12,7 +12,8 @@
 //! **Precision.** Traversal is `f32` (obvhs); the mesh is translated so its bounding box
 //! is centred at the origin first, which keeps `f32` relative precision for meshes far
 //! from the origin. Ray–triangle tests use the watertight algorithm of Woop, Benthin &
-//! Wald 2013 ("Watertight Ray/Triangle Intersection", JCGT 2(1)), so a ray through a
+//! Wald 2013 ("Watertight Ray/Triangle Intersection", JCGT 2(1); module `bvh_watertight`,
+//! on triangles stored by coordinate rows in BVH leaf order), so a ray through a
 //! shared edge or vertex never slips between triangles; the winning triangle's `t` and
 //! barycentric coordinates are then recomputed in `f64`. Ties (same `t`) go to the lower
 //! triangle index, so results do not depend on the tree layout or the thread count.
@@ -31,6 +32,7 @@
 //! queries can return them).
 
 use crate::{MeshError, TriMesh};
+use bvh_watertight::{RowTriangle, Shear};
 use fieldtex_core::vec3::{self, V3};
 use glam::{UVec2, Vec3A};
 use obvhs::BvhBuildParams;
@@ -85,7 +87,7 @@ pub struct ClosestPoint {
 pub struct Bvh {
     cwbvh: CwBvh,
     /// `f32` triangles in BVH primitive order (translated by `-centre`).
-    prim_tris: Vec<Triangle>,
+    prim_tris: Vec<RowTriangle>,
     /// Mesh triangle of each BVH primitive.
     prim_ids: Vec<u32>,
     /// Binary BVH for closest-point queries (boxes translated by `-centre`).
@@ -114,73 +116,6 @@ impl std::fmt::Debug for Bvh {
 #[inline]
 fn to_f32(p: V3, c: V3) -> Vec3A {
     Vec3A::new((p[0] - c[0]) as f32, (p[1] - c[1]) as f32, (p[2] - c[2]) as f32)
-}
-
-/// Per-ray constants of the watertight test (Woop et al. 2013, §3): the dominant axis
-/// `kz` of the direction, the two others, and the shear.
-#[derive(Clone, Copy)]
-struct Shear {
-    k: [usize; 3],
-    s: [f32; 3],
-    org: Vec3A,
-    tmin: f32,
-    tmax: f32,
-}
-
-impl Shear {
-    fn new(r: &ORay) -> Self {
-        let d = r.direction;
-        let kz = if d.x.abs() >= d.y.abs() && d.x.abs() >= d.z.abs() {
-            0
-        } else if d.y.abs() >= d.z.abs() {
-            1
-        } else {
-            2
-        };
-        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        Self {
-            k: [kx, ky, kz],
-            s: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]],
-            org: r.origin,
-            tmin: r.tmin,
-            tmax: r.tmax,
-        }
-    }
-
-    /// Ray parameter of the hit with triangle `tri`, or `f32::INFINITY`.
-    #[inline(always)]
-    fn intersect(&self, tri: &Triangle) -> f32 {
-        let [kx, ky, kz] = self.k;
-        let [sx, sy, sz] = self.s;
-        let a = (tri.v0 - self.org).to_array();
-        let b = (tri.v1 - self.org).to_array();
-        let c = (tri.v2 - self.org).to_array();
-        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            // Exactly on an edge in f32: decide in f64 (§3.3 of the paper).
-            let f = |x: f32| x as f64;
-            u = (f(cx) * f(by) - f(cy) * f(bx)) as f32;
-            v = (f(ax) * f(cy) - f(ay) * f(cx)) as f32;
-            w = (f(bx) * f(ay) - f(by) * f(ax)) as f32;
-        }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-            return f32::INFINITY;
-        }
-        let det = u + v + w;
-        if det == 0.0 {
-            return f32::INFINITY;
-        }
-        let t = (u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz])) / det;
-        if t >= self.tmin && t <= self.tmax { t } else { f32::INFINITY }
-    }
 }
 
 impl Bvh {
@@ -231,8 +166,8 @@ impl Bvh {
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
             let cw = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
-            let prim_tris: Vec<Triangle> =
-                cw.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
+            let prim_tris: Vec<RowTriangle> =
+                cw.primitive_indices.iter().map(|&i| RowTriangle::new(&tris[i as usize])).collect();
             let prim_ids: Vec<u32> =
                 cw.primitive_indices.iter().map(|&i| keep[i as usize]).collect();
             let prim_ids2: Vec<u32> =
@@ -318,7 +253,7 @@ impl Bvh {
         let tri = self.prim_ids[best_prim as usize];
         let (t, bary) =
             refine_hit(self.corners[tri as usize], ray.origin, ray.dir).unwrap_or_else(|| {
-                let b = self.prim_tris[best_prim as usize].compute_barycentric(&oray);
+                let b = self.prim_tris[best_prim as usize].triangle().compute_barycentric(&oray);
                 (best_t as f64, [1.0 - (b.x + b.y) as f64, b.x as f64, b.y as f64])
             });
         Some(Hit { triangle: tri, t, barycentric: bary })
@@ -525,6 +460,9 @@ pub fn closest_point_on_triangle(p: V3, c: [V3; 3]) -> (V3, [f64; 3]) {
     }
     best
 }
+
+#[path = "bvh_watertight.rs"]
+mod bvh_watertight;
 
 #[path = "bvh_ray_order.rs"]
 mod bvh_ray_order;

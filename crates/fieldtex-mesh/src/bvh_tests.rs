@@ -224,3 +224,35 @@ fn batches_in_coherent_order_match_single_queries() {
     }
     assert!(n_hits > 3000 && n_hits < 11_000, "{n_hits}");
 }
+
+#[test]
+fn rays_aimed_at_vertices_and_edge_midpoints_never_miss() {
+    // Every ray coming from the outside, roughly along the normal, aimed exactly at a
+    // vertex or an edge midpoint of a closed mesh hits at or before it: no slipping
+    // through shared corners and edges. (Grazing silhouette rays may rightly miss.)
+    let meshes = [(torus(2.0, 0.7, 24, 12), 2.0), (icosphere(2), 0.0)];
+    for (m, ring) in meshes {
+        let bvh = Bvh::build(&m).unwrap();
+        // Outward normal of the torus with this ring radius (or of the unit sphere).
+        let normal = |p: V3| {
+            let r = (p[0] * p[0] + p[1] * p[1]).sqrt().max(1e-12);
+            let c = [p[0] * ring / r, p[1] * ring / r, 0.0];
+            vec3::normalize(vec3::sub(p, c)).unwrap()
+        };
+        let mut targets: Vec<V3> = m.positions.clone();
+        for t in &m.triangles {
+            for k in 0..3 {
+                let (a, b) = (m.positions[t[k] as usize], m.positions[t[(k + 1) % 3] as usize]);
+                targets.push(vec3::scale(vec3::add(a, b), 0.5));
+            }
+        }
+        for (i, &p) in targets.iter().enumerate() {
+            let off = vec3::add(normal(p), vec3::scale(random_unit(5, i as u64), 0.4));
+            let o = vec3::add(p, off);
+            let d = vec3::sub(p, o);
+            let h = bvh.closest_hit(o, d, f64::INFINITY);
+            assert!(h.is_some_and(|h| h.t <= 1.0 + 1e-6), "target {i} {p:?}: {h:?}");
+            assert!(bvh.any_hit(o, d, 1.0 + 1e-6), "target {i}");
+        }
+    }
+}
