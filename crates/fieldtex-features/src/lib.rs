@@ -17,7 +17,9 @@
 mod crest_crossings;
 pub mod crest_lines;
 pub mod curve_preprocessing;
+pub mod distance_transform;
 pub mod error;
+pub mod exemplar_feature_lines;
 pub mod extremality;
 pub mod feature_quality;
 pub mod given_curves;
@@ -33,7 +35,12 @@ pub use crest_lines::{
     crest_lines_with_progress,
 };
 pub use curve_preprocessing::{CurvePreprocessOptions, preprocess_lines, preprocess_polylines};
+pub use distance_transform::{euclidean_distance_transform, squared_distance_transform};
 pub use error::FeaturesError;
+pub use exemplar_feature_lines::{
+    ExemplarFeatureOptions, ExemplarFeatures, LinePolarity, detect_exemplar_feature_lines,
+    exemplar_features_from_polylines,
+};
 pub use feature_quality::{SharpEdgeCoverage, sharp_edge_coverage};
 pub use given_curves::{GivenCurvesOptions, given_curves};
 pub use mesh_scale::mean_edge_length;
