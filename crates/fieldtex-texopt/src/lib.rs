@@ -1,6 +1,68 @@
-//! Texture optimisation (Kwatra, Essa, Bobick & Kwatra 2005; Kwatra et al. 2007;
-//! paper A §5) over surface-sample domains.
+//! Texture optimisation on surfaces: Kwatra, Essa, Bobick & Kwatra 2005 ("Texture
+//! Optimization for Example-based Synthesis"), on surfaces as in Kwatra et al. 2007, with
+//! the feature-to-feature alignment of paper A (Xu, Cohen-Or, Ju, Liu, Zhang, Zhou & Chen
+//! 2009, "Feature-aligned shape texturing", §5.1–5.2).
 //!
-//! Placeholder: the engine is being written (issue 4). This crate is split from
-//! `fieldtex-synth` because its domain is an unstructured set of surface samples
-//! with tangent frames and radius neighbour queries rather than a grid hierarchy.
+//! # Pieces
+//! - [`SurfaceDomain`] (`surface_domain.rs`): colour *carriers* (triangle + barycentric
+//!   coordinates: atlas texels or vertices) with positions, normals and tangent frames
+//!   from a per-vertex direction field. Reusable by the transfer pipeline (paper B).
+//! - [`UniformGrid`]: deterministic radius-neighbour queries over 3-D points.
+//! - [`sample_set`]: the sample set `X†` by dart throwing over the carriers at spacing
+//!   `r·w·h`, salient-curve carriers first (paper A §5.1).
+//! - [`optimise`]: the coarse-to-fine search/blend loop
+//!   ([`texture_optimisation`]), nearest-patch search ([`patch_search`]: PCA exhaustive
+//!   or strided scan + coherence + random candidates, §5.2 constrained candidates) and
+//!   the robust blend ([`robust_blend`]: IRLS weights `|x_p − z_p|^(r−2)`, `r = 0.8`,
+//!   Kwatra 2005 eq. 2–3; `λ_p = 1/(d + 10⁻⁶)`, paper A eq. 4).
+//! - [`dominant_orientation`]: structure-tensor orientation, for measurements.
+//!
+//! # Conventions
+//! - Units: `h` ([`TexOptOptions::pixel_size`]) is the surface length of one exemplar
+//!   pixel; patches are `w × w` exemplar pixels, i.e. `w·h` surface units wide.
+//! - Orientation: patch pixel `(i, j)` sits at surface offset
+//!   `(i − w/2)·h·t − (j − w/2)·h·b` from the sample, `t` the field direction (rotated by
+//!   [`TexOptOptions::exemplar_angle`]) and `b = n × t`: exemplar rows run along the field
+//!   and the texture is not mirrored seen from outside. An exemplar with horizontal
+//!   stripes gives stripes along the field.
+//! - Offsets are measured in the tangent plane of the sample (orthogonal projection), not
+//!   geodesically; carriers whose normal turns away (`cos < normal_cosine`) are excluded,
+//!   which keeps the two sides of thin parts apart.
+//! - Colours: RGBA `f32` in the exemplar's encoding (sRGB as stored), matched on RGB.
+//! - Exemplar coordinates in the output: pixel centres at `i + 0.5`.
+//! - Determinism: all randomness from `fieldtex_core::rng` streams keyed by (seed, stage,
+//!   level, iteration, sample); search and blend are per-item parallel maps with
+//!   sequential reductions, so output is bit-identical for any thread count.
+//!
+//! # Substitutes and what is not implemented
+//! - Large patches are described by an `8 × 8` grid every `w/8` pixels of a
+//!   tent-filtered exemplar (192-D), for every `w`; all carriers stay at full
+//!   resolution at every level (no carrier hierarchy as in Kwatra 2007).
+//! - Search: no k-d tree (DEPENDENCIES.md: trees do not help at this dimension);
+//!   exhaustive PCA scan within a budget, strided subsets beyond it, plus coherence and
+//!   random candidates. No k-coherence precomputation.
+//! - The blend is the closed-form weighted average (Kwatra 2005 eq. 3 for fixed
+//!   matches), not a linear system; no per-pixel falloff inside patches.
+//! - §5.2 uses unsigned distances on both sides: a patch may put the feature line on
+//!   either side of its centre; the principal-feature-line choice is the caller's (it
+//!   builds the distance map).
+//! - The exemplar is used at one scale (`h`); no multi-scale exemplar pyramid.
+
+mod error;
+mod exemplar_patches;
+mod options;
+pub mod patch_search;
+pub mod robust_blend;
+mod sample_set;
+mod structure_tensor;
+mod surface_domain;
+pub mod texture_optimisation;
+mod uniform_grid;
+
+pub use error::TexOptError;
+pub use options::{FeatureAlignment, TexOptOptions};
+pub use sample_set::sample_set;
+pub use structure_tensor::{dominant_orientation, line_angle_difference};
+pub use surface_domain::{Carrier, SurfaceDomain, vertex_carriers};
+pub use texture_optimisation::{LevelStats, TexOptResult, optimise};
+pub use uniform_grid::UniformGrid;

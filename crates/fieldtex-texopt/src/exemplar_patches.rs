@@ -1,0 +1,300 @@
+//! Exemplar analysis for one patch size: filtered exemplar, patch descriptors, PCA.
+//!
+//! A `w × w` patch (`w = 8·s`) is described by an `8 × 8` grid of RGB values taken every
+//! `s` pixels from the exemplar filtered by a tent of radius `s` (separable weights
+//! `1 − |d|/s`; the identity for `s = 1`). The tent matches what the surface side sees:
+//! carriers about one pixel apart splatted bilinearly onto a grid of step `s`. This is
+//! Kwatra et al. 2005's subsampling of large neighbourhoods; descriptors stay 192-D for
+//! every `w`, then [`Pca`] reduces them for exhaustive search.
+//!
+//! Patch positions are integer *origins* `o` (the pixel of grid point `(0, 0)`); grid
+//! point `(i, j)` is pixel `o + (i·s, j·s)`, and the patch centre is `o + 3.5·s`. With
+//! `toroidal = false` every origin keeps the grid inside the exemplar
+//! (`0 ≤ o ≤ W − 1 − 7s`); with `toroidal = true` every pixel is an origin and lookups
+//! wrap. Coordinates here are pixel-*index* space (pixel `x` at `x`); the public API adds
+//! `0.5` (pixel centres at `x + 0.5`, as `Image::sample_bilinear`).
+
+use crate::TexOptError;
+use fieldtex_core::Image;
+use fieldtex_linalg::Pca;
+use rayon::prelude::*;
+
+/// Descriptor grid points per side.
+pub(crate) const GRID: usize = 8;
+/// Descriptor length: `GRID² × RGB`.
+pub(crate) const DIM: usize = GRID * GRID * 3;
+/// Patch coordinate of the grid centre.
+pub(crate) const HALF: f64 = (GRID as f64 - 1.0) / 2.0;
+
+/// Exemplar data of one patch size.
+pub(crate) struct ExemplarLevel {
+    pub step: usize,
+    pub width: usize,
+    pub height: usize,
+    pub toroidal: bool,
+    /// Filtered exemplar, `width × height` RGBA.
+    pub image: Vec<[f32; 4]>,
+    /// Origins per axis: `nx × ny` positions, index `oy·nx + ox`.
+    pub nx: usize,
+    pub ny: usize,
+    /// `M × DIM` descriptors.
+    pub descriptors: Vec<f32>,
+    /// `M × kp` PCA coefficients, zero-padded to `kp` (a multiple of 8) per row.
+    pub coords: Vec<f32>,
+    /// Padded row length of `coords`.
+    pub kp: usize,
+    /// `kp × DIM` components (rows past `k` zero) and the `DIM` mean, `f32`.
+    basis: Vec<f32>,
+    mean: Vec<f32>,
+    pub pca: Pca,
+    /// Feature distance (exemplar pixels) at each position's centre, `M`.
+    pub centre_distance: Option<Vec<f32>>,
+    /// Positions grouped by `round(centre_distance)`.
+    pub feature_bins: Vec<Vec<u32>>,
+}
+
+impl ExemplarLevel {
+    /// Analyses `exemplar` for patch size `patch` (a multiple of 8). `distance` is the
+    /// optional `W × H` feature-distance map.
+    pub fn new(
+        exemplar: &Image,
+        patch: usize,
+        toroidal: bool,
+        pca_components: usize,
+        distance: Option<&[f32]>,
+    ) -> Result<Self, TexOptError> {
+        let (w, h) = (exemplar.width, exemplar.height);
+        let step = patch / GRID;
+        if w < patch || h < patch {
+            return Err(TexOptError::ExemplarTooSmall { width: w, height: h, patch, min: patch });
+        }
+        let image = tent_filter(exemplar, step, toroidal);
+        let span = (GRID - 1) * step;
+        let (nx, ny) = if toroidal { (w, h) } else { (w - span, h - span) };
+        let mut level = Self {
+            step,
+            width: w,
+            height: h,
+            toroidal,
+            image,
+            nx,
+            ny,
+            descriptors: Vec::new(),
+            coords: Vec::new(),
+            kp: 0,
+            basis: Vec::new(),
+            mean: Vec::new(),
+            pca: Pca { mean: Vec::new(), components: Vec::new(), variances: Vec::new() },
+            centre_distance: None,
+            feature_bins: Vec::new(),
+        };
+        let m = nx * ny;
+        let mut descriptors = vec![0.0f32; m * DIM];
+        descriptors
+            .par_chunks_mut(DIM)
+            .enumerate()
+            .for_each(|(p, d)| level.descriptor(p as u32, d));
+        let k = pca_components.clamp(1, DIM);
+        let pca =
+            Pca::fit(&descriptors, DIM, k).map_err(|source| TexOptError::Pca { patch, source })?;
+        let kp = k.div_ceil(8) * 8;
+        level.kp = kp;
+        level.basis = vec![0.0; kp * DIM];
+        for (c, comp) in pca.components.iter().enumerate() {
+            for (b, &v) in level.basis[c * DIM..(c + 1) * DIM].iter_mut().zip(comp) {
+                *b = v as f32;
+            }
+        }
+        level.mean = pca.mean.iter().map(|&m| m as f32).collect();
+        let mut coords = vec![0.0f32; m * kp];
+        descriptors.par_chunks(DIM).zip(coords.par_chunks_mut(kp)).with_min_len(256).for_each(
+            |(d, c)| {
+                let d: &[f32; DIM] = d.try_into().expect("DIM-long chunk");
+                level.project(d, c);
+            },
+        );
+        level.descriptors = descriptors;
+        level.coords = coords;
+        level.pca = pca;
+        if let Some(dist) = distance {
+            let centre: Vec<f32> = (0..m as u32)
+                .map(|p| {
+                    let [ox, oy] = level.origin(p);
+                    let c = HALF * step as f64;
+                    let x = ((ox as f64 + c).round() as i64).rem_euclid(w as i64) as usize;
+                    let y = ((oy as f64 + c).round() as i64).rem_euclid(h as i64) as usize;
+                    dist[y * w + x]
+                })
+                .collect();
+            let max_bin =
+                centre.iter().fold(0.0f32, |a, &b| if b.is_finite() { a.max(b) } else { a });
+            let mut bins = vec![Vec::new(); max_bin.round() as usize + 1];
+            for (p, &d) in centre.iter().enumerate() {
+                if d.is_finite() && d >= 0.0 {
+                    bins[d.round() as usize].push(p as u32);
+                }
+            }
+            level.centre_distance = Some(centre);
+            level.feature_bins = bins;
+        }
+        Ok(level)
+    }
+
+    /// Number of patch positions `M`.
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Origin pixel of position `p`.
+    #[inline]
+    pub fn origin(&self, p: u32) -> [i64; 2] {
+        [(p as usize % self.nx) as i64, (p as usize / self.nx) as i64]
+    }
+
+    /// The position whose origin is nearest to the continuous origin `(x, y)` (clamped,
+    /// or wrapped when toroidal).
+    #[inline]
+    pub fn position_near(&self, x: f64, y: f64) -> u32 {
+        let (xi, yi) = (x.round() as i64, y.round() as i64);
+        let (xi, yi) = if self.toroidal {
+            (xi.rem_euclid(self.nx as i64), yi.rem_euclid(self.ny as i64))
+        } else {
+            (xi.clamp(0, self.nx as i64 - 1), yi.clamp(0, self.ny as i64 - 1))
+        };
+        (yi as usize * self.nx + xi as usize) as u32
+    }
+
+    #[inline]
+    fn pixel(&self, x: i64, y: i64) -> [f32; 4] {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let (x, y) = if self.toroidal {
+            (x.rem_euclid(w), y.rem_euclid(h))
+        } else {
+            (x.clamp(0, w - 1), y.clamp(0, h - 1))
+        };
+        self.image[(y * w + x) as usize]
+    }
+
+    /// Bilinear lookup of the filtered exemplar at pixel-index coordinates.
+    #[inline]
+    pub fn sample(&self, x: f64, y: f64) -> [f32; 4] {
+        let (x0, y0) = (x.floor(), y.floor());
+        let (tx, ty) = ((x - x0) as f32, (y - y0) as f32);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let a = self.pixel(x0, y0);
+        let b = self.pixel(x0 + 1, y0);
+        let c = self.pixel(x0, y0 + 1);
+        let d = self.pixel(x0 + 1, y0 + 1);
+        let mut out = [0.0f32; 4];
+        for k in 0..4 {
+            let top = a[k] + (b[k] - a[k]) * tx;
+            let bot = c[k] + (d[k] - c[k]) * tx;
+            out[k] = top + (bot - top) * ty;
+        }
+        out
+    }
+
+    /// Writes the descriptor of position `p` into `out` (`DIM`).
+    fn descriptor(&self, p: u32, out: &mut [f32]) {
+        let [ox, oy] = self.origin(p);
+        let s = self.step as i64;
+        for j in 0..GRID {
+            for i in 0..GRID {
+                let c = self.pixel(ox + i as i64 * s, oy + j as i64 * s);
+                let o = (j * GRID + i) * 3;
+                out[o..o + 3].copy_from_slice(&c[..3]);
+            }
+        }
+    }
+
+    /// Squared distance between a descriptor and the stored descriptor of `p`.
+    #[inline]
+    pub fn distance2(&self, x: &[f32; DIM], p: u32) -> f32 {
+        let d = &self.descriptors[p as usize * DIM..(p as usize + 1) * DIM];
+        let mut s = [0.0f32; 8];
+        for (a, b) in x.chunks_exact(8).zip(d.chunks_exact(8)) {
+            for k in 0..8 {
+                let e = a[k] - b[k];
+                s[k] += e * e;
+            }
+        }
+        s.iter().sum()
+    }
+
+    /// Projects a descriptor onto the padded PCA basis: `out[..kp]`.
+    #[inline]
+    pub fn project(&self, x: &[f32; DIM], out: &mut [f32]) {
+        let mut centred = [0.0f32; DIM];
+        for ((c, &v), &m) in centred.iter_mut().zip(x).zip(&self.mean) {
+            *c = v - m;
+        }
+        for (o, row) in out[..self.kp].iter_mut().zip(self.basis.chunks_exact(DIM)) {
+            let mut s = [0.0f32; 8];
+            for (a, b) in centred.chunks_exact(8).zip(row.chunks_exact(8)) {
+                for k in 0..8 {
+                    s[k] += a[k] * b[k];
+                }
+            }
+            *o = (s[0] + s[1]) + (s[2] + s[3]) + ((s[4] + s[5]) + (s[6] + s[7]));
+        }
+    }
+
+    /// Squared distance in PCA space between the padded projection `q` (`kp`) and
+    /// position `p`, or any value `≥ bound` once the partial sum exceeds `bound`
+    /// (components come by decreasing variance, so the early exit is effective).
+    #[inline]
+    pub fn coord_distance2(&self, q: &[f32], p: u32, bound: f32) -> f32 {
+        let kp = self.kp;
+        let c = &self.coords[p as usize * kp..(p as usize + 1) * kp];
+        let mut total = 0.0f32;
+        for (a, b) in q.chunks_exact(8).zip(c.chunks_exact(8)) {
+            let mut s = [0.0f32; 8];
+            for k in 0..8 {
+                let e = a[k] - b[k];
+                s[k] = e * e;
+            }
+            total += (s[0] + s[1]) + (s[2] + s[3]) + ((s[4] + s[5]) + (s[6] + s[7]));
+            if total >= bound {
+                return total;
+            }
+        }
+        total
+    }
+}
+
+/// Separable tent filter of radius `s` (weights `1 − |d|/s`), clamped or wrapped.
+fn tent_filter(img: &Image, s: usize, toroidal: bool) -> Vec<[f32; 4]> {
+    if s <= 1 {
+        return img.pixels.clone();
+    }
+    let (w, h) = (img.width as i64, img.height as i64);
+    let weights: Vec<(i64, f32)> =
+        (-(s as i64) + 1..s as i64).map(|d| (d, 1.0 - d.abs() as f32 / s as f32)).collect();
+    let norm: f32 = weights.iter().map(|x| x.1).sum();
+    let fetch = |v: i64, n: i64| if toroidal { v.rem_euclid(n) } else { v.clamp(0, n - 1) };
+    let pass = |src: &[[f32; 4]], horizontal: bool| -> Vec<[f32; 4]> {
+        let mut out = vec![[0.0f32; 4]; src.len()];
+        out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate() {
+                let mut acc = [0.0f32; 4];
+                for &(d, wt) in &weights {
+                    let (sx, sy) = if horizontal {
+                        (fetch(x as i64 + d, w), y as i64)
+                    } else {
+                        (x as i64, fetch(y as i64 + d, h))
+                    };
+                    let c = src[(sy * w + sx) as usize];
+                    for k in 0..4 {
+                        acc[k] += wt * c[k];
+                    }
+                }
+                for k in 0..4 {
+                    o[k] = acc[k] / norm;
+                }
+            }
+        });
+        out
+    };
+    let tmp = pass(&img.pixels, true);
+    pass(&tmp, false)
+}

@@ -1,0 +1,167 @@
+//! Options of [`optimise`](crate::optimise) and the feature-alignment input.
+
+use crate::TexOptError;
+use serde::{Deserialize, Serialize};
+
+/// Options of the surface texture optimisation; every field has a documented default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TexOptOptions {
+    /// Patch widths `w` in exemplar pixels, coarse to fine; each a multiple of 8 (the
+    /// descriptor is an 8 × 8 grid every `w/8` pixels). Default `[32, 16, 8]` (Kwatra
+    /// et al. 2005 §3.1 use 32, 16, 8).
+    pub patch_sizes: Vec<usize>,
+    /// `h`: surface length of one exemplar pixel (surface units). Default `None`: the
+    /// carrier spacing `sqrt(area / #C)`, i.e. one exemplar pixel per carrier.
+    pub pixel_size: Option<f64>,
+    /// `r` of paper A §5.1: samples are `r·w·h` apart. Default 0.25.
+    pub sample_spacing_ratio: f64,
+    /// Robust exponent of Kwatra et al. 2005 eq. 2: energy `Σ |x_p − z_p|^r`, IRLS
+    /// weights `|x_p − z_p|^(r−2)`. Default 0.8.
+    pub robust_exponent: f64,
+    /// Search/blend iterations per patch size at most. Default 4.
+    pub max_iterations: usize,
+    /// A level stops when at most this fraction of samples changed match. Default 0.01.
+    pub converge_fraction: f64,
+    /// Random exemplar candidates per sample and iteration (alternately uniform and in a
+    /// shrinking window around the current match), at most 16. Default 6.
+    pub random_candidates: usize,
+    /// Neighbouring samples whose shifted matches are candidates. Default 8.
+    pub coherence_neighbours: usize,
+    /// PCA components of the 192-D descriptors for exhaustive search. Default 24.
+    pub pca_components: usize,
+    /// Exhaustive PCA search when `samples × positions` is at most this; above it, over
+    /// a strided subset of positions of this many pairs in all (per iteration). Default
+    /// 1.5 million.
+    pub exact_search_budget: usize,
+    /// Rotation (radians, counter-clockwise from `t` towards `b`) of the exemplar's `+x`
+    /// axis relative to the field. Default 0: exemplar rows follow the field.
+    pub exemplar_angle: f64,
+    /// Treat the exemplar as tileable (wrapped lookups, every pixel a patch origin).
+    /// Default false (patches stay inside the exemplar).
+    pub toroidal: bool,
+    /// Paper A §5.2 feature-to-feature alignment when a [`FeatureAlignment`] is given;
+    /// false for the ablation. Default true.
+    pub feature_align: bool,
+    /// Accepted difference (exemplar pixels) between a sample's curve distance and a
+    /// candidate centre's feature distance. Default 1.0.
+    pub feature_threshold: f64,
+    /// Carriers whose normal makes a cosine below this with the patch normal are not
+    /// part of the patch (the other side of thin parts). Default 0.3.
+    pub normal_cosine: f64,
+    /// Seed of all random streams. Default 0.
+    pub seed: u64,
+}
+
+impl Default for TexOptOptions {
+    fn default() -> Self {
+        Self {
+            patch_sizes: vec![32, 16, 8],
+            pixel_size: None,
+            sample_spacing_ratio: 0.25,
+            robust_exponent: 0.8,
+            max_iterations: 4,
+            converge_fraction: 0.01,
+            random_candidates: 6,
+            coherence_neighbours: 8,
+            pca_components: 24,
+            exact_search_budget: 1_500_000,
+            exemplar_angle: 0.0,
+            toroidal: false,
+            feature_align: true,
+            feature_threshold: 1.0,
+            normal_cosine: 0.3,
+            seed: 0,
+        }
+    }
+}
+
+impl TexOptOptions {
+    pub fn with_patch_sizes(mut self, sizes: Vec<usize>) -> Self {
+        self.patch_sizes = sizes;
+        self
+    }
+    pub fn with_pixel_size(mut self, h: f64) -> Self {
+        self.pixel_size = Some(h);
+        self
+    }
+    pub fn with_max_iterations(mut self, n: usize) -> Self {
+        self.max_iterations = n;
+        self
+    }
+    pub fn with_exemplar_angle(mut self, radians: f64) -> Self {
+        self.exemplar_angle = radians;
+        self
+    }
+    pub fn with_feature_align(mut self, on: bool) -> Self {
+        self.feature_align = on;
+        self
+    }
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Checks every field once, at the boundary.
+    pub fn validate(&self) -> Result<(), TexOptError> {
+        let bad =
+            |name, value: f64, reason| Err(TexOptError::InvalidOption { name, value, reason });
+        if self.patch_sizes.is_empty() {
+            return bad("patch_sizes.len()", 0.0, "give at least one patch size");
+        }
+        if let Some(&w) = self.patch_sizes.iter().find(|&&w| w < 8 || w % 8 != 0 || w > 512) {
+            return bad(
+                "patch_sizes",
+                w as f64,
+                "each patch size must be a multiple of 8 between 8 and 512",
+            );
+        }
+        if let Some(h) = self.pixel_size
+            && !(h.is_finite() && h > 0.0)
+        {
+            return bad("pixel_size", h, "must be positive and finite");
+        }
+        let r = self.sample_spacing_ratio;
+        if !(r.is_finite() && r > 0.0 && r <= 1.0) {
+            return bad("sample_spacing_ratio", r, "must be in (0, 1]");
+        }
+        let e = self.robust_exponent;
+        if !(e.is_finite() && e > 0.0 && e <= 2.0) {
+            return bad("robust_exponent", e, "must be in (0, 2]");
+        }
+        if self.max_iterations == 0 {
+            return bad("max_iterations", 0.0, "must be at least 1");
+        }
+        let c = self.converge_fraction;
+        if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
+            return bad("converge_fraction", c, "must be in [0, 1]");
+        }
+        if self.pca_components == 0 {
+            return bad("pca_components", 0.0, "must be at least 1");
+        }
+        if !self.exemplar_angle.is_finite() {
+            return bad("exemplar_angle", self.exemplar_angle, "must be finite");
+        }
+        let t = self.feature_threshold;
+        if !(t.is_finite() && t >= 0.0) {
+            return bad("feature_threshold", t, "must be non-negative and finite");
+        }
+        let n = self.normal_cosine;
+        if !(n.is_finite() && (-1.0..=1.0).contains(&n)) {
+            return bad("normal_cosine", n, "must be in [-1, 1]");
+        }
+        Ok(())
+    }
+}
+
+/// Inputs of paper A §5.2 feature-to-feature alignment (plain arrays; the feature lines
+/// and distances are computed elsewhere).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FeatureAlignment {
+    /// `W × H` (row-major, exemplar size): distance in exemplar pixels from each pixel
+    /// to the nearest exemplar feature line. Non-finite values mean "no feature".
+    pub exemplar_distance: Vec<f32>,
+    /// `#C`: surface (geodesic) distance from each carrier to the salient curves, in
+    /// surface units. `+∞` for carriers the curves cannot reach; NaN is an error.
+    pub carrier_curve_distance: Vec<f64>,
+}
