@@ -225,12 +225,13 @@ pub fn orient_curves<'m>(
                     -1
                 };
                 signs[i] = sign;
-                let r = solver.add_constraints(&sampled[i], f64::from(sign))?;
-                step.new_constraints += r.new_vertices;
-                step.update_ms += 1e3 * r.update_seconds;
-                step.factor_ms += 1e3 * r.factor_seconds;
-                progress.advance(1);
             }
+            let all: Vec<_> = pending.iter().map(|&i| (&sampled[i], f64::from(signs[i]))).collect();
+            let r = solver.add_constraints_many(&all)?;
+            step.new_constraints += r.new_vertices;
+            step.update_ms += 1e3 * r.update_seconds;
+            step.factor_ms += 1e3 * r.factor_seconds;
+            progress.advance(pending.len() as u64);
             let s = solver.solve()?;
             step.solve_ms = 1e3 * s.seconds;
             step.residual = s.max_residual;
@@ -347,4 +348,60 @@ fn empty_step(curve: usize, sign: i8) -> OrientationStep {
         solve_ms: 0.0,
         residual: 0.0,
     }
+}
+
+/// Diffuses the field of `curves` with given orientations (`signs[i]`: `+1` as given,
+/// `−1` reversed, `0` skip) on `mesh`: all penalties at once (one factorisation per
+/// component), one solve. Curves that sample to no constraint on `mesh` get sign 0.
+/// Errors: `signs.len() != curves.len()`, invalid mesh or options, failed solves.
+pub fn orient_curves_with_signs<'m>(
+    mesh: &'m TriMesh,
+    curves: &[Vec<V3>],
+    signs: &[i8],
+    options: &CurveFieldOptions,
+) -> Result<CurveOrientationResult<'m>, FieldsError> {
+    let t0 = Instant::now();
+    if signs.len() != curves.len() {
+        return Err(FieldsError::InvalidOption {
+            name: "signs (one per curve)",
+            value: signs.len() as f64,
+            expected: "as many signs as curves",
+        });
+    }
+    let mut solver = CurveFieldSolver::new(mesh, options)?;
+    let sampled: Vec<CurveConstraints> =
+        curves.par_iter().map(|c| solver.sample_curve(c)).collect();
+    let mut out_signs = vec![0i8; curves.len()];
+    let mut all = Vec::new();
+    for (i, (c, &s)) in sampled.iter().zip(signs).enumerate() {
+        if s != 0 && !c.vertices.is_empty() {
+            out_signs[i] = s.signum();
+            all.push((c, f64::from(s.signum())));
+        }
+    }
+    let added = solver.add_constraints_many(&all)?;
+    let solved = solver.solve()?;
+    let field = solver.field()?;
+    let warnings = field.warnings.clone();
+    let step = OrientationStep {
+        curve: usize::MAX,
+        sign: 0,
+        round: 0,
+        score: f64::NAN,
+        normalized_score: f64::NAN,
+        new_constraints: added.new_vertices,
+        update_ms: 1e3 * added.update_seconds,
+        factor_ms: 1e3 * added.factor_seconds,
+        solve_ms: 1e3 * solved.seconds,
+        residual: solved.max_residual,
+    };
+    Ok(CurveOrientationResult {
+        signs: out_signs,
+        curves: sampled,
+        steps: vec![step],
+        field,
+        solver,
+        total_ms: 1e3 * t0.elapsed().as_secs_f64(),
+        warnings,
+    })
 }

@@ -89,6 +89,12 @@ pub struct CurveFieldOptions {
     pub overlap: OverlapPolicy,
     /// Components without constraints. Default [`UnconstrainedFallback::PrincipalDirection`].
     pub fallback: UnconstrainedFallback,
+    /// New penalties on an already factored component beyond which
+    /// [`CurveFieldSolver::add_constraints_many`] refactors numerically instead of
+    /// applying one rank-1 update each. Default 200: one update cost ~1/220 of a
+    /// refactorisation from fandisk to the refined horse (`examples/bench_orientation.rs`,
+    /// `refactor_over_rank1`). A greedy step (one curve, tens of vertices) stays below.
+    pub refactor_above: usize,
 }
 
 impl Default for CurveFieldOptions {
@@ -99,6 +105,7 @@ impl Default for CurveFieldOptions {
             max_distance: 2.0,
             overlap: OverlapPolicy::KeepFirst,
             fallback: UnconstrainedFallback::PrincipalDirection,
+            refactor_above: 200,
         }
     }
 }
@@ -510,42 +517,59 @@ impl<'m> CurveFieldSolver<'m> {
         curve: &CurveConstraints,
         sign: f64,
     ) -> Result<AddReport, FieldsError> {
-        let s = if sign < 0.0 { -1.0 } else { 1.0 };
+        self.add_constraints_many(&[(curve, sign)])
+    }
+
+    /// Adds the constraints of several curves at once (`(curve, sign)` in order, as
+    /// repeated [`CurveFieldSolver::add_constraints`] would): every target is set
+    /// first, then each touched component is factored once — a first factorisation
+    /// with all its penalties, rank-1 updates of an existing factor, or, when the new
+    /// penalties outnumber [`CurveFieldOptions::refactor_above`], a numeric
+    /// refactorisation with the kept symbolic analysis. Same field as one curve at a
+    /// time (to rounding), without a rank-1 update per vertex after the first curve.
+    pub fn add_constraints_many(
+        &mut self,
+        curves: &[(&CurveConstraints, f64)],
+    ) -> Result<AddReport, FieldsError> {
         let mut report = AddReport::default();
         let mut fresh: Vec<Vec<u32>> = vec![Vec::new(); self.blocks.len()];
-        for (&v, &t) in curve.vertices.iter().zip(&curve.tangents) {
-            let vi = v as usize;
-            if vi >= self.targets.len() || self.component[vi] == NONE {
-                continue;
-            }
-            let t = vec3::scale(t, s);
-            let c = self.component[vi] as usize;
-            match (&mut self.targets[vi], self.options.overlap) {
-                (Some(_), OverlapPolicy::KeepFirst) => report.overlapping_vertices += 1,
-                (Some((target, sum)), OverlapPolicy::Average) => {
-                    report.overlapping_vertices += 1;
-                    *sum = vec3::add(*sum, t);
-                    if let Some(u) = vec3::normalize(*sum) {
-                        *target = u;
-                    }
-                    self.blocks[c].dirty = true;
+        for &(curve, sign) in curves {
+            let s = if sign < 0.0 { -1.0 } else { 1.0 };
+            for (&v, &t) in curve.vertices.iter().zip(&curve.tangents) {
+                let vi = v as usize;
+                if vi >= self.targets.len() || self.component[vi] == NONE {
+                    continue;
                 }
-                (slot @ None, _) => {
-                    *slot = Some((t, t));
-                    self.constrained.push(v);
-                    fresh[c].push(v);
-                    report.new_vertices += 1;
+                let t = vec3::scale(t, s);
+                let c = self.component[vi] as usize;
+                match (&mut self.targets[vi], self.options.overlap) {
+                    (Some(_), OverlapPolicy::KeepFirst) => report.overlapping_vertices += 1,
+                    (Some((target, sum)), OverlapPolicy::Average) => {
+                        report.overlapping_vertices += 1;
+                        *sum = vec3::add(*sum, t);
+                        if let Some(u) = vec3::normalize(*sum) {
+                            *target = u;
+                        }
+                        self.blocks[c].dirty = true;
+                    }
+                    (slot @ None, _) => {
+                        *slot = Some((t, t));
+                        self.constrained.push(v);
+                        fresh[c].push(v);
+                        report.new_vertices += 1;
+                    }
                 }
             }
         }
         let alpha = self.options.penalty;
+        let refactor_above = self.options.refactor_above;
         for (c, verts) in fresh.into_iter().enumerate().filter(|(_, f)| !f.is_empty()) {
             let block = &mut self.blocks[c];
             block.dirty = true;
             if block.failed {
                 continue;
             }
-            if let Some(factor) = block.factor.as_mut() {
+            if let Some(factor) = block.factor.as_mut().filter(|_| verts.len() <= refactor_above) {
                 let t0 = Instant::now();
                 for &v in &verts {
                     factor.add_diagonal_penalty(self.local[v as usize] as usize, alpha)?;
@@ -767,9 +791,14 @@ fn factor_block(
     alpha: f64,
 ) -> Result<(), FieldsError> {
     let a = penalised_matrix(block, targets, alpha);
-    let symbolic = SymbolicCholesky::analyze(&a)?;
-    let factor = Cholesky::factor_with(&symbolic, &a)?;
+    // The pattern of `L + P` is that of `L` (diagonal present), so a kept analysis serves
+    // every later refactorisation.
+    let symbolic = match block.symbolic.take() {
+        Some(s) => s,
+        None => SymbolicCholesky::analyze(&a)?,
+    };
+    let factor = Cholesky::factor_with(&symbolic, &a);
     block.symbolic = Some(symbolic);
-    block.factor = Some(factor);
+    block.factor = Some(factor?);
     Ok(())
 }

@@ -81,7 +81,7 @@ pub mod harmonic_diffusion;
 pub mod surface_field_metrics;
 pub use greedy_curve_orientation::{
     CurveOrientationOptions, CurveOrientationResult, OrientationMode, OrientationScore,
-    OrientationStep, orient_curves, orientation_score,
+    OrientationStep, orient_curves, orient_curves_with_signs, orientation_score,
 };
 pub use harmonic_diffusion::{
     AddReport, CurveConstraints, CurveField, CurveFieldOptions, CurveFieldSolver, OverlapPolicy,

@@ -152,3 +152,40 @@ fn batched_rounds_orient_consistent_curves_together() {
         assert!(orient_curves(&mesh, &curves, &o, &NoProgress).is_err(), "τ = {tau}");
     }
 }
+
+#[test]
+fn given_signs_in_one_factorisation_reproduce_the_greedy_field() {
+    let mesh = icosphere(4);
+    let tau = std::f64::consts::TAU;
+    let curves = vec![
+        meridian(0.0, -1.1, 1.1, 40),
+        meridian(tau / 3.0, 1.1, -1.1, 40),
+        meridian(2.0 * tau / 3.0, -0.9, 0.9, 30),
+    ];
+    let options = CurveOrientationOptions::default();
+    let greedy = orient_curves(&mesh, &curves, &options, &NoProgress).unwrap();
+    assert!(greedy.steps.iter().skip(1).all(|s| s.factor_ms == 0.0 && s.update_ms > 0.0));
+    let given =
+        fieldtex_fields::orient_curves_with_signs(&mesh, &curves, &greedy.signs, &options.field)
+            .unwrap();
+    assert_eq!(given.signs, greedy.signs);
+    assert_eq!(given.steps.len(), 1);
+    let step = given.steps[0];
+    assert!(step.factor_ms > 0.0 && step.update_ms == 0.0, "one factorisation: {step:?}");
+    assert_eq!(step.new_constraints, greedy.solver.constraints().len());
+    // Rank-1 updates per curve vs all penalties in one factorisation: the same solution.
+    let (a, b) = (greedy.solver.raw_solution(), given.solver.raw_solution());
+    let scale = a.iter().map(|v| vec3::norm(*v)).fold(0.0, f64::max);
+    let diff = a.iter().zip(b).map(|(x, y)| vec3::norm(vec3::sub(*x, *y))).fold(0.0, f64::max);
+    assert!(scale > 0.0 && diff <= 1e-9 * scale, "diff {diff:e}, scale {scale:e}");
+    // Flipping every sign flips the field; a wrong sign count is an error.
+    let flipped: Vec<i8> = greedy.signs.iter().map(|s| -s).collect();
+    let f = fieldtex_fields::orient_curves_with_signs(&mesh, &curves, &flipped, &options.field)
+        .unwrap();
+    let v = greedy.solver.constraints()[0].0 as usize;
+    let (p, q) = (greedy.field.vectors[v], f.field.vectors[v]);
+    assert!(vec3::dot(p, q) < -0.99, "{p:?} vs {q:?}");
+    assert!(
+        fieldtex_fields::orient_curves_with_signs(&mesh, &curves, &[1], &options.field).is_err()
+    );
+}
