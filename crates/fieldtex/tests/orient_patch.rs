@@ -159,75 +159,37 @@ fn mesh_design_places_singularities_by_position() {
     assert_eq!(designed[0]["index"].as_f64(), Some(0.5));
 }
 
-/// A disk cut out of a real scan (the Demosthenes bust around the tip of its face)
-/// goes through with a whorl: no flattening defect, outputs written, stripes still
-/// follow the field.
+/// A disk cut out of a real scan with `patch` (the Demosthenes bust around the tip of
+/// its face) goes through with a whorl: no flattening defect, outputs written, stripes
+/// still follow the field. A cut far from the mesh, or `patch` without a mesh, is bad
+/// input.
 #[test]
 fn real_scan_patch_with_a_whorl() {
-    let loaded = io::read_mesh(&shared().join("meshes/demosthenes-bust-open.obj")).unwrap();
-    let m = loaded.mesh;
+    let bust = shared().join("meshes/demosthenes-bust-open.obj");
+    let m = io::read_mesh(&bust).unwrap().mesh;
     let tip =
         *m.positions.iter().filter(|p| p[1] > 1.3).max_by(|a, b| a[2].total_cmp(&b[2])).unwrap();
-    let patch = ball_patch(&m, tip, 0.5);
-    assert!(patch.n_triangles() > 800, "{} triangles", patch.n_triangles());
     let dir = tmp("demosthenes");
-    let mesh = write_mesh(&dir, "patch.obj", &patch);
     let out = dir.join("out");
-    let r = run(&out, FieldSource::Preset("whorl".into()), "stripes_Fabric071.png", &mesh, 128);
+    let mut o =
+        OrientOptions::new(FieldSource::Preset("whorl".into()), exemplar("stripes_Fabric071.png"));
+    o.size = 128;
+    o.mesh = Some(bust.clone());
+    o.patch = Some([tip[0], tip[1], tip[2], 0.5]);
+    let r = orient(&out, &o, &NoProgress).unwrap_or_else(|e| panic!("{e}"));
     assert!(out.join("model.glb").is_file() && out.join("preview.png").is_file());
+    let triangles = r.input["mesh_triangles"].as_u64().unwrap();
+    assert!((800..4000).contains(&triangles), "{triangles} triangles in the cut");
     assert!(!r.warnings.iter().any(|w| w.code == "patch-flattening-defects"), "{:?}", r.warnings);
     let chart = metric(&r, &["chart_orientation_error", "mean_error_deg"]);
     assert!(chart <= 15.0, "chart orientation error {chart}°");
     assert!(!r.metrics["designed_singularities"].as_array().unwrap().is_empty());
-}
-
-/// The connected set of triangles, around the triangle nearest `c`, whose centroids
-/// lie within `r` of `c`; compacted.
-fn ball_patch(m: &TriMesh, c: [f64; 3], r: f64) -> TriMesh {
-    let centroid = |t: &[u32; 3]| -> [f64; 3] {
-        std::array::from_fn(|k| t.iter().map(|&v| m.positions[v as usize][k]).sum::<f64>() / 3.0)
-    };
-    let dist = |p: [f64; 3]| {
-        ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt()
-    };
-    let inside: Vec<bool> = m.triangles.iter().map(|t| dist(centroid(t)) < r).collect();
-    let topo = mesh::Topology::build(m.n_vertices(), &m.triangles);
-    let seed = (0..m.n_triangles())
-        .filter(|&f| inside[f])
-        .min_by(|&a, &b| {
-            dist(centroid(&m.triangles[a])).total_cmp(&dist(centroid(&m.triangles[b])))
-        })
-        .unwrap();
-    let mut keep = vec![false; m.n_triangles()];
-    let mut stack = vec![seed];
-    keep[seed] = true;
-    while let Some(f) = stack.pop() {
-        for &e in &topo.face_edges[f] {
-            for &g in topo.edge_faces(e as usize) {
-                let g = g as usize;
-                if inside[g] && !keep[g] {
-                    keep[g] = true;
-                    stack.push(g);
-                }
-            }
-        }
-    }
-    let mut map = vec![u32::MAX; m.n_vertices()];
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    for (f, t) in m.triangles.iter().enumerate() {
-        if !keep[f] {
-            continue;
-        }
-        triangles.push(t.map(|v| {
-            if map[v as usize] == u32::MAX {
-                map[v as usize] = positions.len() as u32;
-                positions.push(m.positions[v as usize]);
-            }
-            map[v as usize]
-        }));
-    }
-    TriMesh::new(positions, triangles)
+    o.patch = Some([tip[0] + 100.0, tip[1], tip[2], 0.5]);
+    let e = orient(&dir.join("far"), &o, &NoProgress).unwrap_err();
+    assert!(e.exit_code() == 2 && e.to_string().contains("no triangle lies within"), "{e}");
+    o.mesh = None;
+    let e = orient(&dir.join("no-mesh"), &o, &NoProgress).unwrap_err();
+    assert!(e.exit_code() == 2 && e.to_string().contains("--mesh"), "{e}");
 }
 
 /// Closed meshes and disks with a hole are refused as bad input naming the topology.

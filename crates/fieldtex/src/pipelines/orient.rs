@@ -45,6 +45,9 @@ pub struct OrientOptions {
     pub seed: u64,
     /// A disk-topology mesh patch to texture (`--mesh`); `None` = the plane. Default None.
     pub mesh: Option<PathBuf>,
+    /// With `mesh`: texture only the connected region of triangles whose centroids lie
+    /// within radius `[3]` of the point `[0..3]` (`--patch X,Y,Z,R`). Default None.
+    pub patch: Option<[f64; 4]>,
 }
 
 impl OrientOptions {
@@ -58,6 +61,7 @@ impl OrientOptions {
             rosy_fix: true,
             seed: 1,
             mesh: None,
+            patch: None,
         }
     }
 }
@@ -161,6 +165,9 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
             None,
             format!("--scale must be in (0, 16], got {}", options.scale),
         ));
+    }
+    if options.patch.is_some() && options.mesh.is_none() {
+        return Err(Error::bad_input(None, "--patch X,Y,Z,R cuts a region of --mesh; give --mesh"));
     }
     if let Some(mesh) = &options.mesh {
         return super::orient_patch::orient_patch(out_dir, options, mesh, progress);

@@ -1,9 +1,11 @@
 //! `fieldtex orient --mesh PATCH`: orientation-field guided synthesis on a curved,
 //! disk-topology patch (Liu et al., paper D, §3 and §4 "curved patches").
 //!
-//! 1. **Patch.** The mesh is repaired (welding, orientation) and must then be one
-//!    component with one boundary loop and Euler characteristic 1 (a disk), else the
-//!    run stops with a bad-input error (exit 2).
+//! 1. **Patch.** The mesh is repaired (welding, orientation); with `--patch X,Y,Z,R`
+//!    only the connected triangles whose centroids lie within `R` of `(X, Y, Z)` are
+//!    kept (ears on the cut rim trimmed), so a disk can be cut out of any mesh. The
+//!    patch must then be one component with one boundary loop and Euler
+//!    characteristic 1 (a disk), else the run stops with a bad-input error (exit 2).
 //! 2. **Parameterisation.** LSCM of the whole patch (Lévy et al. 2002, via
 //!    `fieldtex-param`; planar projection if the solve fails). The UV bounding box's
 //!    enclosing square, with a 2-texel margin, is the `size × size` texture: texel
@@ -12,7 +14,8 @@
 //!    image axes (x right, y down) see the surface as a viewer outside it does: the
 //!    texture is not mirrored on the surface.
 //! 3. **Field on the mesh.** A `[domain] kind = "mesh"` design is built on the patch
-//!    as is (singularities by `position = [x, y, z]`). A **plane** design, and every
+//!    as is (singularities by `position = [x, y, z]`); if its matrix cannot be factored
+//!    the regularisation is raised (warning `field-regularized`). A **plane** design, and every
 //!    `--preset`, is *mapped through the parameterisation*: its `W × H` rectangle
 //!    (presets: 512 × 512) is laid on the UV bounding box (x → u, y down → v down, so
 //!    the preset appears upright in `texture.png`; a non-square box stretches it), each
@@ -44,41 +47,29 @@
 //! patches with several boundary loops or handles (no cutting), a field on the surface
 //! of a closed mesh, holonomy of the reference frames (see `fieldtex-fields`).
 
+mod patch_parameterization;
+mod plane_design_mapping;
+mod texel_jacobians;
+
 use super::orient::{DesignedSingularity, FieldSource, OrientOptions, kind_index};
 use crate::outputs::{prepare_out_dir, write_report};
 use crate::pipelines::eval::image_metrics;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
-use fieldtex_core::vec3::{add, cross, dot, norm, normalize, scale, sub};
-use fieldtex_fields::design_file::{DomainKind, DomainSpec};
-use fieldtex_fields::{DesignFile, FieldDesign, Singularity, SingularityKind, Stroke, Symmetry};
-use fieldtex_mesh::{CornerUvs, TriMesh};
+use fieldtex_core::vec3::{add, cross, normalize, sub};
+use fieldtex_fields::design_file::DomainKind;
+use fieldtex_fields::{DesignFile, FieldDesign, SingularityKind};
+use fieldtex_mesh::TriMesh;
 use fieldtex_param::TexelMap;
-use fieldtex_param::chart_topology::ChartMesh;
-use fieldtex_param::face_graph::FaceGraph;
 use fieldtex_synth::{ImageDomain, SynthesisOptions, synthesize};
-use rayon::prelude::*;
+use patch_parameterization::{Patch, check_disk, cut_ball, parameterize};
+use plane_design_mapping::{build_mesh_design, map_plane_design};
 use serde::Serialize;
 use std::path::Path;
+use texel_jacobians::{jacobians, sample_texels};
 
-/// Texels of margin around the UV bounding box.
-const MARGIN_TEXELS: f64 = 2.0;
-
-/// The parameterised patch: the mesh with texture UVs and, per triangle, its corners
-/// in image coordinates (texels, x right, y down) and the image → surface Jacobian.
-struct Patch {
-    mesh: TriMesh,
-    /// `#F` corners in image coordinates.
-    image_corners: Vec<[[f64; 2]; 3]>,
-    /// `#F` Jacobian columns `(∂p/∂x, ∂p/∂y)`; `None` for degenerate triangles.
-    jacobian: Vec<Option<[[f64; 3]; 2]>>,
-    /// `#F` unit normals.
-    normals: Vec<[f64; 3]>,
-    /// UV bounding box in image coordinates: `[x0, y0, x1, y1]`.
-    image_box: [f64; 4],
-    /// Mean surface length per texel over the chart.
-    length_per_texel: f64,
-}
+/// Mean area stretch of the flattening above which a warning is given.
+const AREA_DISTORTION_WARNING: f64 = 4.0;
 
 /// A designed singularity on the patch.
 #[derive(Debug, Clone, Serialize)]
@@ -109,7 +100,10 @@ pub(crate) fn orient_patch(
     let mut mesh = repaired.mesh;
     mesh.uvs = None;
     mesh.vertex_colors = None;
-    check_disk(&mesh, mesh_path)?;
+    if let Some(cut) = options.patch {
+        mesh = report.time("cut", || cut_ball(&mesh, cut, mesh_path))?;
+    }
+    check_disk(&mesh, mesh_path, options.patch.is_some())?;
     report.input = serde_json::json!({
         "exemplar": options.exemplar.display().to_string(),
         "exemplar_size": [exemplar.width, exemplar.height],
@@ -124,6 +118,17 @@ pub(crate) fn orient_patch(
     if let Some(uvs) = &patch.mesh.uvs
         && let Ok(stats) = fieldtex_param::parameterization_distortion(&patch.mesh, uvs)
     {
+        if stats.area_distortion > AREA_DISTORTION_WARNING {
+            report.warnings.push(fieldtex_core::Warning::new(
+                "patch-area-distortion",
+                format!(
+                    "the flattened patch stretches area by ×{:.1} on average, so texels cover \
+                     very different surface areas and the texture is blurred or aliased where \
+                     they do; a smaller or flatter patch (--patch) flattens better",
+                    stats.area_distortion
+                ),
+            ));
+        }
         report.metric("parameterization", stats);
     }
     let map = report
@@ -185,178 +190,6 @@ pub(crate) fn orient_patch(
     Ok(report)
 }
 
-/// Bad input unless `mesh` is one disk: one component, one boundary loop, Euler
-/// characteristic 1, no non-manifold edge.
-fn check_disk(mesh: &TriMesh, path: &Path) -> Result<()> {
-    if mesh.triangles.is_empty() {
-        return Err(Error::bad_input(Some(path), "no usable triangle is left after repair"));
-    }
-    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let (_, components) = topo.face_components(&mesh.triangles);
-    let loops = topo.boundary_loops(&mesh.triangles).len();
-    let nonmanifold = (0..topo.n_edges()).filter(|&e| topo.is_nonmanifold_edge(e)).count();
-    let mut used = vec![false; mesh.n_vertices()];
-    for t in &mesh.triangles {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    let nv = used.iter().filter(|&&u| u).count() as i64;
-    let euler = nv - topo.n_edges() as i64 + mesh.n_triangles() as i64;
-    if components != 1 || loops != 1 || euler != 1 || nonmanifold > 0 {
-        return Err(Error::bad_input(
-            Some(path),
-            format!(
-                "--mesh needs a disk-topology patch (1 component, 1 boundary loop, Euler \
-                 characteristic 1, manifold); this mesh has {components} component(s), {loops} \
-                 boundary loop(s), Euler characteristic {euler} and {nonmanifold} non-manifold \
-                 edge(s). Cut a disk-like region out of it (closed meshes and meshes with holes \
-                 cannot be flattened into one chart)"
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// LSCM of the whole patch, scaled into the `n × n` texture (module docs).
-fn parameterize(
-    mut mesh: TriMesh,
-    n: usize,
-    warnings: &mut Vec<fieldtex_core::Warning>,
-) -> Result<Patch> {
-    let nf = mesh.n_triangles();
-    let graph = FaceGraph::build(&mesh);
-    let chart = ChartMesh::build((0..nf as u32).collect(), &graph, &mesh.triangles);
-    let uv = match fieldtex_param::lscm::lscm(&chart, &mesh, &graph) {
-        Ok(uv) if uv.iter().all(|p| p[0].is_finite() && p[1].is_finite()) => uv,
-        other => {
-            let why = other.err().map(|e| e.to_string()).unwrap_or_else(|| "non-finite UVs".into());
-            warnings.push(fieldtex_core::Warning::new(
-                "lscm-failed",
-                format!("LSCM failed ({why}); the patch is projected onto its mean plane instead"),
-            ));
-            fieldtex_param::lscm::planar_projection(&chart, &mesh, &graph)
-        }
-    };
-    let defects = fieldtex_param::lscm::flattening_defects(&chart, &uv, &graph);
-    if !defects.is_clean() {
-        warnings.push(fieldtex_core::Warning::new(
-            "patch-flattening-defects",
-            format!(
-                "the flattened patch has {} flipped or collapsed triangle(s){}; the texture may \
-                 overlap itself there",
-                defects.flipped,
-                if defects.boundary_crossing { " and its boundary crosses itself" } else { "" }
-            ),
-        ));
-    }
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in &uv {
-        for k in 0..2 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let side = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    if !(side > 0.0 && side.is_finite()) {
-        return Err(Error::bad_input(None, "the patch flattens to a point or a line"));
-    }
-    let nf64 = n as f64;
-    // Texture uv = (uv − centre) / span + ½, span leaving MARGIN_TEXELS on each side.
-    let span = side * nf64 / (nf64 - 2.0 * MARGIN_TEXELS);
-    let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-    let values: Vec<[f64; 2]> = uv
-        .iter()
-        .map(|p| [(p[0] - centre[0]) / span + 0.5, (p[1] - centre[1]) / span + 0.5])
-        .collect();
-    let to_image = |t: [f64; 2]| [t[0] * nf64, (1.0 - t[1]) * nf64];
-    let (bl, tr) = (
-        to_image([(lo[0] - centre[0]) / span + 0.5, (lo[1] - centre[1]) / span + 0.5]),
-        to_image([(hi[0] - centre[0]) / span + 0.5, (hi[1] - centre[1]) / span + 0.5]),
-    );
-    let image_box = [bl[0], tr[1], tr[0], bl[1]];
-    let mut image_corners = Vec::with_capacity(nf);
-    let mut jacobian = Vec::with_capacity(nf);
-    let mut normals = Vec::with_capacity(nf);
-    let (mut area3, mut area_img) = (0.0, 0.0);
-    for f in 0..nf {
-        let q: [[f64; 2]; 3] =
-            std::array::from_fn(|k| to_image(values[chart.corners[f][k] as usize]));
-        let p = mesh.triangle_positions(f);
-        let (e1, e2) = (sub(p[1], p[0]), sub(p[2], p[0]));
-        let c = cross(e1, e2);
-        let a3 = 0.5 * norm(c);
-        normals.push(normalize(c).unwrap_or([0.0, 0.0, 1.0]));
-        let (a, b) =
-            ([q[1][0] - q[0][0], q[1][1] - q[0][1]], [q[2][0] - q[0][0], q[2][1] - q[0][1]]);
-        let det = a[0] * b[1] - a[1] * b[0];
-        image_corners.push(q);
-        if !(det.abs() > 1e-12 && a3 > 0.0) {
-            jacobian.push(None);
-            continue;
-        }
-        area3 += a3;
-        area_img += 0.5 * det.abs();
-        // [∂p/∂x ∂p/∂y] = [e1 e2] · inv([a b]).
-        let (i00, i01, i10, i11) = (b[1] / det, -b[0] / det, -a[1] / det, a[0] / det);
-        let px = add(scale(e1, i00), scale(e2, i10));
-        let py = add(scale(e1, i01), scale(e2, i11));
-        jacobian.push(Some([px, py]));
-    }
-    if !(area3 > 0.0 && area_img > 0.0) {
-        return Err(Error::bad_input(None, "the patch has no triangle of positive area"));
-    }
-    mesh.uvs = Some(CornerUvs { values, indices: chart.corners.clone() });
-    Ok(Patch {
-        mesh,
-        image_corners,
-        jacobian,
-        normals,
-        image_box,
-        length_per_texel: (area3 / area_img).sqrt(),
-    })
-}
-
-impl Patch {
-    /// Triangle and barycentric coordinates of image point `q` (texels), starting from
-    /// the triangle the texel map shows there; `None` outside the chart.
-    fn locate_image(&self, map: &TexelMap, q: [f64; 2]) -> Option<(usize, [f64; 3])> {
-        let (x, y) = (q[0].floor(), q[1].floor());
-        if !(x >= 0.0 && y >= 0.0 && (x as usize) < map.width && (y as usize) < map.height) {
-            return None;
-        }
-        let i = y as usize * map.width + x as usize;
-        let e = map.entries[i].filter(|_| map.is_covered(i))?;
-        let f = e.triangle as usize;
-        let t = self.image_corners[f];
-        let (a, b, p) = (
-            [t[1][0] - t[0][0], t[1][1] - t[0][1]],
-            [t[2][0] - t[0][0], t[2][1] - t[0][1]],
-            [q[0] - t[0][0], q[1] - t[0][1]],
-        );
-        let det = a[0] * b[1] - a[1] * b[0];
-        if det.abs() < 1e-12 {
-            return Some((f, e.bary.map(f64::from)));
-        }
-        // Barycentric coordinates of q, clamped into the triangle (q may lie just
-        // outside the triangle nearest its texel's centre).
-        let v = ((p[0] * b[1] - p[1] * b[0]) / det).max(0.0);
-        let w = ((a[0] * p[1] - a[1] * p[0]) / det).max(0.0);
-        let (v, w) = if v + w > 1.0 { (v / (v + w), w / (v + w)) } else { (v, w) };
-        Some((f, [1.0 - v - w, v, w]))
-    }
-
-    fn surface_point(&self, f: usize, b: [f64; 3]) -> [f64; 3] {
-        let p = self.mesh.triangle_positions(f);
-        add(add(scale(p[0], b[0]), scale(p[1], b[1])), scale(p[2], b[2]))
-    }
-
-    fn image_point(&self, f: usize, b: [f64; 3]) -> [f64; 2] {
-        let t = self.image_corners[f];
-        std::array::from_fn(|k| b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k])
-    }
-}
-
 /// The texel field (`n × n` unit image-space directions, chart texels meaningful) and
 /// the designed singularities.
 fn texel_field(
@@ -399,19 +232,19 @@ fn texel_field(
             (d, None)
         }
     };
-    let bad = |e: fieldtex_fields::FieldsError| Error::bad_input(src, e.to_string());
+    let bad = |e: fieldtex_fields::FieldsError| match e {
+        fieldtex_fields::FieldsError::Solve(_) => Error::Internal(e.to_string()),
+        _ => Error::bad_input(src, e.to_string()),
+    };
     let mut designed = Vec::new();
     let mut mapping_warnings = Vec::new();
     let fd = report.time("field_factor", || -> Result<FieldDesign> {
-        if file.domain.kind == DomainKind::Mesh {
-            return file.build(Some(patch.mesh.clone())).map_err(bad);
+        let mesh_design = file.domain.kind == DomainKind::Mesh;
+        let mut fd = build_mesh_design(&file, &patch.mesh, mesh_design, &mut mapping_warnings)
+            .map_err(bad)?;
+        if !mesh_design {
+            map_plane_design(&file, patch, map, &mut fd, &mut mapping_warnings).map_err(bad)?;
         }
-        let mut base = file.clone();
-        base.domain = DomainSpec { kind: DomainKind::Mesh, width: None, height: None, grid: 128 };
-        base.singularities.clear();
-        base.strokes.clear();
-        let mut fd = base.build(Some(patch.mesh.clone())).map_err(bad)?;
-        map_plane_design(&file, patch, map, &mut fd, &mut mapping_warnings).map_err(bad)?;
         Ok(fd)
     })?;
     report.warnings.extend(mapping_warnings);
@@ -437,254 +270,6 @@ fn texel_field(
     let dirs = fieldtex_fields::orientation_field::face_directions(&fd, &solved);
     let field = report.time("field_sample", || sample_texels(patch, map, &dirs, fd.symmetry()));
     Ok((field, designed))
-}
-
-/// Lays the plane design `file` on the UV bounding box and adds its singularities and
-/// strokes to the mesh design `fd` (module docs, step 3).
-fn map_plane_design(
-    file: &DesignFile,
-    patch: &Patch,
-    map: &TexelMap,
-    fd: &mut FieldDesign,
-    warnings: &mut Vec<fieldtex_core::Warning>,
-) -> std::result::Result<(), fieldtex_fields::FieldsError> {
-    let (w, h) = (file.domain.width.unwrap_or(1.0), file.domain.height.unwrap_or(1.0));
-    let [x0, y0, x1, y1] = patch.image_box;
-    let (kx, ky) = ((x1 - x0) / w, (y1 - y0) / h);
-    let to_image = |x: f64, y: f64| [x0 + x * kx, y0 + y * ky];
-    for (i, s) in file.singularity_list()?.into_iter().enumerate() {
-        let Some((f, b)) = patch.locate_image(map, to_image(s.position[0], s.position[1])) else {
-            warnings.push(fieldtex_core::Warning::new(
-                "singularity-outside-patch",
-                format!(
-                    "singularity {i} ({}) at ({:.1}, {:.1}) of the {w}×{h} design falls outside \
-                     the flattened patch; it is left out",
-                    s.kind.name(),
-                    s.position[0],
-                    s.position[1]
-                ),
-            ));
-            continue;
-        };
-        let p = patch.surface_point(f, b);
-        let g = fd.locate(p).map_or(f, |(g, _)| g);
-        let angle = match patch.jacobian[g] {
-            Some([px, py]) => {
-                let (e1, e2) = fd.frames()[g];
-                // Plane axes on the surface, in the frame of the singularity's triangle.
-                let (ax, ay) = (scale(px, kx), scale(py, ky));
-                let m = [[dot(e1, ax), dot(e1, ay)], [dot(e2, ax), dot(e2, ay)]];
-                let phi = m[1][0].atan2(m[0][0]);
-                let reflect = m[0][0] * m[1][1] - m[0][1] * m[1][0] < 0.0;
-                angle_in_frame(s.kind, s.angle, phi, reflect)
-            }
-            None => s.angle,
-        };
-        fd.add_singularity(Singularity { position: p, angle, ..s })?;
-    }
-    // Strokes: samples every 1/256 of the box's longer side, lifted to the surface.
-    let step = w.max(h) / 256.0;
-    for (i, st) in file.stroke_list().into_iter().enumerate() {
-        let mut pieces: Vec<Vec<[f64; 3]>> = vec![Vec::new()];
-        let mut push = |q: [f64; 3]| match patch.locate_image(map, to_image(q[0], q[1])) {
-            Some((f, b)) => pieces.last_mut().expect("non-empty").push(patch.surface_point(f, b)),
-            None => {
-                if !pieces.last().expect("non-empty").is_empty() {
-                    pieces.push(Vec::new());
-                }
-            }
-        };
-        for seg in st.points.windows(2) {
-            let d = sub(seg[1], seg[0]);
-            let k = ((norm(d) / step).ceil() as usize).clamp(1, 100_000);
-            for j in 0..k {
-                push(add(seg[0], scale(d, j as f64 / k as f64)));
-            }
-        }
-        if let Some(last) = st.points.last() {
-            push(*last);
-        }
-        let mut added = 0;
-        for piece in pieces.into_iter().filter(|p| p.len() >= 2) {
-            match fd.add_stroke(Stroke { points: piece, weight: st.weight }) {
-                Ok(_) => added += 1,
-                Err(fieldtex_fields::FieldsError::StrokeMissesDomain { .. }) => {}
-                Err(e) => return Err(e),
-            }
-        }
-        if added == 0 {
-            warnings.push(fieldtex_core::Warning::new(
-                "stroke-outside-patch",
-                format!(
-                    "stroke {i} of the design lies outside the flattened patch; it is left out"
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// Rotation α of a singularity re-expressed in a frame where the design plane's x axis
-/// has angle `phi` (and the plane is mirrored when `reflect`): angles `a` of the plane
-/// become `±a + phi` in the frame. Derived from the model fields of
-/// [`SingularityKind`] (wedge `θ = ψ/2 + α`, trisector `θ = −(ψ/2 + α)`, vector kinds
-/// `u = ψ + arg c`, saddle `u = −ψ − α`).
-fn angle_in_frame(kind: SingularityKind, alpha: f64, phi: f64, reflect: bool) -> f64 {
-    use std::f64::consts::PI;
-    match (kind, reflect) {
-        (SingularityKind::Wedge, false) => alpha + 0.5 * phi,
-        (SingularityKind::Wedge, true) => 0.5 * phi - alpha,
-        (SingularityKind::Trisector, false) => alpha - 1.5 * phi,
-        (SingularityKind::Trisector, true) => -alpha - 1.5 * phi,
-        (SingularityKind::Saddle, false) => alpha - 2.0 * phi,
-        (SingularityKind::Saddle, true) => -alpha - 2.0 * phi,
-        (SingularityKind::Vortex, true) => PI - alpha,
-        (_, true) => -alpha,
-        (_, false) => alpha,
-    }
-}
-
-/// Complex square (`N = 2`) or identity of an image-space direction.
-#[inline]
-fn power(w: [f64; 2], symmetry: Symmetry) -> [f64; 2] {
-    match symmetry {
-        Symmetry::Vector => w,
-        Symmetry::Orientation => [w[0] * w[0] - w[1] * w[1], 2.0 * w[0] * w[1]],
-    }
-}
-
-/// Image-space direction of surface direction `d` on a triangle with Jacobian `[px, py]`
-/// (least squares `P w = d`), normalised.
-fn pull_back(jac: [[f64; 3]; 2], d: [f64; 3]) -> [f64; 2] {
-    let [px, py] = jac;
-    let (a, b, c) = (dot(px, px), dot(px, py), dot(py, py));
-    let (r0, r1) = (dot(px, d), dot(py, d));
-    let det = a * c - b * b;
-    let w = if det.abs() > 0.0 {
-        [(c * r0 - b * r1) / det, (a * r1 - b * r0) / det]
-    } else {
-        [1.0, 0.0]
-    };
-    let l = (w[0] * w[0] + w[1] * w[1]).sqrt();
-    if l > 0.0 && l.is_finite() { [w[0] / l, w[1] / l] } else { [1.0, 0.0] }
-}
-
-/// Texel field from per-triangle surface directions (module docs, step 4).
-fn sample_texels(
-    patch: &Patch,
-    map: &TexelMap,
-    dirs: &[[f64; 3]],
-    symmetry: Symmetry,
-) -> Vec<[f32; 2]> {
-    let mesh = &patch.mesh;
-    let z_face: Vec<[f64; 2]> = (0..mesh.n_triangles())
-        .map(|f| match patch.jacobian[f] {
-            Some(j) => power(pull_back(j, dirs[f]), symmetry),
-            None => [0.0, 0.0],
-        })
-        .collect();
-    let mut z_vertex = vec![[0.0f64; 2]; mesh.n_vertices()];
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        let p = mesh.triangle_positions(f);
-        let a = 0.5 * norm(cross(sub(p[1], p[0]), sub(p[2], p[0])));
-        for &v in t {
-            let z = &mut z_vertex[v as usize];
-            z[0] += a * z_face[f][0];
-            z[1] += a * z_face[f][1];
-        }
-    }
-    (0..map.width * map.height)
-        .into_par_iter()
-        .map(|i| {
-            let Some(e) = map.entries[i] else { return [1.0, 0.0] };
-            let t = mesh.triangles[e.triangle as usize];
-            let mut z = [0.0f64; 2];
-            for k in 0..3 {
-                let zv = z_vertex[t[k] as usize];
-                z[0] += e.bary[k] as f64 * zv[0];
-                z[1] += e.bary[k] as f64 * zv[1];
-            }
-            let z = [z[0] as f32, z[1] as f32];
-            fieldtex_fields::orientation_field::nrosy_root_f32(z, symmetry)
-        })
-        .collect()
-}
-
-/// Per-texel Jacobians (module docs, step 5), the field with texels outside the chart
-/// filled from the nearest chart texel, and the chart mask.
-fn jacobians(
-    patch: &Patch,
-    map: &TexelMap,
-    field: &[[f32; 2]],
-    options: &OrientOptions,
-) -> (Vec<[f32; 4]>, Vec<[f32; 2]>, Vec<bool>) {
-    let inv_s = options.scale / patch.length_per_texel;
-    let own: Vec<Option<[f32; 4]>> = (0..map.width * map.height)
-        .into_par_iter()
-        .map(|i| {
-            if !map.is_covered(i) {
-                return None;
-            }
-            let e = map.entries[i]?;
-            let f = e.triangle as usize;
-            let [px, py] = patch.jacobian[f]?;
-            let w = [field[i][0] as f64, field[i][1] as f64];
-            let d = normalize(add(scale(px, w[0]), scale(py, w[1])))?;
-            let dp = cross(patch.normals[f], d);
-            let r1 = [dot(d, px) * inv_s, dot(d, py) * inv_s];
-            let mut r2 = [dot(dp, px) * inv_s, dot(dp, py) * inv_s];
-            let det = r1[0] * r2[1] - r1[1] * r2[0];
-            if det < 0.0 {
-                r2 = [-r2[0], -r2[1]];
-            }
-            let j = [r1[0] as f32, r1[1] as f32, r2[0] as f32, r2[1] as f32];
-            let (jd, jn) = (j[0] * j[3] - j[1] * j[2], j.iter().map(|v| v * v).sum::<f32>());
-            (j.iter().all(|v| v.is_finite()) && jd > 1e-5 * jn && jn > 1e-12).then_some(j)
-        })
-        .collect();
-    let inside: Vec<bool> = own.iter().map(Option::is_some).collect();
-    let source = nearest_source(map.width, map.height, &inside);
-    let mut jac = Vec::with_capacity(own.len());
-    let mut out_field = Vec::with_capacity(own.len());
-    let fallback = [options.scale as f32, 0.0, 0.0, options.scale as f32];
-    for &s in &source {
-        if s == u32::MAX {
-            jac.push(fallback);
-            out_field.push([1.0, 0.0]);
-        } else {
-            jac.push(own[s as usize].unwrap_or(fallback));
-            out_field.push(field[s as usize]);
-        }
-    }
-    (jac, out_field, inside)
-}
-
-/// For each texel, a chart texel near it: itself when inside, else the first one a
-/// breadth-first flood (8-neighbours, row-major seeds, fixed neighbour order) reaches.
-fn nearest_source(w: usize, h: usize, inside: &[bool]) -> Vec<u32> {
-    let mut source = vec![u32::MAX; w * h];
-    let mut queue = std::collections::VecDeque::new();
-    for (i, &b) in inside.iter().enumerate() {
-        if b {
-            source[i] = i as u32;
-            queue.push_back(i);
-        }
-    }
-    while let Some(i) = queue.pop_front() {
-        let (x, y) = ((i % w) as i64, (i / w) as i64);
-        for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
-            let (nx, ny) = (x + dx, y + dy);
-            if nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
-                continue;
-            }
-            let j = ny as usize * w + nx as usize;
-            if source[j] == u32::MAX {
-                source[j] = source[i];
-                queue.push_back(j);
-            }
-        }
-    }
-    source
 }
 
 /// Orientation error of the texture against `field` over chart texels only.
@@ -740,9 +325,20 @@ fn preview(mesh: &TriMesh, texture: &Image, designed: &[PatchSingularity]) -> Im
         let p = mesh.triangle_positions(f);
         nsum = add(nsum, cross(sub(p[1], p[0]), sub(p[2], p[0])));
     }
-    let nrm = normalize(nsum).unwrap_or([0.0, 0.0, 1.0]);
-    let azimuth = nrm[0].atan2(nrm[2]).to_degrees() + 15.0;
-    let elevation = (nrm[1].clamp(-1.0, 1.0).asin().to_degrees() + 15.0).clamp(-80.0, 80.0);
+    let area2: f64 = (0..mesh.n_triangles())
+        .map(|f| {
+            let p = mesh.triangle_positions(f);
+            fieldtex_core::vec3::norm(cross(sub(p[1], p[0]), sub(p[2], p[0])))
+        })
+        .sum();
+    // Strongly curved patches (mean normal short) get the renderer's default view.
+    let (azimuth, elevation) = match normalize(nsum) {
+        Some(nrm) if fieldtex_core::vec3::norm(nsum) > 0.35 * area2 => (
+            nrm[0].atan2(nrm[2]).to_degrees() + 15.0,
+            (nrm[1].clamp(-1.0, 1.0).asin().to_degrees() + 15.0).clamp(-80.0, 80.0),
+        ),
+        _ => RenderOptions::default().view,
+    };
     let mut scene = Scene::new(mesh).with_texture(texture);
     for (kind, shape, color) in [
         (SingularityKind::Wedge, MarkerShape::Disc, [0.9, 0.15, 0.1, 1.0]),
