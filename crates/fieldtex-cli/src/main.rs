@@ -109,6 +109,10 @@ enum Command {
         /// presets are laid on the patch's UV bounding box.
         #[arg(long)]
         mesh: Option<PathBuf>,
+        /// With --mesh: texture only the connected region within radius R of the point
+        /// (X, Y, Z), e.g. to cut a disk out of a closed mesh.
+        #[arg(long, value_name = "X,Y,Z,R", value_delimiter = ',', allow_negative_numbers = true)]
+        patch: Option<Vec<f64>>,
         #[arg(long)]
         out: PathBuf,
     },
@@ -269,6 +273,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             scale,
             no_rosy_fix,
             mesh,
+            patch,
             out,
         } => {
             let source = match (design, preset, field) {
@@ -290,6 +295,16 @@ fn run(cli: Cli) -> Result<(), Error> {
             opts.seed = g.seed;
             let model = if mesh.is_some() { "model.glb, " } else { "" };
             opts.mesh = mesh;
+            opts.patch = match patch.as_deref() {
+                None => None,
+                Some(&[x, y, z, r]) => Some([x, y, z, r]),
+                Some(v) => {
+                    return Err(Error::bad_input(
+                        None,
+                        format!("--patch needs four numbers X,Y,Z,R; got {}", v.len()),
+                    ));
+                }
+            };
             let report = fieldtex::orient(&out, &opts, &progress)?;
             print_warnings(&report.warnings, g.quiet);
             say(&format!(
