@@ -145,6 +145,42 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Feature-aligned texturing (paper A): crest lines or given curves, an oriented
+    /// field, texture optimisation on the surface with feature-to-feature alignment;
+    /// writes model.glb, preview.png, report.json (and curves.obj, field.ply with --keep).
+    Align {
+        #[arg(long)]
+        mesh: PathBuf,
+        #[arg(long)]
+        exemplar: PathBuf,
+        /// OBJ polylines (`l` elements) to align to; default: detected crest lines.
+        #[arg(long)]
+        curves: Option<PathBuf>,
+        /// Exemplar feature lines as OBJ polylines in pixel coordinates (x right, y down);
+        /// default: detected from the exemplar.
+        #[arg(long)]
+        exemplar_lines: Option<PathBuf>,
+        /// Atlas texture size in texels (square).
+        #[arg(long, default_value_t = 1024)]
+        size: usize,
+        /// Size of one exemplar pixel in atlas texels (2 = pattern twice as large).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Ablation: no feature-to-feature alignment (paper A §5.2).
+        #[arg(long)]
+        no_feature_align: bool,
+        /// Curve orientation: greedy (paper A §4.1) or arbitrary (random, from --seed).
+        #[arg(long, default_value = "greedy", value_parser = ["greedy", "arbitrary"])]
+        orient: String,
+        /// Also write curves.obj and field.ply.
+        #[arg(long)]
+        keep: bool,
+        /// Draw the curves on preview.png.
+        #[arg(long)]
+        draw_curves: bool,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Render a shaded preview of a mesh (textured when it has a texture).
     Render {
         model: PathBuf,
@@ -324,6 +360,36 @@ fn run(cli: Cli) -> Result<(), Error> {
             let summary = fieldtex::field_file(&mesh, &out, &opts, &progress)?;
             print_warnings(&summary.warnings, g.quiet);
             println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+        }
+        Command::Align {
+            mesh,
+            exemplar,
+            curves,
+            exemplar_lines,
+            size,
+            scale,
+            no_feature_align,
+            orient,
+            keep,
+            draw_curves,
+            out,
+        } => {
+            let opts = fieldtex::AlignOptions {
+                mesh,
+                exemplar,
+                curves,
+                exemplar_lines,
+                size,
+                scale,
+                feature_align: !no_feature_align,
+                greedy: orient == "greedy",
+                keep,
+                draw_curves,
+                seed: g.seed,
+            };
+            let report = fieldtex::align(&out, &opts, &progress)?;
+            print_warnings(&report.warnings, g.quiet);
+            say(&format!("wrote {}/{{model.glb,preview.png,report.json}}", out.display()));
         }
         Command::Render { model, out, size, view } => {
             let opts = fieldtex::RenderCommandOptions { size, view };

@@ -544,3 +544,107 @@ fn orient_patch_refuses_non_disk_meshes() {
         assert!(!e.contains("panicked"), "{e}");
     }
 }
+
+/// Number of errors the Khronos validator reports for `glb`.
+fn validator_errors(glb: &Path) -> u64 {
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
+    assert!(
+        validator.join("node_modules/gltf-validator").is_dir(),
+        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
+    );
+    let o = Command::new("node").arg(validator.join("validate.js")).arg(glb).output().unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    report["issues"]["numErrors"].as_u64().unwrap_or(u64::MAX)
+}
+
+/// `align` on fandisk (crest lines, greedy field, texture optimisation with feature
+/// alignment): every output incl. `--keep` files, byte-identical for 1 and 2 threads,
+/// a valid GLB, and a report that carries the field and synthesis statistics.
+#[test]
+fn align_outputs_determinism_and_valid_glb() {
+    let mesh = shared().join("meshes/fandisk.obj");
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let (a, b) = (tmp("align-t1"), tmp("align-t2"));
+    for (dir, threads) in [(&a, "1"), (&b, "2")] {
+        let o = run(
+            &[
+                "align",
+                "--mesh",
+                mesh.to_str().unwrap(),
+                "--exemplar",
+                ex.to_str().unwrap(),
+                "--size",
+                "256",
+                "--keep",
+                "--out",
+                dir.to_str().unwrap(),
+                "--threads",
+                threads,
+                "--quiet",
+            ],
+            Duration::from_secs(300),
+        );
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+    }
+    for f in ["model.glb", "preview.png", "curves.obj", "field.ply"] {
+        let x = std::fs::read(a.join(f)).unwrap();
+        assert!(!x.is_empty(), "{f} is empty");
+        assert!(x == std::fs::read(b.join(f)).unwrap(), "{f} differs between 1 and 2 threads");
+    }
+    let r = report_without_timings(&a);
+    assert_eq!(r, report_without_timings(&b));
+    assert!(r["metrics"]["field"]["curves"].as_u64().unwrap() > 5, "{r}");
+    let levels = r["metrics"]["texopt"]["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 3);
+    assert!(levels.iter().all(|l| l["samples"].as_u64().unwrap() > 0));
+    assert!(r["metrics"]["texopt"]["feature_align"].as_bool().unwrap());
+    assert_eq!(validator_errors(&a.join("model.glb")), 0);
+}
+
+/// A sphere has no crest lines: `align` still textures it, with a warning naming the
+/// fallback; the ablation switch turns feature alignment off; bad inputs exit 2.
+#[test]
+fn align_fallback_ablation_and_bad_input() {
+    let d = tmp("align-sphere");
+    let obj = d.join("sphere.obj");
+    let m = fieldtex::crates::mesh::primitives::icosphere(3);
+    fieldtex::crates::io::write_obj(&obj, &m, None).unwrap();
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let out = d.join("out");
+    let args = |o: &Path| -> Vec<String> {
+        ["align", "--mesh", obj.to_str().unwrap(), "--exemplar", ex.to_str().unwrap()]
+            .iter()
+            .map(|s| s.to_string())
+            .chain(["--size", "128", "--no-feature-align", "--quiet", "--out"].map(String::from))
+            .chain([o.to_str().unwrap().to_string()])
+            .collect()
+    };
+    let a = args(&out);
+    let o = run(&a.iter().map(String::as_str).collect::<Vec<_>>(), Duration::from_secs(300));
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let r = report_without_timings(&out);
+    let warned = r["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "no-curves");
+    assert!(warned, "no fallback warning: {}", r["warnings"]);
+    assert!(!r["metrics"]["texopt"]["feature_align"].as_bool().unwrap());
+    assert!(out.join("model.glb").is_file());
+    // An exemplar smaller than the largest patch, and a missing exemplar: exit 2.
+    let small = d.join("small.png");
+    let im = fieldtex::Image::new(16, 16, [0.5, 0.5, 0.5, 1.0]);
+    fieldtex::crates::io::write_png(&small, &im).unwrap();
+    for bad in [small.clone(), d.join("missing.png")] {
+        let o = run(
+            &[
+                "align",
+                "--mesh",
+                obj.to_str().unwrap(),
+                "--exemplar",
+                bad.to_str().unwrap(),
+                "--out",
+                d.join("bad").to_str().unwrap(),
+            ],
+            Duration::from_secs(60),
+        );
+        assert_eq!(code(&o), 2, "{}", stderr(&o));
+        assert!(stderr(&o).contains(bad.file_name().unwrap().to_str().unwrap()), "{}", stderr(&o));
+    }
+}

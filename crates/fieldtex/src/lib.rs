@@ -15,6 +15,7 @@
 //! | [`crest_file`] | `fieldtex crest` |
 //! | [`field_file`] | `fieldtex field` (paper A §4) |
 //! | [`orient`] | `fieldtex orient` (paper D) |
+//! | [`align`] | `fieldtex align` (paper A) |
 
 mod error;
 mod outputs;
@@ -24,6 +25,7 @@ mod report;
 pub use error::{Error, Result};
 pub use fieldtex_core::{Image, NoProgress, Progress, Warning};
 pub use outputs::write_text;
+pub use pipelines::align::{AlignOptions, align};
 pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
 pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};
@@ -46,4 +48,5 @@ pub mod crates {
     pub use fieldtex_param as param;
     pub use fieldtex_render as render;
     pub use fieldtex_synth as synth;
+    pub use fieldtex_texopt as texopt;
 }

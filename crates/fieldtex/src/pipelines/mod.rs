@@ -1,4 +1,5 @@
 //! One module per pipeline.
+pub mod align;
 pub mod atlas;
 pub mod crest;
 pub mod demo;

@@ -1,0 +1,433 @@
+//! `fieldtex align`: feature-aligned shape texturing (paper A, Xu et al. 2009).
+//!
+//! Steps: read and repair the mesh; salient curves (given OBJ polylines, or crest lines
+//! detected with the default options); greedy curve orientation and harmonic penalty
+//! diffusion of the field (§4, rank-1 updates, see `field`); an atlas and its texel map;
+//! texture optimisation over the atlas texels as colour carriers with oriented
+//! tangent-plane patches (§5.1, `fieldtex-texopt`), optionally with feature-to-feature
+//! alignment (§5.2: exemplar feature lines and their distance map against the surface
+//! geodesic distance to the salient curves); the texture is the carriers' colours with
+//! gutters dilated. Writes `model.glb`, `preview.png`, `report.json` and, with `keep`,
+//! `curves.obj` and `field.ply`.
+//!
+//! A mesh without crest lines falls back to the fields crate's documented behaviour:
+//! principal curvature directions where no curve constrains the field (a warning says
+//! so); users can pass their own curves.
+
+use crate::outputs::{prepare_out_dir, write_report};
+use crate::pipelines::atlas::atlas_options;
+use crate::{Error, Progress, Report, Result};
+use fieldtex_core::{Image, Warning};
+use fieldtex_features::{ExemplarFeatureOptions, ExemplarFeatures};
+use fieldtex_fields::{CurveOrientationOptions, OrientationMode, orient_curves};
+use fieldtex_mesh::TriMesh;
+use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
+use fieldtex_texopt::{Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Options of [`align`].
+#[derive(Debug, Clone, Serialize)]
+pub struct AlignOptions {
+    pub mesh: PathBuf,
+    pub exemplar: PathBuf,
+    /// OBJ polylines; `None` detects crest lines.
+    pub curves: Option<PathBuf>,
+    /// Exemplar feature lines as polylines in pixel coordinates (OBJ `l` elements with
+    /// `x y 0` vertices); `None` detects them.
+    pub exemplar_lines: Option<PathBuf>,
+    /// Atlas resolution in texels. Default 1024.
+    pub size: usize,
+    /// Size of one exemplar pixel in atlas texels (2 = the pattern twice as large on the
+    /// surface). Default 1.
+    pub scale: f64,
+    /// Feature-to-feature alignment (§5.2). Default on; off is the ablation.
+    pub feature_align: bool,
+    /// `greedy` (default) or `arbitrary` curve orientation.
+    pub greedy: bool,
+    /// Also write `curves.obj` and `field.ply`.
+    pub keep: bool,
+    /// Draw the curves on the preview.
+    pub draw_curves: bool,
+    pub seed: u64,
+}
+
+impl Default for AlignOptions {
+    fn default() -> Self {
+        Self {
+            mesh: PathBuf::new(),
+            exemplar: PathBuf::new(),
+            curves: None,
+            exemplar_lines: None,
+            size: 1024,
+            scale: 1.0,
+            feature_align: true,
+            greedy: true,
+            keep: false,
+            draw_curves: false,
+            seed: 1,
+        }
+    }
+}
+
+/// The salient curves of `mesh`: read from `path`, or crest lines.
+pub(crate) fn salient_curves(
+    mesh: &TriMesh,
+    mesh_path: &Path,
+    path: Option<&Path>,
+    warnings: &mut Vec<Warning>,
+) -> Result<(Vec<Vec<[f64; 3]>>, String)> {
+    let (curves, source) = match path {
+        Some(p) => (fieldtex_io::read_obj_polylines(p)?, p.display().to_string()),
+        None => {
+            let crest =
+                fieldtex_features::crest_lines(mesh, &fieldtex_features::CrestOptions::default())
+                    .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
+            warnings.extend(crest.warnings.iter().cloned());
+            (
+                crest.lines.into_iter().map(|l| l.points).collect(),
+                "crest lines (default options)".to_string(),
+            )
+        }
+    };
+    if curves.is_empty() {
+        warnings.push(Warning::new(
+            "no-curves",
+            "no feature curve was found or given: the field follows principal curvature \
+             directions where no curve constrains it (pass --curves C.obj to steer it)",
+        ));
+    }
+    Ok((curves, source))
+}
+
+/// Preview of the textured model, optionally with the curves drawn.
+fn preview_with_curves(
+    mesh: &TriMesh,
+    texture: &Image,
+    curves: Option<&[Vec<[f64; 3]>]>,
+    size: usize,
+) -> Image {
+    let mut scene = Scene::new(mesh).with_texture(texture);
+    for c in curves.unwrap_or(&[]) {
+        scene = scene.with_overlay(Overlay::Polyline(
+            Polyline3::new(c.clone()).with_color([0.9, 0.15, 0.1, 1.0]),
+        ));
+    }
+    render(&scene, &RenderOptions { size, ..Default::default() })
+}
+
+/// Surface points `(triangle, barycentric)` along `curves`, about `spacing` apart, with
+/// the curve length each point stands for (for length-weighted measures).
+fn curve_surface_points(
+    bvh: &fieldtex_mesh::Bvh,
+    curves: &[Vec<[f64; 3]>],
+    spacing: f64,
+) -> Vec<((u32, [f64; 3]), f64)> {
+    let mut pts = Vec::new();
+    for c in curves {
+        for s in c.windows(2) {
+            let len = fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(s[1], s[0]));
+            if !len.is_finite() {
+                continue;
+            }
+            let n = ((len / spacing).ceil() as usize).clamp(1, 10_000);
+            for k in 0..n {
+                let t = (k as f64 + 0.5) / n as f64;
+                let p = fieldtex_core::vec3::lerp(s[0], s[1], t);
+                if let Some(cp) = bvh.closest_point(p) {
+                    pts.push(((cp.triangle, cp.barycentric), len / n as f64));
+                }
+            }
+        }
+    }
+    pts
+}
+
+/// Texel index of a surface point, through the atlas UVs (`None` off the atlas).
+fn texel_of(mesh: &TriMesh, size: usize, triangle: u32, bary: [f64; 3]) -> Option<usize> {
+    let uv = mesh.uvs.as_ref()?;
+    let t = uv.indices.get(triangle as usize)?;
+    let (mut u, mut v) = (0.0, 0.0);
+    for k in 0..3 {
+        let c = uv.values.get(t[k] as usize)?;
+        u += bary[k] * c[0];
+        v += bary[k] * c[1];
+    }
+    let x = (u * size as f64).floor();
+    let y = ((1.0 - v) * size as f64).floor();
+    if !(x >= 0.0 && y >= 0.0 && x < size as f64 && y < size as f64) {
+        return None;
+    }
+    Some(y as usize * size + x as usize)
+}
+
+/// Runs `fieldtex align` into `out_dir` (module docs).
+pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) -> Result<Report> {
+    let aopts = atlas_options(options.size, 4)?;
+    if !(options.scale.is_finite() && options.scale > 0.0 && options.scale <= 64.0) {
+        return Err(Error::bad_input(
+            None,
+            format!("--scale must be in (0, 64], got {}", options.scale),
+        ));
+    }
+    let mut inputs = vec![options.mesh.as_path(), options.exemplar.as_path()];
+    if let Some(c) = &options.curves {
+        inputs.push(c);
+    }
+    let mut report =
+        Report::new("align", options.seed, serde_json::to_value(options).unwrap_or_default());
+    let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
+    report.warnings.extend(loaded.warnings.iter().cloned());
+    let exemplar = fieldtex_io::read_image(&options.exemplar)?;
+    let min_side = TexOptOptions::default().patch_sizes.into_iter().max().unwrap_or(8);
+    if exemplar.width < min_side || exemplar.height < min_side {
+        return Err(Error::bad_input(
+            Some(&options.exemplar),
+            format!(
+                "the exemplar is {}×{} pixels; align needs at least {min_side}×{min_side} (its largest patch)",
+                exemplar.width, exemplar.height
+            ),
+        ));
+    }
+    prepare_out_dir(out_dir)?;
+    for name in ["model.glb", "preview.png", "report.json", "curves.obj", "field.ply"] {
+        fieldtex_io::ensure_not_input(&out_dir.join(name), &inputs)?;
+    }
+    // 1. Repair once; everything below uses this mesh (the atlas keeps its triangles).
+    let repaired = report.time("repair", || {
+        fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default())
+    });
+    for c in &repaired.changes {
+        report.warnings.push(Warning::new(
+            format!("repair:{}", c.code),
+            format!("{} ({})", c.message, c.count),
+        ));
+    }
+    report.warnings.extend(repaired.warnings.iter().cloned());
+    let mesh = repaired.mesh;
+    if mesh.triangles.is_empty() {
+        return Err(Error::bad_input(
+            Some(&options.mesh),
+            "no usable triangle is left after repair",
+        ));
+    }
+    report.input = serde_json::json!({
+        "mesh": options.mesh.display().to_string(),
+        "vertices": mesh.n_vertices(),
+        "triangles": mesh.n_triangles(),
+        "exemplar": options.exemplar.display().to_string(),
+        "exemplar_size": [exemplar.width, exemplar.height],
+    });
+    // 2. Salient curves and the oriented field (paper A §3–4).
+    let mut warnings = Vec::new();
+    let (curves, curves_source) = report.time("curves", || {
+        salient_curves(&mesh, &options.mesh, options.curves.as_deref(), &mut warnings)
+    })?;
+    report.warnings.extend(warnings);
+    let mode = if options.greedy {
+        OrientationMode::Greedy
+    } else {
+        OrientationMode::Arbitrary { seed: options.seed }
+    };
+    let copts = CurveOrientationOptions { mode, ..Default::default() };
+    let oriented = report
+        .time("field", || orient_curves(&mesh, &curves, &copts, progress))
+        .map_err(|e| Error::Internal(format!("field: {e}")))?;
+    report.warnings.extend(oriented.warnings.iter().cloned());
+    report.warnings.extend(oriented.field.warnings.iter().cloned());
+    let field_metrics = fieldtex_fields::surface_field_metrics(
+        &mesh,
+        &oriented.field.vectors,
+        &oriented.solver.constraints(),
+    )
+    .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
+    report.metric(
+        "field",
+        serde_json::json!({
+            "curves": curves.len(),
+            "curves_source": curves_source,
+            "orientation": if options.greedy { "greedy" } else { "arbitrary" },
+            "singularities": field_metrics.singularities.len(),
+            "index_sum": field_metrics.index_sum,
+            "dirichlet_energy": field_metrics.dirichlet_energy,
+            "alignment_mean_deg": field_metrics.alignment.mean_deg,
+        }),
+    );
+    let field = oriented.field.vectors.clone();
+    let normals = oriented.solver.normals().to_vec();
+    drop(oriented);
+    // 3. Atlas and colour carriers (covered texels).
+    let atlas = report
+        .time("atlas", || fieldtex_param::build_atlas(&mesh, &aopts, progress))
+        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+    report.warnings.extend(atlas.warnings.iter().cloned());
+    let size = options.size;
+    let map = report
+        .time("texel_map", || {
+            fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
+        })
+        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+    let covered: Vec<usize> = (0..size * size).filter(|&i| map.is_covered(i)).collect();
+    let carriers: Vec<Carrier> = covered
+        .iter()
+        .filter_map(|&i| map.entries[i])
+        .map(|e| Carrier {
+            triangle: e.triangle,
+            barycentric: [e.bary[0] as f64, e.bary[1] as f64, e.bary[2] as f64],
+        })
+        .collect();
+    let (domain, dwarn) = report
+        .time("domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
+        .map_err(|e| Error::Internal(format!("surface domain: {e}")))?;
+    report.warnings.extend(dwarn);
+    let topts = TexOptOptions {
+        pixel_size: Some(domain.carrier_spacing() / options.scale),
+        feature_align: options.feature_align,
+        seed: options.seed,
+        ..Default::default()
+    };
+    // 4. Feature alignment inputs (§5.2).
+    let bvh =
+        fieldtex_mesh::Bvh::build(&atlas.mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+    let h = topts.pixel_size.unwrap_or(1.0);
+    let curve_points = curve_surface_points(&bvh, &curves, h);
+    let exemplar_features = report.time("exemplar_features", || -> Result<ExemplarFeatures> {
+        match &options.exemplar_lines {
+            Some(p) => {
+                let lines: Vec<Vec<[f32; 2]>> = fieldtex_io::read_obj_polylines(p)?
+                    .into_iter()
+                    .map(|l| l.into_iter().map(|q| [q[0] as f32, q[1] as f32]).collect())
+                    .collect();
+                fieldtex_features::exemplar_features_from_polylines(
+                    exemplar.width,
+                    exemplar.height,
+                    &lines,
+                    topts.toroidal,
+                )
+                .map_err(|e| Error::bad_input(Some(p), e.to_string()))
+            }
+            None => fieldtex_features::detect_exemplar_feature_lines(
+                &exemplar,
+                &ExemplarFeatureOptions { toroidal: topts.toroidal, ..Default::default() },
+            )
+            .map_err(|e| Error::bad_input(Some(&options.exemplar), e.to_string())),
+        }
+    })?;
+    report.warnings.extend(exemplar_features.warnings.iter().cloned());
+    let features = if options.feature_align && !curve_points.is_empty() {
+        let vertex_distance = report.time("curve_distance", || -> Result<Vec<f64>> {
+            let heat = fieldtex_mesh::HeatGeodesic::new(
+                &atlas.mesh,
+                &fieldtex_mesh::HeatGeodesicOptions::default(),
+            )
+            .map_err(|e| Error::Internal(format!("geodesic distance: {e}")))?;
+            let pts: Vec<_> = curve_points.iter().map(|p| p.0).collect();
+            heat.distance_from_points(&pts)
+                .map_err(|e| Error::Internal(format!("geodesic distance: {e}")))
+        })?;
+        let carrier_curve_distance = carriers
+            .iter()
+            .map(|c| {
+                let t = atlas.mesh.triangles[c.triangle as usize];
+                (0..3).map(|k| c.barycentric[k] * vertex_distance[t[k] as usize]).sum::<f64>()
+            })
+            .map(|d: f64| if d.is_finite() { d.max(0.0) } else { f64::INFINITY })
+            .collect();
+        Some(FeatureAlignment {
+            exemplar_distance: exemplar_features.distance.clone(),
+            carrier_curve_distance,
+        })
+    } else {
+        None
+    };
+    // 5. Texture optimisation (§5.1).
+    let result = report
+        .time("synthesis", || {
+            fieldtex_texopt::optimise(&domain, &exemplar, &topts, features.as_ref(), progress)
+        })
+        .map_err(|e| match e {
+            TexOptError::ExemplarTooSmall { .. }
+            | TexOptError::ExemplarBufferSize { .. }
+            | TexOptError::NonFiniteExemplar { .. } => {
+                Error::bad_input(Some(&options.exemplar), e.to_string())
+            }
+            e => Error::Internal(format!("texture optimisation: {e}")),
+        })?;
+    report.warnings.extend(result.warnings.iter().cloned());
+    let mut texture = Image::new(size, size, [0.5, 0.5, 0.5, 1.0]);
+    let mut carrier_of_texel = vec![u32::MAX; size * size];
+    for (k, &i) in covered.iter().enumerate() {
+        texture.pixels[i] = result.colors[k];
+        carrier_of_texel[i] = k as u32;
+    }
+    for i in 0..size * size {
+        let s = map.source[i];
+        if s != u32::MAX && s as usize != i {
+            texture.pixels[i] = texture.pixels[s as usize];
+        }
+    }
+    // 6. Metrics.
+    let coverage_samples: Vec<([f32; 2], f64)> = curve_points
+        .iter()
+        .filter_map(|&((f, b), w)| {
+            let texel = texel_of(&atlas.mesh, size, f, b)?;
+            let src = map.source[texel];
+            let k = *carrier_of_texel.get(src as usize)?;
+            (k != u32::MAX).then(|| (result.source[k as usize], w))
+        })
+        .collect();
+    // Per-level wall times belong to the (nondeterministic) timings section.
+    let mut levels = serde_json::to_value(&result.levels).unwrap_or_default();
+    for (l, stats) in levels.as_array_mut().into_iter().flatten().zip(&result.levels) {
+        if let Some(o) = l.as_object_mut() {
+            o.remove("seconds");
+        }
+        report.timings_ms.push((format!("synthesis_w{}", stats.patch_size), stats.seconds * 1e3));
+    }
+    report.metric(
+        "texopt",
+        serde_json::json!({
+            "pixel_size": result.pixel_size,
+            "carriers": carriers.len(),
+            "levels": levels,
+            "feature_align": features.is_some(),
+            "exemplar_feature_lines": exemplar_features.lines.len(),
+        }),
+    );
+    let total: f64 = coverage_samples.iter().map(|s| s.1).sum();
+    let on_line: f64 = coverage_samples
+        .iter()
+        // texopt's coordinates put pixel centres at i + 0.5, the distance map at i.
+        .filter(|s| exemplar_features.distance_at(s.0[0] as f64 - 0.5, s.0[1] as f64 - 0.5) <= 1.0)
+        .map(|s| s.1)
+        .sum();
+    report.metric(
+        "feature_coverage",
+        serde_json::json!({
+            "fraction": if total > 0.0 { on_line / total } else { f64::NAN },
+            "curve_length": total,
+            "tolerance_px": 1.0,
+        }),
+    );
+    // 7. Outputs.
+    report.time("write", || super::write_model(out_dir, &atlas.mesh, Some(&texture)))?;
+    let preview = report.time("preview", || {
+        preview_with_curves(&atlas.mesh, &texture, options.draw_curves.then_some(&curves[..]), 800)
+    });
+    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    if options.keep {
+        fieldtex_io::write_obj_polylines(&out_dir.join("curves.obj"), &curves)?;
+        let mut ply_mesh = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
+        ply_mesh.vertex_normals = Some(normals.clone());
+        let comp = |k: usize| -> Vec<f32> { field.iter().map(|v| v[k] as f32).collect() };
+        let (fx, fy, fz) = (comp(0), comp(1), comp(2));
+        fieldtex_io::write_ply(
+            &out_dir.join("field.ply"),
+            &ply_mesh,
+            &[("fx", &fx), ("fy", &fy), ("fz", &fz)],
+            true,
+        )?;
+    }
+    write_report(out_dir, &report)?;
+    Ok(report)
+}
