@@ -6,7 +6,10 @@
 //! - [`color_sliced_wasserstein()`]: distance between colour distributions;
 //! - [`orientation_error`]: structure-tensor feature direction vs a guidance field;
 //! - [`singularities()`]: ±1/2 singularities of an orientation map;
-//! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px.
+//! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px;
+//! - [`surface_orientation_error`]: orientation error on a textured mesh by
+//!   tangent-plane resampling; [`feature_line_coverage`]: salient-curve length on
+//!   which an exemplar feature line lies.
 //!
 //! Every metric returns a `serde::Serialize` report for `report.json`.
 //!
@@ -23,6 +26,7 @@ pub mod nearest_patch;
 pub mod orientation;
 pub mod phase_defects;
 pub mod singularities;
+pub mod surface_metrics;
 
 pub use coherence::coherence;
 pub use color_sliced_wasserstein::{
@@ -46,4 +50,8 @@ pub use phase_defects::{
 pub use singularities::{
     ExpectedSingularity, Singularity, SingularityCluster, SingularityMatch, SingularityOptions,
     SingularityReport, match_singularities, singularities,
+};
+pub use surface_metrics::{
+    CurveSample, FeatureCoverageOptions, FeatureCoverageReport, SurfaceOrientationOptions,
+    SurfaceOrientationReport, feature_line_coverage, surface_orientation_error,
 };
