@@ -18,9 +18,10 @@
 //!   factor has been downdated one refinement step is always taken
 //!   ([`CholeskyOptions::refine_after_downdate`]).
 //! - **Parallelism**: the numeric factorisation uses faer with the current rayon pool.
-//!   Solves run faer's triangular solves with `Par::Seq` per right-hand side (faer's
-//!   multi-RHS supernodal solve under `Par::Rayon` is 6–10× slower, DEPENDENCIES.md);
-//!   [`Cholesky::solve_many`] runs right-hand sides in parallel.
+//!   Solves run faer's triangular solves with `Par::Seq` (faer's multi-RHS supernodal
+//!   solve under `Par::Rayon` is 6–10× slower, DEPENDENCIES.md);
+//!   [`Cholesky::solve_many`] solves up to 8 right-hand sides in one pass over the factor
+//!   (`crate::multi_rhs_solve`), larger sets in parallel blocks.
 //! - Not implemented: `LDLᵀ` / indefinite matrices, regularisation of singular matrices
 //!   (a singular or indefinite matrix is a [`LinalgError::FactorizationFailed`]).
 
@@ -33,7 +34,6 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky as fc;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
-use rayon::prelude::*;
 
 use crate::cholesky_update::DynamicFactor;
 use crate::{LinalgError, SparseMatrix};
@@ -349,88 +349,24 @@ impl Cholesky {
                 found: b.len(),
             });
         }
-        if let Some(index) = b.iter().position(|v| !v.is_finite()) {
-            return Err(LinalgError::NonFinite { what: "right-hand side", index });
-        }
-        let b_norm = norm2(b);
-        if b_norm == 0.0 {
-            return Ok((vec![0.0; n], 0.0));
-        }
-        let mut x = b.to_vec();
-        self.raw_solve_in_place(&mut x);
-        let mut r = self.residual(&x, b);
-        let mut rel = norm2(&r) / b_norm;
-        let mut steps = 0;
-        // After a downdate the factor carries an absolute error ~ε·(removed weight); one
-        // refinement step against the exact matrix removes it from the solution even
-        // when the residual already looks small.
-        let forced = if self.downdated && self.options.refine_after_downdate { 1 } else { 0 };
-        while (steps < forced || exceeds(rel, self.options.refine_above))
-            && steps < self.options.max_refinement_steps.max(forced)
-        {
-            if !rel.is_finite() {
-                break;
-            }
-            self.raw_solve_in_place(&mut r);
-            let candidate: Vec<f64> = x.iter().zip(&r).map(|(a, d)| a + d).collect();
-            let r_new = self.residual(&candidate, b);
-            let rel_new = norm2(&r_new) / b_norm;
-            steps += 1;
-            let accept = if steps <= forced { rel_new.is_finite() } else { rel_new < rel };
-            if !accept {
-                break;
-            }
-            x = candidate;
-            r = r_new;
-            rel = rel_new;
-        }
-        if exceeds(rel, self.options.residual_tolerance) || x.iter().any(|v| !v.is_finite()) {
-            return Err(LinalgError::SolveFailed {
-                size: n,
-                residual: rel,
-                tolerance: self.options.residual_tolerance,
-            });
-        }
-        Ok((x, rel))
+        let (x, rel) = self.solve_block(b, 1)?;
+        Ok((x, rel[0]))
     }
 
-    /// Solves `A X = B` for several right-hand sides (in parallel, each sequential);
-    /// fails if any of them fails. [`Cholesky::last_residual`] gets the largest residual.
-    pub fn solve_many(&self, b: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, LinalgError> {
-        let results: Vec<_> = b.par_iter().map(|bi| self.solve_with_residual(bi)).collect();
-        let mut out = Vec::with_capacity(b.len());
-        let mut worst = 0.0f64;
-        for res in results {
-            let (x, r) = res?;
-            worst = worst.max(r);
-            out.push(x);
-        }
-        self.last_residual.store(worst.to_bits(), Ordering::Relaxed);
-        Ok(out)
+    pub(crate) fn store_last_residual(&self, r: f64) {
+        self.last_residual.store(r.to_bits(), Ordering::Relaxed);
     }
 
-    /// `r = b − A x` with the current matrix (extra rank-1 terms included).
-    fn residual(&self, x: &[f64], b: &[f64]) -> Vec<f64> {
-        // A is symmetric, so Aᵀx (column-parallel, fixed order) equals A x.
-        let mut ax = self.matrix.transpose_mul_vec(x);
-        for (w, sign) in &self.extra_terms {
-            let d: f64 = w.iter().map(|&(i, v)| v * x[i]).sum();
-            for &(i, v) in w {
-                ax[i] += sign * v * d;
-            }
-        }
-        b.iter().zip(ax).map(|(bi, a)| bi - a).collect()
-    }
-
-    /// `x ← A⁻¹ x` with the current factor, no checks.
-    pub(crate) fn raw_solve_in_place(&self, x: &mut [f64]) {
+    /// `X ← A⁻¹ X` for a column-major `n × k` block with the current factor, no checks:
+    /// one forward and one backward pass over the factor for all `k` columns.
+    pub(crate) fn raw_solve_block_in_place(&self, x: &mut [f64], k: usize) {
         let n = self.size();
-        if n == 0 {
+        if n == 0 || k == 0 {
             return;
         }
         let values = match &self.dynamic {
             Some(d) if !d.faer_layout => {
-                d.solve_in_place(x);
+                d.solve_block_in_place(x, k);
                 return;
             }
             Some(d) => &d.values()[..self.symbolic.inner.faer.len_val()],
@@ -438,8 +374,8 @@ impl Cholesky {
         };
         let fsym = &self.symbolic.inner.faer;
         let llt = fc::LltRef::new(fsym, values);
-        let mut mem = MemBuffer::new(fsym.solve_in_place_scratch::<f64>(1, Par::Seq));
-        let rhs = MatMut::from_column_major_slice_mut(x, n, 1);
+        let mut mem = MemBuffer::new(fsym.solve_in_place_scratch::<f64>(k, Par::Seq));
+        let rhs = MatMut::from_column_major_slice_mut(x, n, k);
         llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut mem));
     }
 
@@ -447,11 +383,6 @@ impl Cholesky {
     pub(crate) fn take_faer_values(&mut self) -> (&fc::SymbolicCholesky<usize>, Vec<f64>) {
         (&self.symbolic.inner.faer, std::mem::take(&mut self.values))
     }
-}
-
-/// `true` when `r` is NaN or above `tol`.
-fn exceeds(r: f64, tol: f64) -> bool {
-    r.is_nan() || r > tol
 }
 
 pub(crate) fn failed(size: usize, reason: String) -> LinalgError {

@@ -32,8 +32,9 @@
 //! solves after a downdate take one step of iterative refinement against the exact
 //! matrix (`CholeskyOptions::refine_after_downdate`).
 //!
-//! Not implemented: multiple-rank updates (Davis & Hager 2001; apply rank-1 updates in
-//! turn), row/column addition and deletion, and pattern shrinking (entries cancelled by
+//! Multiple-rank updates of diagonal penalties (Davis & Hager 2001) are in
+//! `crate::multiple_rank_update`. Not implemented: general (non-diagonal) multiple-rank
+//! updates (apply rank-1 updates in turn), row/column addition and deletion, and pattern shrinking (entries cancelled by
 //! a downdate stay as explicit zeros).
 
 use faer::sparse::linalg::cholesky as fc;
@@ -51,7 +52,7 @@ pub enum UpdateSign {
     Down,
 }
 
-const NONE: usize = usize::MAX;
+pub(crate) const NONE: usize = usize::MAX;
 
 /// Simplicial lower-triangular factor of `P A Pᵀ` (`perm[k]` = original index of the
 /// `k`-th unknown), column `j` stored at `start[j]..start[j] + len[j]` with the diagonal
@@ -60,20 +61,22 @@ const NONE: usize = usize::MAX;
 pub(crate) struct DynamicFactor {
     /// `vals[..len_val]` is still a valid faer factor (no column has moved).
     pub(crate) faer_layout: bool,
-    perm: Vec<usize>,
-    inv: Vec<usize>,
-    start: Vec<usize>,
-    len: Vec<usize>,
-    cap: Vec<usize>,
-    rows: Vec<u32>,
-    vals: Vec<f64>,
-    parent: Vec<usize>,
+    pub(crate) perm: Vec<usize>,
+    pub(crate) inv: Vec<usize>,
+    pub(crate) start: Vec<usize>,
+    pub(crate) len: Vec<usize>,
+    pub(crate) cap: Vec<usize>,
+    pub(crate) rows: Vec<u32>,
+    pub(crate) vals: Vec<f64>,
+    pub(crate) parent: Vec<usize>,
     // scratch
-    work: Vec<f64>,
-    mark: Vec<u64>,
-    stamp: u64,
-    path: Vec<usize>,
-    backup: Vec<f64>,
+    pub(crate) work: Vec<f64>,
+    pub(crate) mark: Vec<u64>,
+    pub(crate) stamp: u64,
+    pub(crate) path: Vec<usize>,
+    pub(crate) backup: Vec<f64>,
+    /// Compact slot of each column on a multiple-rank path (`crate::multiple_rank_update`).
+    pub(crate) slot: Vec<u32>,
 }
 
 impl DynamicFactor {
@@ -178,10 +181,11 @@ impl DynamicFactor {
             stamp: 0,
             path: Vec::new(),
             backup: Vec::new(),
+            slot: Vec::new(),
         }
     }
 
-    fn n(&self) -> usize {
+    pub(crate) fn n(&self) -> usize {
         self.perm.len()
     }
 
@@ -207,31 +211,52 @@ impl DynamicFactor {
         &self.vals
     }
 
-    /// `x ← A⁻¹ x`: permute, `L y = P x`, `Lᵀ z = y`, permute back (own simplicial
-    /// loops; used once fill has moved columns out of faer's layout).
-    pub(crate) fn solve_in_place(&self, x: &mut [f64]) {
+    /// `X ← A⁻¹ X` for a column-major `n × k` block: permute, `L Y = P X`, `Lᵀ Z = Y`,
+    /// permute back, with the `k` columns interleaved so each factor entry is read once
+    /// per pass (own simplicial loops; used once fill has moved columns out of faer's
+    /// layout).
+    pub(crate) fn solve_block_in_place(&self, x: &mut [f64], k: usize) {
         let n = self.n();
-        let mut y: Vec<f64> = self.perm.iter().map(|&p| x[p]).collect();
+        let mut y = vec![0.0f64; n * k];
+        for (i, &p) in self.perm.iter().enumerate() {
+            for c in 0..k {
+                y[i * k + c] = x[c * n + p];
+            }
+        }
+        let mut t = vec![0.0f64; k];
         for j in 0..n {
             let s = self.start[j];
-            let yj = y[j] / self.vals[s];
-            y[j] = yj;
-            if yj != 0.0 {
-                for p in s + 1..s + self.len[j] {
-                    y[self.rows[p] as usize] -= self.vals[p] * yj;
+            let d = self.vals[s];
+            t.copy_from_slice(&y[j * k..(j + 1) * k]);
+            for tc in t.iter_mut() {
+                *tc /= d;
+            }
+            y[j * k..(j + 1) * k].copy_from_slice(&t);
+            for p in s + 1..s + self.len[j] {
+                let (r, v) = (self.rows[p] as usize, self.vals[p]);
+                for (yc, tc) in y[r * k..(r + 1) * k].iter_mut().zip(&t) {
+                    *yc -= v * tc;
                 }
             }
         }
         for j in (0..n).rev() {
             let s = self.start[j];
-            let mut t = y[j];
+            t.copy_from_slice(&y[j * k..(j + 1) * k]);
             for p in s + 1..s + self.len[j] {
-                t -= self.vals[p] * y[self.rows[p] as usize];
+                let (r, v) = (self.rows[p] as usize, self.vals[p]);
+                for (tc, yc) in t.iter_mut().zip(&y[r * k..(r + 1) * k]) {
+                    *tc -= v * yc;
+                }
             }
-            y[j] = t / self.vals[s];
+            let d = self.vals[s];
+            for (yc, tc) in y[j * k..(j + 1) * k].iter_mut().zip(&t) {
+                *yc = tc / d;
+            }
         }
-        for (k, &p) in self.perm.iter().enumerate() {
-            x[p] = y[k];
+        for (i, &p) in self.perm.iter().enumerate() {
+            for c in 0..k {
+                x[c * n + p] = y[i * k + c];
+            }
         }
     }
 
@@ -442,18 +467,7 @@ impl Cholesky {
                 index,
             });
         }
-        if self.dynamic.is_none() {
-            if n >= u32::MAX as usize {
-                return Err(LinalgError::Dimension {
-                    what: "rank-1 updates support n < 2³²",
-                    expected: u32::MAX as usize - 1,
-                    found: n,
-                });
-            }
-            let (sym, values) = self.take_faer_values();
-            self.dynamic = Some(DynamicFactor::from_faer(sym, values));
-        }
-        let dynamic = self.dynamic.as_mut().expect("created above");
+        let dynamic = self.ensure_dynamic()?;
         let permuted: Vec<(usize, f64)> =
             merged.iter().map(|&(i, v)| (dynamic.inv[i], v)).collect();
         let up = sign == UpdateSign::Up;
@@ -484,6 +498,23 @@ impl Cholesky {
             None => self.extra_terms.push((merged, s)),
         }
         Ok(())
+    }
+
+    /// The updatable factor, taking over faer's factor on first use (needs `n < 2³²`).
+    pub(crate) fn ensure_dynamic(&mut self) -> Result<&mut DynamicFactor, LinalgError> {
+        if self.dynamic.is_none() {
+            let n = self.size();
+            if n >= u32::MAX as usize {
+                return Err(LinalgError::Dimension {
+                    what: "rank-1 updates support n < 2³²",
+                    expected: u32::MAX as usize - 1,
+                    found: n,
+                });
+            }
+            let (sym, values) = self.take_faer_values();
+            self.dynamic = Some(DynamicFactor::from_faer(sym, values));
+        }
+        Ok(self.dynamic.as_mut().expect("created above"))
     }
 
     /// Adds the penalty `α eᵢ eᵢᵀ` (a soft constraint on unknown `i`); `α` finite, > 0.
@@ -518,7 +549,7 @@ impl Cholesky {
     }
 }
 
-fn check_alpha(alpha: f64) -> Result<(), LinalgError> {
+pub(crate) fn check_alpha(alpha: f64) -> Result<(), LinalgError> {
     if !(alpha.is_finite() && alpha > 0.0) {
         return Err(LinalgError::InvalidArgument {
             what: "penalty weight alpha",

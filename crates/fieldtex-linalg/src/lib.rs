@@ -23,19 +23,23 @@
 //! - Nothing is ever returned as NaN silently: non-finite input, failed factorisations
 //!   and solves whose residual is too large are typed [`LinalgError`]s.
 //! - Determinism: numeric factorisation runs faer with the current rayon pool; solves run
-//!   sequentially per right-hand side (right-hand sides in parallel), and every reduction
+//!   sequentially per block of up to [`MAX_BLOCK`] right-hand sides (blocks in
+//!   parallel), and every reduction
 //!   has a fixed order, so results do not depend on the thread count.
 
 mod cholesky;
 mod cholesky_update;
 mod dense;
 mod least_squares;
+mod multi_rhs_solve;
+mod multiple_rank_update;
 mod sparse_matrix;
 
 pub use cholesky::{Cholesky, CholeskyOptions, FactorLayout, SymbolicCholesky};
 pub use cholesky_update::UpdateSign;
 pub use dense::{Pca, symmetric_eigen};
 pub use least_squares::least_squares;
+pub use multi_rhs_solve::MAX_BLOCK;
 pub use sparse_matrix::SparseMatrix;
 
 use thiserror::Error;

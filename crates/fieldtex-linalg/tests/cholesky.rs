@@ -61,7 +61,9 @@ fn solve_many_matches_single_solves() {
     let bs: Vec<Vec<f64>> = (0..3).map(|_| rng.vec(w * h)).collect();
     let xs = chol.solve_many(&bs).unwrap();
     for (b, x) in bs.iter().zip(&xs) {
-        assert_eq!(&chol.solve(b).unwrap(), x);
+        let single = chol.solve(b).unwrap();
+        let d = max_abs_diff(&single, x) / max_abs(&single);
+        assert!(d < 1e-13, "blocked vs single solve: {d:e}");
     }
     assert!(chol.solve_many(&[]).unwrap().is_empty());
 }

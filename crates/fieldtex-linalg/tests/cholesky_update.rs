@@ -207,7 +207,7 @@ fn penalty_constraints_on_a_grid_laplacian_with(layout: FactorLayout) {
     assert!(rel_residual(&direct, &x, &b) < 1e-12);
     // multi-RHS after updates
     let xs = chol.solve_many(&[b.clone(), rng.vec(n)]).unwrap();
-    assert_eq!(xs[0], x);
+    assert!(rel_diff(&xs[0], &x) < 1e-13, "{}", rel_diff(&xs[0], &x));
 }
 
 #[test]
