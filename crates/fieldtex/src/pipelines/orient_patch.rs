@@ -242,15 +242,15 @@ fn texel_field(
         let mesh_design = file.domain.kind == DomainKind::Mesh;
         let mut fd = build_mesh_design(&file, &patch.mesh, mesh_design, &mut mapping_warnings)
             .map_err(bad)?;
+        if fd.dec().n_faces() != patch.mesh.n_triangles() {
+            return Err(Error::Internal("the field design changed the patch's triangles".into()));
+        }
         if !mesh_design {
             map_plane_design(&file, patch, map, &mut fd, &mut mapping_warnings).map_err(bad)?;
         }
         Ok(fd)
     })?;
     report.warnings.extend(mapping_warnings);
-    if fd.dec().n_faces() != patch.mesh.n_triangles() {
-        return Err(Error::Internal("field design changed the patch's triangles".into()));
-    }
     let mut fd = fd;
     let solved = report
         .time("field_solve", || fd.solve())
