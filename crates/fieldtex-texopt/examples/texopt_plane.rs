@@ -54,6 +54,20 @@ fn main() {
         luma[(size - 1 - j) * size + i] = 0.2126 * col[0] + 0.7152 * col[1] + 0.0722 * col[2];
     }
     img.save(&out).expect("write png");
+    // The same carriers coloured by their source coordinate (nearest exemplar pixel).
+    let mut src_img = image::RgbaImage::new(size as u32, size as u32);
+    for (c, &v) in vertices.iter().enumerate() {
+        let (i, j) = (v as usize % size, v as usize / size);
+        let [x, y] = result.source[c];
+        let col = exemplar
+            .get((x as usize).min(exemplar.width - 1), (y as usize).min(exemplar.height - 1));
+        src_img.put_pixel(
+            i as u32,
+            (size - 1 - j) as u32,
+            image::Rgba(col.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)),
+        );
+    }
+    src_img.save(out.with_extension("source.png")).expect("write png");
     let (ex_angle, _) =
         dominant_orientation(&exemplar.luminance(), exemplar.width, exemplar.height)
             .unwrap_or((0.0, 0.0));

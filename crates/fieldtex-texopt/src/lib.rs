@@ -36,8 +36,16 @@
 //!
 //! # Substitutes and what is not implemented
 //! - Large patches are described by an `8 × 8` grid every `w/8` pixels of a
-//!   tent-filtered exemplar (192-D), for every `w`; all carriers stay at full
-//!   resolution at every level (no carrier hierarchy as in Kwatra 2007).
+//!   tent-filtered exemplar (192-D), for every `w`. Coarse levels (`w > 8`) iterate on
+//!   a subset of carriers about `0.75·w/8` pixels apart and blend all carriers once at
+//!   the end of the level; this stands in for Kwatra 2007's mesh hierarchy.
+//! - Matches carry a sub-pixel origin offset inherited through coherence, so patches
+//!   copied from one exemplar region agree exactly across rotated sample frames.
+//! - The blend weights patch pixels by a Gaussian falloff from the patch centre
+//!   ([`TexOptOptions::blend_falloff`], `σ = 1.5` grid units by default; `None` gives
+//!   the plain Kwatra average). The plain average is visibly blurrier; even with the
+//!   falloff, fine exemplar detail is softened where overlapping matches disagree.
+//!   [`TexOptResult::source`] gives the sharp winner-take-all alternative.
 //! - Search: no k-d tree (DEPENDENCIES.md: trees do not help at this dimension);
 //!   exhaustive PCA scan within a budget, strided subsets beyond it, plus coherence and
 //!   random candidates. No k-coherence precomputation.

@@ -49,6 +49,10 @@ pub struct TexOptOptions {
     /// Carriers whose normal makes a cosine below this with the patch normal are not
     /// part of the patch (the other side of thin parts). Default 0.3.
     pub normal_cosine: f64,
+    /// `σ` (patch grid units, one unit = `w/8` pixels) of the Gaussian falloff weighting
+    /// patch pixels in the blend; `None` for Kwatra 2005's uniform patch weights (blurrier
+    /// where overlapping matches disagree). Default `Some(1.5)`.
+    pub blend_falloff: Option<f64>,
     /// Seed of all random streams. Default 0.
     pub seed: u64,
 }
@@ -71,6 +75,7 @@ impl Default for TexOptOptions {
             feature_align: true,
             feature_threshold: 1.0,
             normal_cosine: 0.3,
+            blend_falloff: Some(1.5),
             seed: 0,
         }
     }
@@ -145,6 +150,11 @@ impl TexOptOptions {
         let t = self.feature_threshold;
         if !(t.is_finite() && t >= 0.0) {
             return bad("feature_threshold", t, "must be non-negative and finite");
+        }
+        if let Some(sigma) = self.blend_falloff
+            && !(sigma.is_finite() && sigma > 0.0)
+        {
+            return bad("blend_falloff", sigma, "must be positive and finite (or None)");
         }
         let n = self.normal_cosine;
         if !(n.is_finite() && (-1.0..=1.0).contains(&n)) {

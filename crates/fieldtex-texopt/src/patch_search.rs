@@ -2,7 +2,8 @@
 //! paper A §5.2 constrained candidates).
 //!
 //! The sample's current colours are gathered into the `8 × 8` descriptor grid of its
-//! oriented patch: every carrier within the footprint (same side of the surface, patch
+//! oriented patch: every *active* carrier (all carriers at `w = 8`, a subset about
+//! `0.75·s·h` apart for coarser patches) within the footprint (same side of the surface, patch
 //! coordinates in `[−½, 7½)²`) is splatted bilinearly onto the grid, and empty grid
 //! points take the patch mean. Candidates, each compared with the exact 192-D distance:
 //! - the sample's previous match;
@@ -28,10 +29,26 @@ const MAX_CANDIDATES: usize = 48;
 /// Cap on the positions scanned for a constrained sample.
 const MAX_CONSTRAINED_SCAN: usize = 1024;
 
+/// Where a sample's patch sits in the exemplar: an integer position (whose descriptor
+/// is compared) and a sub-pixel offset of the origin in `[−½, ½]²`, inherited from
+/// coherence so that neighbouring patches copied from one exemplar region agree exactly
+/// (no blur from rounding).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Placement {
+    pub position: u32,
+    pub offset: [f32; 2],
+}
+
+impl Placement {
+    pub fn at(position: u32) -> Self {
+        Self { position, offset: [0.0; 2] }
+    }
+}
+
 /// Outcome of one sample's search.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Match {
-    pub position: u32,
+    pub placement: Placement,
     /// Squared 192-D distance between the gathered patch and the match.
     pub distance2: f32,
     /// Whether the feature constraint was applied.
@@ -52,8 +69,8 @@ pub(crate) fn gather_patch(
     let mut acc = [0.0f32; DIM];
     let mut wsum = [0.0f32; GRID * GRID];
     let lim = GRID as f64 - 0.5;
-    ctx.carrier_grid.for_each_within(pos, f.pos, ctx.radius, |c, _| {
-        let c = c as usize;
+    ctx.carrier_grid.for_each_within(&ctx.active_positions, f.pos, ctx.radius, |a, _| {
+        let c = ctx.active[a as usize] as usize;
         if dot(nrm[c], f.n) < ctx.normal_cosine {
             return;
         }
@@ -102,13 +119,15 @@ pub(crate) fn gather_patch(
 }
 
 struct Candidates {
-    list: [u32; MAX_CANDIDATES],
+    list: [Placement; MAX_CANDIDATES],
     len: usize,
 }
 
 impl Candidates {
-    fn push(&mut self, c: u32) {
-        if self.len < MAX_CANDIDATES && !self.list[..self.len].contains(&c) {
+    fn push(&mut self, c: Placement) {
+        if self.len < MAX_CANDIDATES
+            && !self.list[..self.len].iter().any(|o| o.position == c.position)
+        {
             self.list[self.len] = c;
             self.len += 1;
         }
@@ -130,7 +149,7 @@ fn keep_best(best: &mut [(f32, u32); 2], d: f32, c: u32) {
 pub(crate) fn search_sample(
     ctx: &LevelContext,
     colors: &[[f32; 4]],
-    prev: &[u32],
+    prev: &[Placement],
     p: usize,
     iteration: usize,
 ) -> Match {
@@ -138,9 +157,9 @@ pub(crate) fn search_sample(
     let m = lvl.len() as u64;
     let mut x = [0.0f32; DIM];
     if !gather_patch(ctx, colors, p, &mut x) {
-        return Match { position: prev[p], distance2: 0.0, constrained: false };
+        return Match { placement: prev[p], distance2: 0.0, constrained: false };
     }
-    let mut cand = Candidates { list: [0; MAX_CANDIDATES], len: 0 };
+    let mut cand = Candidates { list: [Placement::at(0); MAX_CANDIDATES], len: 0 };
     cand.push(prev[p]);
     let f = &ctx.frames[p];
     let s = lvl.step as f64;
@@ -149,24 +168,31 @@ pub(crate) fn search_sample(
             break;
         }
         let fq = &ctx.frames[q as usize];
-        let [ox, oy] = lvl.origin(prev[q as usize]);
+        let pq = prev[q as usize];
+        let [ox, oy] = lvl.origin(pq.position);
         let d = sub(f.pos, fq.pos);
-        cand.push(lvl.position_near(ox as f64 + dot(d, fq.tx) * s, oy as f64 + dot(d, fq.ty) * s));
+        let x = ox as f64 + pq.offset[0] as f64 + dot(d, fq.tx) * s;
+        let y = oy as f64 + pq.offset[1] as f64 + dot(d, fq.ty) * s;
+        let c = lvl.position_near(x, y);
+        let [cx, cy] = lvl.origin(c);
+        let offset =
+            [(x - cx as f64).clamp(-0.5, 0.5) as f32, (y - cy as f64).clamp(-0.5, 0.5) as f32];
+        cand.push(Placement { position: c, offset });
     }
     // Random search (PatchMatch style): alternately uniform over the exemplar and in a
     // window around the previous match that halves with each draw.
     let rbase = ((ctx.level_index as u64 * 1024 + iteration as u64) << 36) | ((p as u64) << 4);
-    let [px, py] = lvl.origin(prev[p]);
+    let [px, py] = lvl.origin(prev[p].position);
     let mut window = lvl.width.max(lvl.height) as f64 * 0.25;
     for k in 0..ctx.random_candidates.min(16) {
         let r = stream_seed(ctx.seed, "texopt-random", rbase | k as u64);
         if k % 2 == 0 {
-            cand.push((r % m) as u32);
+            cand.push(Placement::at((r % m) as u32));
         } else {
             let (a, b) =
                 ((r >> 11) as u32 as f64 / u32::MAX as f64, (r >> 43) as f64 / (1u64 << 21) as f64);
             let (dx, dy) = ((2.0 * a - 1.0) * window, (2.0 * b - 1.0) * window);
-            cand.push(lvl.position_near(px as f64 + dx, py as f64 + dy));
+            cand.push(Placement::at(lvl.position_near(px as f64 + dx, py as f64 + dy)));
             window = (window * 0.5).max(2.0);
         }
     }
@@ -198,7 +224,7 @@ pub(crate) fn search_sample(
             let mut kept = 0;
             for i in 0..cand.len {
                 let c = cand.list[i];
-                if (cd[c as usize] - dp).abs() <= thr {
+                if (cd[c.position as usize] - dp).abs() <= thr {
                     cand.list[kept] = c;
                     kept += 1;
                 }
@@ -220,19 +246,19 @@ pub(crate) fn search_sample(
     }
     for (_, c) in best {
         if c != u32::MAX {
-            cand.push(c);
+            cand.push(Placement::at(c));
         }
     }
-    let mut out = Match { position: prev[p], distance2: f32::INFINITY, constrained };
+    let mut out = Match { placement: prev[p], distance2: f32::INFINITY, constrained };
     for &c in &cand.list[..cand.len] {
-        let d = lvl.distance2(&x, c);
+        let d = lvl.distance2(&x, c.position);
         if d < out.distance2 {
             out.distance2 = d;
-            out.position = c;
+            out.placement = c;
         }
     }
     if !out.distance2.is_finite() {
-        out.distance2 = lvl.distance2(&x, out.position);
+        out.distance2 = lvl.distance2(&x, out.placement.position);
     }
     out
 }

@@ -10,10 +10,13 @@
 //!
 //! The blend is a gather over carriers (each carrier looks up the samples whose
 //! footprint contains it), so it runs in parallel without write conflicts and is
-//! deterministic. The carrier's *source* is the exemplar coordinate it receives from
-//! the winning patch: the largest `ω_p · exp(−ρ²/8)` (`ρ` = distance from the patch
-//! centre in grid units), so centres win over borders. Carriers outside every
-//! footprint keep their colour and source.
+//! deterministic. Each patch pixel's contribution is further weighted by a Gaussian
+//! falloff `exp(−ρ²/(2σ²))` (`ρ` = distance from the patch centre in grid units,
+//! `σ` = [`TexOptOptions::blend_falloff`](crate::TexOptOptions::blend_falloff)): fewer
+//! patches disagree at each carrier, so the result is sharper than the plain average
+//! (`σ = ∞` gives Kwatra 2005 exactly). The carrier's *source* is the exemplar
+//! coordinate it receives from the patch with the largest weight, so centres win over
+//! borders. Carriers outside every footprint keep their colour and source.
 
 use crate::exemplar_patches::{GRID, HALF};
 use crate::texture_optimisation::LevelContext;
@@ -28,67 +31,97 @@ pub fn robust_weight(lambda: f64, d2: f32, exponent: f64) -> f64 {
     lambda * rms.powf(exponent - 2.0)
 }
 
-/// Blends all carriers from the matches; returns the number of uncovered carriers.
+/// Blends the carriers `which` (all when `None`) from the matches; returns the number
+/// of those left uncovered.
 pub(crate) fn blend(
     ctx: &LevelContext,
-    matches: &[u32],
+    which: Option<&[u32]>,
+    matches: &[crate::patch_search::Placement],
     weights: &[f64],
     colors: &mut [[f32; 4]],
     source: &mut [[f32; 2]],
 ) -> usize {
-    let lvl = ctx.level;
-    let s = lvl.step as f64;
-    let pos = ctx.domain.positions();
-    let nrm = ctx.domain.normals();
-    let lim = GRID as f64 - 0.5;
+    if let Some(list) = which {
+        let results: Vec<Option<([f32; 4], [f32; 2])>> = list
+            .par_iter()
+            .with_min_len(1024)
+            .map(|&c| blend_carrier(ctx, c as usize, matches, weights))
+            .collect();
+        let mut uncovered = 0;
+        for (&c, r) in list.iter().zip(results) {
+            match r {
+                Some((col, src)) => {
+                    colors[c as usize] = col;
+                    source[c as usize] = src;
+                }
+                None => uncovered += 1,
+            }
+        }
+        return uncovered;
+    }
     colors
         .par_iter_mut()
         .zip(source.par_iter_mut())
         .enumerate()
         .with_min_len(1024)
-        .map(|(c, (col, src))| {
-            let mut acc = [0.0f64; 4];
-            let mut wsum = 0.0f64;
-            let mut win = (f64::NEG_INFINITY, [0.0f64; 2]);
-            ctx.sample_grid.for_each_within(&ctx.sample_positions, pos[c], ctx.radius, |p, _| {
-                let p = p as usize;
-                let f = &ctx.frames[p];
-                if dot(nrm[c], f.n) < ctx.normal_cosine {
-                    return;
-                }
-                let d = sub(pos[c], f.pos);
-                let u = dot(d, f.tx) + HALF;
-                let v = dot(d, f.ty) + HALF;
-                if !(-0.5..lim).contains(&u) || !(-0.5..lim).contains(&v) {
-                    return;
-                }
-                let [ox, oy] = lvl.origin(matches[p]);
-                let (ex, ey) = (ox as f64 + u * s, oy as f64 + v * s);
-                let z = lvl.sample(ex, ey);
-                let w = weights[p];
-                for k in 0..4 {
-                    acc[k] += w * z[k] as f64;
-                }
-                wsum += w;
-                let rho2 = (u - HALF).powi(2) + (v - HALF).powi(2);
-                let score = w * (-rho2 / 8.0).exp();
-                if score > win.0 {
-                    win = (score, [ex, ey]);
-                }
-            });
-            if wsum > 0.0 && wsum.is_finite() {
-                for k in 0..4 {
-                    col[k] = (acc[k] / wsum) as f32;
-                }
-                let (w, h) = (lvl.width as f64, lvl.height as f64);
-                let wrap = |v: f64, n: f64| {
-                    if lvl.toroidal { v.rem_euclid(n) } else { v.clamp(0.0, n - 1.0) }
-                };
-                *src = [wrap(win.1[0], w) as f32, wrap(win.1[1], h) as f32];
+        .map(|(c, (col, src))| match blend_carrier(ctx, c, matches, weights) {
+            Some((a, b)) => {
+                *col = a;
+                *src = b;
                 0
-            } else {
-                1
             }
+            None => 1,
         })
         .sum()
+}
+
+/// The blended colour and source of carrier `c`, `None` when no patch covers it.
+fn blend_carrier(
+    ctx: &LevelContext,
+    c: usize,
+    matches: &[crate::patch_search::Placement],
+    weights: &[f64],
+) -> Option<([f32; 4], [f32; 2])> {
+    let lvl = ctx.level;
+    let s = lvl.step as f64;
+    let pos = ctx.domain.positions();
+    let nrm = ctx.domain.normals();
+    let lim = GRID as f64 - 0.5;
+    let mut acc = [0.0f64; 4];
+    let mut wsum = 0.0f64;
+    let mut win = (f64::NEG_INFINITY, [0.0f64; 2]);
+    ctx.sample_grid.for_each_within(&ctx.sample_positions, pos[c], ctx.radius, |p, _| {
+        let p = p as usize;
+        let f = &ctx.frames[p];
+        if dot(nrm[c], f.n) < ctx.normal_cosine {
+            return;
+        }
+        let d = sub(pos[c], f.pos);
+        let u = dot(d, f.tx) + HALF;
+        let v = dot(d, f.ty) + HALF;
+        if !(-0.5..lim).contains(&u) || !(-0.5..lim).contains(&v) {
+            return;
+        }
+        let [ox, oy] = lvl.origin(matches[p].position);
+        let [fx, fy] = matches[p].offset;
+        let (ex, ey) = (ox as f64 + fx as f64 + u * s, oy as f64 + fy as f64 + v * s);
+        let z = lvl.sample(ex, ey);
+        let rho2 = (u - HALF).powi(2) + (v - HALF).powi(2);
+        let g = if ctx.falloff > 0.0 { (-rho2 * ctx.falloff).exp() } else { 1.0 };
+        let w = weights[p] * g;
+        for k in 0..4 {
+            acc[k] += w * z[k] as f64;
+        }
+        wsum += w;
+        if w > win.0 {
+            win = (w, [ex, ey]);
+        }
+    });
+    if !(wsum > 0.0 && wsum.is_finite()) {
+        return None;
+    }
+    let col = [0, 1, 2, 3].map(|k| (acc[k] / wsum) as f32);
+    let (w, h) = (lvl.width as f64, lvl.height as f64);
+    let wrap = |v: f64, n: f64| if lvl.toroidal { v.rem_euclid(n) } else { v.clamp(0.0, n - 1.0) };
+    Some((col, [wrap(win.1[0], w) as f32, wrap(win.1[1], h) as f32]))
 }

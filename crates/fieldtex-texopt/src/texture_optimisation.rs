@@ -22,7 +22,7 @@
 //! IRLS decreases.
 
 use crate::exemplar_patches::{ExemplarLevel, GRID};
-use crate::patch_search::{Match, search_sample};
+use crate::patch_search::{Match, Placement, search_sample};
 use crate::robust_blend::{blend, robust_weight};
 use crate::{FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, UniformGrid, sample_set};
 use fieldtex_core::rng::stream_seed;
@@ -89,6 +89,10 @@ pub(crate) struct LevelContext<'a> {
     pub level_index: usize,
     pub frames: Vec<SampleFrame>,
     pub sample_positions: Vec<V3>,
+    /// Carriers gathered into descriptors (sorted ids) and their positions; the grid
+    /// indexes `active_positions`.
+    pub active: Vec<u32>,
+    pub active_positions: Vec<V3>,
     pub carrier_grid: UniformGrid,
     pub sample_grid: UniformGrid,
     /// Footprint radius (half diagonal of the patch), surface units.
@@ -103,6 +107,8 @@ pub(crate) struct LevelContext<'a> {
     pub feature_threshold: f64,
     pub normal_cosine: f64,
     pub seed: u64,
+    /// `1/(2σ²)` of the blend falloff (0 for none).
+    pub falloff: f64,
 }
 
 fn validate_inputs(
@@ -228,8 +234,21 @@ pub fn optimise(
             })
             .collect();
         let sample_positions: Vec<V3> = frames.iter().map(|f| f.pos).collect();
-        let carrier_grid = UniformGrid::new(domain.positions(), radius);
-        let sample_grid = UniformGrid::new(&sample_positions, radius);
+        // Coarse levels work on a subset of carriers about 0.75 cells apart (all
+        // carriers get blended once at the end of the level).
+        let active: Vec<u32> = if level.step > 1 {
+            let mut a =
+                sample_set(domain, 0.75 * cell, None, 0.0, options.seed ^ 0xAC71 ^ li as u64);
+            a.sort_unstable();
+            a
+        } else {
+            (0..domain.len() as u32).collect()
+        };
+        let subset = active.len() < domain.len();
+        let active_positions: Vec<V3> =
+            active.iter().map(|&c| domain.positions()[c as usize]).collect();
+        let carrier_grid = UniformGrid::new(&active_positions, 0.5 * radius);
+        let sample_grid = UniformGrid::new(&sample_positions, 0.5 * radius);
         let k_neighbours = options.coherence_neighbours.clamp(1, 32);
         let neighbours =
             nearest_samples(&sample_grid, &sample_positions, 2.5 * spacing, k_neighbours);
@@ -252,6 +271,8 @@ pub fn optimise(
             level_index: li,
             frames,
             sample_positions,
+            active,
+            active_positions,
             carrier_grid,
             sample_grid,
             radius,
@@ -264,19 +285,31 @@ pub fn optimise(
             feature_threshold: options.feature_threshold,
             normal_cosine: options.normal_cosine,
             seed: options.seed,
+            falloff: options.blend_falloff.map_or(0.0, |sigma| 0.5 / (sigma * sigma)),
         };
         let m = level.len() as u64;
         let half = crate::exemplar_patches::HALF * s;
-        let mut matches: Vec<u32> = if li == 0 {
+        let mut matches: Vec<Placement> = if li == 0 {
             (0..samples.len())
-                .map(|p| (stream_seed(options.seed, "texopt-init", p as u64) % m) as u32)
+                .map(|p| {
+                    Placement::at((stream_seed(options.seed, "texopt-init", p as u64) % m) as u32)
+                })
                 .collect()
         } else {
+            // Continue from the coarser result: the placement that reproduces the
+            // sample carrier's source at the patch centre.
             samples
                 .iter()
                 .map(|&c| {
                     let [x, y] = source[c as usize];
-                    level.position_near(x as f64 - half, y as f64 - half)
+                    let (x, y) = (x as f64 - half, y as f64 - half);
+                    let position = level.position_near(x, y);
+                    let [ox, oy] = level.origin(position);
+                    let offset = [
+                        (x - ox as f64).clamp(-0.5, 0.5) as f32,
+                        (y - oy as f64).clamp(-0.5, 0.5) as f32,
+                    ];
+                    Placement { position, offset }
                 })
                 .collect()
         };
@@ -293,7 +326,9 @@ pub fn optimise(
             seconds: 0.0,
         };
         if li == 0 {
-            stats.uncovered_carriers = blend(&ctx, &matches, &weights, &mut colors, &mut source);
+            let which = subset.then_some(ctx.active.as_slice());
+            stats.uncovered_carriers =
+                blend(&ctx, which, &matches, &weights, &mut colors, &mut source);
         }
         progress.stage(&format!("texture optimisation {w}×{w}"), options.max_iterations as u64);
         for iteration in 0..options.max_iterations {
@@ -302,14 +337,18 @@ pub fn optimise(
                 .with_min_len(64)
                 .map(|p| search_sample(&ctx, &colors, &matches, p, iteration))
                 .collect();
-            let changed = found.iter().zip(&matches).filter(|(f, m)| f.position != **m).count();
+            let changed = found
+                .iter()
+                .zip(&matches)
+                .filter(|(f, m)| f.placement.position != m.position)
+                .count();
             let mut energy = 0.0;
             let mut err = 0.0;
             for (p, f) in found.iter().enumerate() {
                 let rms = (f.distance2 as f64 / crate::exemplar_patches::DIM as f64).sqrt();
                 energy += lambda[p] * rms.powf(options.robust_exponent);
                 err += rms;
-                matches[p] = f.position;
+                matches[p] = f.placement;
                 weights[p] = robust_weight(lambda[p], f.distance2, options.robust_exponent);
             }
             stats.constrained_samples = found.iter().filter(|f| f.constrained).count();
@@ -317,9 +356,14 @@ pub fn optimise(
             stats.mean_patch_error.push(err / samples.len().max(1) as f64);
             stats.changed.push(changed);
             stats.iterations += 1;
-            stats.uncovered_carriers = blend(&ctx, &matches, &weights, &mut colors, &mut source);
+            let last = iteration + 1 == options.max_iterations
+                || (iteration > 0
+                    && changed as f64 <= options.converge_fraction * samples.len() as f64);
+            let which = (subset && !last).then_some(ctx.active.as_slice());
+            stats.uncovered_carriers =
+                blend(&ctx, which, &matches, &weights, &mut colors, &mut source);
             progress.advance(1);
-            if iteration > 0 && changed as f64 <= options.converge_fraction * samples.len() as f64 {
+            if last {
                 break;
             }
         }

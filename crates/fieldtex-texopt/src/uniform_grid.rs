@@ -28,6 +28,10 @@ pub struct UniformGrid {
     keys: Vec<u64>,
     ranges: Vec<[u32; 2]>,
     mask: usize,
+    /// Occupancy bits by key hash (a one-hash Bloom filter, 8 bits per table slot), so
+    /// empty cells are rejected without touching the table.
+    occupied: Vec<u64>,
+    occupied_mask: usize,
 }
 
 impl UniformGrid {
@@ -56,6 +60,8 @@ impl UniformGrid {
             keys: Vec::new(),
             ranges: Vec::new(),
             mask: 0,
+            occupied: Vec::new(),
+            occupied_mask: 0,
         };
         let mut keyed: Vec<(u64, u32)> = points
             .par_iter()
@@ -73,6 +79,8 @@ impl UniformGrid {
         grid.keys = vec![EMPTY; cap];
         grid.ranges = vec![[0, 0]; cap];
         grid.mask = cap - 1;
+        grid.occupied = vec![0u64; cap / 8];
+        grid.occupied_mask = cap * 8 - 1;
         grid.order = keyed.iter().map(|&(_, i)| i).collect();
         let mut start = 0;
         while start < keyed.len() {
@@ -81,7 +89,10 @@ impl UniformGrid {
             while end < keyed.len() && keyed[end].0 == key {
                 end += 1;
             }
-            let mut slot = mix64(key) as usize & grid.mask;
+            let hash = mix64(key) as usize;
+            let bit = (hash >> 20) & grid.occupied_mask;
+            grid.occupied[bit >> 6] |= 1 << (bit & 63);
+            let mut slot = hash & grid.mask;
             while grid.keys[slot] != EMPTY {
                 slot = (slot + 1) & grid.mask;
             }
@@ -113,7 +124,12 @@ impl UniformGrid {
 
     #[inline]
     fn lookup(&self, key: u64) -> &[u32] {
-        let mut slot = mix64(key) as usize & self.mask;
+        let hash = mix64(key) as usize;
+        let bit = (hash >> 20) & self.occupied_mask;
+        if self.occupied[bit >> 6] & (1 << (bit & 63)) == 0 {
+            return &[];
+        }
+        let mut slot = hash & self.mask;
         loop {
             let k = self.keys[slot];
             if k == key {
