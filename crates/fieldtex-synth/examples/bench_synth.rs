@@ -100,6 +100,11 @@ fn main() {
                 aopts.coherence_scan = args.next().and_then(|v| v.parse().ok()).expect("--scan N")
             }
             "--tileable" => aopts.tileable = true,
+            "--no-own" => opts.own_candidates = false,
+            "--finest-passes" => {
+                opts.finest_passes =
+                    Some(args.next().and_then(|v| v.parse().ok()).expect("--finest-passes N"))
+            }
             "--k" => {
                 aopts.k = args.next().and_then(|v| v.parse().ok()).expect("--k N");
                 opts.k = aopts.k;
@@ -109,6 +114,8 @@ fn main() {
             s => kind = s.to_string(),
         }
     }
+    std::fs::create_dir_all(&out_dir)
+        .unwrap_or_else(|e| panic!("cannot create {}: {e}", out_dir.display()));
     let ex = load(&exemplar);
     let name =
         exemplar.file_stem().unwrap().to_string_lossy().split('_').next().unwrap().to_string();
@@ -128,6 +135,21 @@ fn main() {
         analysis.level_count(),
         rayon::current_num_threads()
     );
+    let ev: Vec<String> = (0..analysis.level_count())
+        .map(|c| format!("{:.2}", analysis.level(c).explained_variance))
+        .collect();
+    println!("explained_variance per level: [{}]", ev.join(","));
+    for c in [0usize, 2] {
+        let q = &analysis.level(c).appearance_q.data[0];
+        let sd: Vec<String> = (0..8)
+            .map(|d| {
+                let m = q.iter().map(|v| v[d] as f64).sum::<f64>() / q.len() as f64;
+                let var = q.iter().map(|v| (v[d] as f64 - m).powi(2)).sum::<f64>() / q.len() as f64;
+                format!("{:.1}", var.sqrt())
+            })
+            .collect();
+        println!("level {c} component std in quantisation steps: [{}]", sd.join(","));
+    }
     let f = field(&kind, size);
     let domain = ImageDomain::from_direction_field(size, size, &f, 1.0).unwrap();
     let opts = SynthesisOptions { seed, rosy_fix: rosy, ..opts };
@@ -140,7 +162,12 @@ fn main() {
     }
     let result = result.unwrap();
     let levels: Vec<String> = result.level_timings_ms.iter().map(|t| format!("{t:.0}")).collect();
-    println!("BENCH synth_{size} median_ms={:.1} levels_ms=[{}]", median(times), levels.join(","));
+    println!(
+        "BENCH synth_{size} median_ms={:.1} min_ms={:.1} levels_ms=[{}]",
+        median(times.clone()),
+        times.iter().cloned().fold(f64::INFINITY, f64::min),
+        levels.join(",")
+    );
     let tag = if rosy { "" } else { "_norosy" };
     let out = out_dir.join(format!("synth_{name}_{kind}{tag}.png"));
     save(&result.colors, &out);

@@ -265,6 +265,7 @@ fn bad_exemplars_and_options_are_refused() {
         SynthesisOptions { k: 5, ..Default::default() },
         SynthesisOptions { jitter: f32::NAN, ..Default::default() },
         SynthesisOptions { scale: 0.0, ..Default::default() },
+        SynthesisOptions { finest_passes: Some(17), ..Default::default() },
     ] {
         assert!(matches!(
             synthesize(&an, &dom, &o, &NoProgress),
