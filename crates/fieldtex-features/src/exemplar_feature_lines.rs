@@ -196,25 +196,32 @@ fn border_index(i: i64, n: usize, wrap: bool) -> usize {
     (if k >= n { period - k } else { k }) as usize
 }
 
-/// Correlates rows with `kx`, then columns with `ky`.
-fn separable(data: &[f64], w: usize, h: usize, kx: &[f64], ky: &[f64], wrap: bool) -> Vec<f64> {
-    let (rx, ry) = ((kx.len() / 2) as i64, (ky.len() / 2) as i64);
-    let mut tmp = vec![0f64; w * h];
-    tmp.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
-        let row = &data[y * w..(y + 1) * w];
-        for (x, o) in out.iter_mut().enumerate() {
-            *o = kx
-                .iter()
-                .enumerate()
-                .map(|(k, c)| c * row[border_index(x as i64 + k as i64 - rx, w, wrap)])
-                .sum();
-        }
-    });
+/// Correlates every row with `k` (borders wrapped or mirrored through a padded copy).
+fn row_pass(data: &[f64], w: usize, h: usize, k: &[f64], wrap: bool) -> Vec<f64> {
+    let r = (k.len() / 2) as i64;
+    let mut out = vec![0f64; w * h];
+    out.par_chunks_mut(w).enumerate().for_each_init(
+        || Vec::with_capacity(w + k.len()),
+        |padded, (y, out)| {
+            let row = &data[y * w..(y + 1) * w];
+            padded.clear();
+            padded.extend((-r..w as i64 + r).map(|i| row[border_index(i, w, wrap)]));
+            for (x, o) in out.iter_mut().enumerate() {
+                *o = k.iter().zip(&padded[x..x + k.len()]).map(|(c, v)| c * v).sum();
+            }
+        },
+    );
+    out
+}
+
+/// Correlates every column with `k`.
+fn col_pass(data: &[f64], w: usize, h: usize, k: &[f64], wrap: bool) -> Vec<f64> {
+    let r = (k.len() / 2) as i64;
     let mut out = vec![0f64; w * h];
     out.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
-        for (k, c) in ky.iter().enumerate() {
-            let yy = border_index(y as i64 + k as i64 - ry, h, wrap);
-            for (o, s) in out.iter_mut().zip(&tmp[yy * w..(yy + 1) * w]) {
+        for (j, c) in k.iter().enumerate() {
+            let yy = border_index(y as i64 + j as i64 - r, h, wrap);
+            for (o, s) in out.iter_mut().zip(&data[yy * w..(yy + 1) * w]) {
                 *o += c * s;
             }
         }
@@ -245,11 +252,16 @@ fn responses(
     with_points: bool,
 ) -> Vec<Response> {
     let [g, d1, d2] = gaussian_kernels(sigma);
-    let lxx = separable(luma, w, h, &d2, &g, wrap);
-    let lyy = separable(luma, w, h, &g, &d2, wrap);
-    let lxy = separable(luma, w, h, &d1, &d1, wrap);
+    let (rg, rd1, rd2) = (
+        row_pass(luma, w, h, &g, wrap),
+        row_pass(luma, w, h, &d1, wrap),
+        row_pass(luma, w, h, &d2, wrap),
+    );
+    let lxx = col_pass(&rd2, w, h, &g, wrap);
+    let lyy = col_pass(&rg, w, h, &d2, wrap);
+    let lxy = col_pass(&rd1, w, h, &d1, wrap);
     let (lx, ly) = if with_points {
-        (separable(luma, w, h, &d1, &g, wrap), separable(luma, w, h, &g, &d1, wrap))
+        (col_pass(&rd1, w, h, &g, wrap), col_pass(&rg, w, h, &d1, wrap))
     } else {
         (Vec::new(), Vec::new())
     };
@@ -290,9 +302,12 @@ fn responses(
 /// Mean of the strongest 2 % of responses (scale-selection score).
 fn top_mean(resp: &[Response]) -> f64 {
     let mut s: Vec<f64> = resp.iter().map(|r| r.strength).collect();
-    s.sort_by(|a, b| b.total_cmp(a));
     let k = (s.len() / 50).max(1);
-    s[..k].iter().sum::<f64>() / k as f64
+    s.select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a));
+    // The k largest, summed in sorted order (deterministic).
+    let top = &mut s[..k];
+    top.sort_by(f64::total_cmp);
+    top.iter().sum::<f64>() / k as f64
 }
 
 fn select_scale(luma: &[f64], w: usize, h: usize, o: &ExemplarFeatureOptions) -> f64 {
