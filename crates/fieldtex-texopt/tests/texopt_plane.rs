@@ -262,3 +262,23 @@ fn robust_weights_favour_good_matches() {
     let exact = robust_weight(2.0, 0.0, 0.8);
     assert!(exact.is_finite() && (exact - 2.0 * (1.0f64 / 255.0).powf(-1.2)).abs() < 1e-6 * exact);
 }
+
+#[test]
+fn curved_closed_surface_runs_with_a_swirling_field() {
+    // Torus with the field along the major circles: every carrier covered, finite
+    // colours, sources inside the exemplar.
+    let mesh = fieldtex_mesh::primitives::torus(1.0, 0.4, 96, 48);
+    let field: Vec<[f64; 3]> = mesh.positions.iter().map(|p| [-p[1], p[0], 0.0]).collect();
+    let (domain, _, warnings) = SurfaceDomain::at_vertices(&mesh, &field).unwrap();
+    assert!(warnings.is_empty());
+    let wood = load_exemplar("woodgrain_Wood022.png");
+    let options = quick_options().with_pixel_size(domain.carrier_spacing());
+    let r = optimise(&domain, &wood, &options, None, &NoProgress).unwrap();
+    assert_eq!(r.colors.len(), domain.len());
+    assert_eq!(r.levels.last().unwrap().uncovered_carriers, 0);
+    assert!(r.colors.iter().all(|c| c.iter().all(|v| v.is_finite())));
+    assert!(r.source.iter().all(|s| s[0] >= 0.0
+        && s[0] <= wood.width as f32
+        && s[1] >= 0.0
+        && s[1] <= wood.height as f32));
+}
