@@ -34,6 +34,7 @@ pub mod exemplar_analysis;
 pub mod gaussian_stack;
 pub mod k_coherence;
 pub mod parallel_synthesis;
+pub mod synthesis_options;
 
 pub use domain::{ImageDomain, SynthesisDomain};
 pub use error::SynthError;

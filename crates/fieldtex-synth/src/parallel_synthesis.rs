@@ -22,15 +22,24 @@
 //!    three predictions chosen by rounding the warped offset; choosing the three
 //!    angularly nearest of the eight neighbours is our simplification, identical for
 //!    `J = I`). Candidates are every prediction `(P, α)`, the k-coherence jumps
-//!    `S[q] + C′ᵢ(S[q]) − h F(q) δ` with flip `α`, and `p`'s current value; the one whose
-//!    exemplar neighbourhood `Ẽ_β[u + (−1)^β h Δ]` (4 × 8 = 32-D) is closest wins and sets
-//!    `S[p]`, `I[p]`.
+//!    `S[q] + C′ᵢ(S[q]) − h F(q) δ` with flip `α`, `p`'s current value and (with
+//!    [`SynthesisOptions::own_candidates`]) its own jumps `S[p] + C′ᵢ(S[p])`; the one
+//!    whose exemplar neighbourhood `Ẽ_β[u + (−1)^β h Δ]` (4 × 8 = 32-D) is closest wins
+//!    (ties: the earlier candidate, the current value first) and sets `S[p]`, `I[p]`.
+//!
+//! Speed: the 32-D neighbourhood vector of every exemplar pixel (both copies) is
+//! tabulated per level, so a candidate costs one 32-byte load and an exact integer
+//! distance; candidates are gathered first and scored in one branch-free sweep; on CPUs
+//! with AVX2 the correction runs an AVX2 build (bit-identical results). The finest
+//! level holds ¾ of the samples, so [`SynthesisOptions::finest_passes`] (default 2)
+//! is separate from the coarse levels' [`SynthesisOptions::correction_passes`] (4).
 //!
 //! With [`SynthesisOptions::rosy_fix`] off, the engine is plain anisometric synthesis:
 //! predictions use `J(p)`, no flips, only `Ẽ₀` (the ablation of paper D Fig. 5).
 //!
 //! Not implemented: the second PCA of the neighbourhood vectors (a GPU memory
-//! optimisation), feature-distance channels, per-level jitter control, scale-dependent
+//! optimisation), feature-distance channels, per-level jitter amplitudes (only
+//! [`SynthesisOptions::unjittered_levels`]), scale-dependent
 //! stack levels (with `scale ≠ 1` level `c` still uses stack level `c`).
 
 use std::time::Instant;
@@ -45,75 +54,9 @@ use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
 /// Corner offsets `Δ` of the four-corner neighbourhood; bit 0 of the index is the x
 /// sign (0 = −1), bit 1 the y sign.
 const CORNERS: [[i32; 2]; 4] = [[-1, -1], [1, -1], [-1, 1], [1, 1]];
+pub use crate::synthesis_options::SynthesisOptions;
+use crate::synthesis_options::{MAX_K, validate};
 use crate::{SynthError, SynthesisDomain};
-
-/// Options of [`synthesize`].
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SynthesisOptions {
-    /// Seed of the initialisation and jitter streams. Default 0.
-    pub seed: u64,
-    /// Correction passes per level (all but the finest when [`Self::finest_passes`] is
-    /// set). Default 4: coarse levels hold a quarter of the samples, and extra passes
-    /// there settle the layout (measured: lower patch coherence distance on stripes,
-    /// weave and bands exemplars than 2 passes).
-    pub correction_passes: usize,
-    /// Correction passes at the finest level (`None`: [`Self::correction_passes`]). The
-    /// finest level holds three quarters of the samples and dominates the cost.
-    /// Default `Some(2)` (Lefebvre & Hoppe 2005 use 2 passes).
-    #[serde(default = "default_finest_passes")]
-    pub finest_passes: Option<usize>,
-    /// Subpasses per correction pass: 4 (2×2 interleaving, Lefebvre & Hoppe 2005 §3.4)
-    /// or 1 (all samples at once from the previous state). Default 4.
-    pub subpasses: usize,
-    /// Jitter amplitude as a fraction of the level spacing. Default 0.4.
-    pub jitter: f32,
-    /// Number of finest levels synthesised without jitter (level `c` is jittered when
-    /// `c ≥ unjittered_levels`). Jitter at the finest levels breaks pixel-exact
-    /// coherence that the correction passes then only partly restore. Default 0.
-    #[serde(default = "default_unjittered_levels")]
-    pub unjittered_levels: usize,
-    /// k-coherence candidates used per neighbour (at most the analysis' k). Default 2.
-    pub k: usize,
-    /// Whether the k-coherence jumps of the sample's own coordinate join the candidate
-    /// set (the `δ = 0` entry of the 3×3 set of Lefebvre & Hoppe 2005 §3.3). Default true.
-    #[serde(default = "default_true")]
-    pub own_candidates: bool,
-    /// Multiplier of every domain Jacobian (exemplar pixels per domain sample on top
-    /// of the domain's own scale). Default 1.
-    pub scale: f32,
-    /// Paper D §4 2-RoSy handling (flip indicator, rotated appearance space). Default
-    /// true; false is the ablation `--no-rosy-fix`.
-    pub rosy_fix: bool,
-}
-
-impl Default for SynthesisOptions {
-    fn default() -> Self {
-        Self {
-            seed: 0,
-            correction_passes: 4,
-            finest_passes: default_finest_passes(),
-            subpasses: 4,
-            jitter: 0.4,
-            unjittered_levels: default_unjittered_levels(),
-            own_candidates: true,
-            k: 2,
-            scale: 1.0,
-            rosy_fix: true,
-        }
-    }
-}
-
-fn default_finest_passes() -> Option<usize> {
-    Some(2)
-}
-
-fn default_true() -> bool {
-    true
-}
-
-fn default_unjittered_levels() -> usize {
-    0
-}
 
 /// Result of [`synthesize`]: per finest-level sample (row-major over
 /// [`SynthesisDomain::output_size`]).
@@ -130,8 +73,6 @@ pub struct SynthesisResult {
 }
 
 const NONE: u32 = u32::MAX;
-/// Largest k-coherence count the engine uses (the analysis may store more).
-const MAX_K: usize = 8;
 /// Candidates of one correction at most: per neighbour its prediction and k jumps, and
 /// p's own k jumps.
 const MAX_CANDIDATES: usize = 8 * (1 + MAX_K) + MAX_K;
@@ -536,39 +477,6 @@ impl Pass<'_> {
         }
         best
     }
-}
-
-fn validate(options: &SynthesisOptions, analysis: &ExemplarAnalysis) -> Result<(), SynthError> {
-    let bad = |name, value: f64, reason| Err(SynthError::InvalidOption { name, value, reason });
-    if options.correction_passes > 16 {
-        return bad("correction_passes", options.correction_passes as f64, "must be at most 16");
-    }
-    if let Some(f) = options.finest_passes
-        && f > 16
-    {
-        return bad("finest_passes", f as f64, "must be at most 16");
-    }
-    if options.subpasses != 1 && options.subpasses != 4 {
-        return bad("subpasses", options.subpasses as f64, "must be 1 or 4 (2×2 interleaving)");
-    }
-    if !(options.jitter.is_finite() && (0.0..=4.0).contains(&options.jitter)) {
-        return bad(
-            "jitter",
-            options.jitter as f64,
-            "must be in [0, 4] (fraction of the level spacing)",
-        );
-    }
-    if options.k > analysis.k().min(MAX_K) {
-        return bad(
-            "k",
-            options.k as f64,
-            "must not exceed the k of the exemplar analysis (nor 8)",
-        );
-    }
-    if !(options.scale.is_finite() && options.scale > 0.0) {
-        return bad("scale", options.scale as f64, "must be a positive finite number");
-    }
-    Ok(())
 }
 
 /// Synthesises a texture over `domain` from the analysed exemplar. Deterministic for a
