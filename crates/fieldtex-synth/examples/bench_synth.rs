@@ -1,7 +1,7 @@
 //! Benchmark and visual check of the parallel synthesis engine.
 //!
 //! `cargo run --release -p fieldtex-synth --example bench_synth -- [EXEMPLAR.png]
-//!  [swirl|wedge|trisector|constant|flip] [--size N] [--no-rosy-fix] [--seed S] [--runs R]`
+//!  [swirl|wedge|trisector|constant|diagonal|flip] [--size N] [--no-rosy-fix] [--seed S] [--runs R]`
 //!
 //! Prints `BENCH synth_analysis median_ms=…` and `BENCH synth_<size> median_ms=…` and
 //! writes `/tmp/synth_<name>_<field>.png` (and `…_coords.png`, the coordinate map as
@@ -44,6 +44,8 @@ fn field(kind: &str, n: usize) -> Vec<f32> {
             let phi = dy.atan2(dx);
             let angle = match kind {
                 "constant" => 0.0,
+                // Constant 45°: every patch rotated, no field variation.
+                "diagonal" => std::f32::consts::FRAC_PI_4,
                 "flip" => {
                     if x < n / 2 {
                         0.0
