@@ -59,7 +59,7 @@ use std::sync::Arc;
 
 use fieldtex_core::Warnings;
 use fieldtex_core::vec3::{add, scale};
-use fieldtex_linalg::{Cholesky, CholeskyOptions, SparseMatrix, SymbolicCholesky, UpdateSign};
+use fieldtex_linalg::{Cholesky, CholeskyOptions, SparseMatrix, SymbolicCholesky};
 use fieldtex_mesh::TriMesh;
 use rayon::prelude::*;
 
@@ -481,9 +481,9 @@ impl FieldDesign {
     /// Brings the numeric factorisation up to date with the strokes (no-op when it is;
     /// the first call makes it). A stroke edit changes `A` by `Σ Δw_e e_e e_eᵀ`: when
     /// `updates + 2 × downdates` is at most [`FieldDesignOptions::rank1_update_limit`]
-    /// (edges gaining and losing weight), the factor gets one
-    /// rank-1 update per edge (`Cholesky::update`, Davis & Hager 1999; additions first,
-    /// then removals as downdates); otherwise, if a downdate is refused, or after
+    /// (edges gaining and losing weight), the factor gets one multiple-rank update for the
+    /// additions and one multiple-rank downdate for the removals
+    /// (`Cholesky::add_diagonal_penalties`, Davis & Hager 2001); otherwise, if a downdate is refused, or after
     /// `16 ×` that many updates since the last factorisation (to bound rounding drift),
     /// it is refactored numerically with the kept symbolic analysis.
     pub fn refactor_if_needed(&mut self) -> Result<(), FieldsError> {
@@ -503,19 +503,13 @@ impl FieldDesign {
             let n_down = changes.iter().filter(|c| c.1 < 0.0).count();
             let cost = changes.len() + n_down;
             if cost <= limit && self.updates_since_factor + changes.len() <= 16 * limit {
-                let ups = changes.iter().filter(|c| c.1 > 0.0);
-                let downs = changes.iter().filter(|c| c.1 < 0.0);
-                let mut ok = true;
-                for &(e, delta) in ups {
-                    factor.update(&[(e, delta.sqrt())], UpdateSign::Up)?;
-                }
-                for &(e, delta) in downs {
-                    if factor.update(&[(e, (-delta).sqrt())], UpdateSign::Down).is_err() {
-                        ok = false;
-                        break;
-                    }
-                }
-                if ok {
+                let ups: Vec<(usize, f64)> =
+                    changes.iter().copied().filter(|c| c.1 > 0.0).collect();
+                let downs: Vec<(usize, f64)> =
+                    changes.iter().filter(|c| c.1 < 0.0).map(|&(e, d)| (e, -d)).collect();
+                factor.add_diagonal_penalties(&ups)?;
+                // a refused downdate leaves the factor as it was: refactor below
+                if factor.remove_diagonal_penalties(&downs).is_ok() {
                     self.updates_since_factor += changes.len();
                     self.rank1_update_count += changes.len();
                     self.factored_stroke_diag = d;

@@ -23,8 +23,10 @@
 //! **Components.** Connected components (triangles sharing a vertex, ignoring triangles
 //! whose corners coincide) are independent blocks, each with its own factor. A block is
 //! factored (symbolic + numeric) when it receives its first constraints; **every later
-//! constraint is a rank-1 update `+ α eᵢ eᵢᵀ` of that factor** (Davis & Hager 1999, via
-//! `fieldtex_linalg::Cholesky::add_diagonal_penalty`), never a refactorisation. A
+//! constraint updates that factor by `+ Σ α eᵢ eᵢᵀ`**: the new penalties of one call
+//! form one multiple-rank update (Davis & Hager 2001, equal to rank-1 updates in turn but
+//! walking the union of their elimination-tree paths once; via
+//! `fieldtex_linalg::Cholesky::add_diagonal_penalties`), never a refactorisation. A
 //! component without constraints gets [`UnconstrainedFallback`] and a warning.
 //!
 //! **A vertex constrained twice** (curves crossing or touching), [`OverlapPolicy`]:
@@ -32,9 +34,11 @@
 //! the most consistent curves first; `Average` replaces the target by the normalised sum
 //! of all oriented tangents at the vertex (only `b` changes, the factor does not).
 //!
-//! Not implemented: multiple-rank updates (a curve's `k` vertices are `k` rank-1
-//! updates; Davis & Hager 2001 would share the elimination-tree paths), removing curves
-//! (downdates exist in `fieldtex_linalg` but no caller needs them yet).
+//! The three components are solved together, one pass over the factor for all three
+//! right-hand sides (`fieldtex_linalg::Cholesky::solve_many`).
+//!
+//! Not implemented: removing curves (multiple-rank downdates exist in `fieldtex_linalg`,
+//! `Cholesky::remove_diagonal_penalties`, but no caller needs them yet).
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -91,7 +95,7 @@ pub struct CurveFieldOptions {
     pub fallback: UnconstrainedFallback,
     /// New penalties on an already factored component beyond which
     /// [`CurveFieldSolver::add_constraints_many`] refactors numerically instead of
-    /// applying one rank-1 update each. Default 200: one update cost ~1/220 of a
+    /// applying them as one multiple-rank update. Default 200: one rank-1 update cost ~1/220 of a
     /// refactorisation from fandisk to the refined horse (`examples/bench_orientation.rs`,
     /// `refactor_over_rank1`). A greedy step (one curve, tens of vertices) stays below.
     pub refactor_above: usize,
@@ -173,7 +177,8 @@ pub struct AddReport {
     pub new_vertices: usize,
     /// Vertices already constrained by an earlier curve (see [`OverlapPolicy`]).
     pub overlapping_vertices: usize,
-    /// Rank-1 updates applied and their total time.
+    /// Penalties added by updates of an existing factor (rank-1 terms of the
+    /// multiple-rank updates) and their total time.
     pub rank1_updates: usize,
     pub update_seconds: f64,
     /// First factorisations of components (symbolic + numeric) and their time.
@@ -571,9 +576,9 @@ impl<'m> CurveFieldSolver<'m> {
             }
             if let Some(factor) = block.factor.as_mut().filter(|_| verts.len() <= refactor_above) {
                 let t0 = Instant::now();
-                for &v in &verts {
-                    factor.add_diagonal_penalty(self.local[v as usize] as usize, alpha)?;
-                }
+                let penalties: Vec<(usize, f64)> =
+                    verts.iter().map(|&v| (self.local[v as usize] as usize, alpha)).collect();
+                factor.add_diagonal_penalties(&penalties)?;
                 report.update_seconds += t0.elapsed().as_secs_f64();
                 report.rank1_updates += verts.len();
                 continue;
