@@ -163,6 +163,44 @@ fn main() {
     }
     report("rank1_downdate", t_down);
 
+    // one "curve" of 61 neighbouring unknowns (a staircase across the grid): 61 rank-1
+    // updates in turn vs one multiple-rank update, then back by one multiple-rank downdate
+    let curves: Vec<Vec<(usize, f64)>> = (0..runs)
+        .map(|r| {
+            let (mut x, mut y) = (side / 4 + 7 * r, side / 3 + 5 * r);
+            let mut c = Vec::new();
+            while c.len() < 61 {
+                if !constrained[y * side + x] {
+                    c.push((y * side + x, ALPHA));
+                }
+                if c.len() % 2 == 0 { y += 1 } else { x += 1 }
+            }
+            c
+        })
+        .collect();
+    let mut t_seq = Vec::new();
+    let mut t_multi = Vec::new();
+    let mut t_multi_down = Vec::new();
+    for c in &curves {
+        let mut copy = chol.clone();
+        let (_, ms) = time_ms(|| {
+            for &(i, a) in c {
+                copy.add_diagonal_penalty(i, a).expect("update");
+            }
+        });
+        t_seq.push(ms);
+        let (_, ms) = time_ms(|| chol.add_diagonal_penalties(c).expect("multiple-rank update"));
+        t_multi.push(ms);
+        let (_, ms) =
+            time_ms(|| chol.remove_diagonal_penalties(c).expect("multiple-rank downdate"));
+        t_multi_down.push(ms);
+    }
+    let seq = report("curve61_sequential_rank1", t_seq);
+    let multi = report("curve61_multiple_rank_update", t_multi);
+    report("curve61_multiple_rank_downdate", t_multi_down);
+    println!("INFO curve61_sequential_over_multiple_rank ratio={:.1}", seq / multi);
+    println!("BENCH refactor_over_curve61_update ratio={:.1}", refactor / multi);
+
     let mut t_solve_up = Vec::new();
     for _ in 0..runs {
         let (x, ms) = time_ms(|| chol.solve_many(&rhs).expect("solve after updates"));
