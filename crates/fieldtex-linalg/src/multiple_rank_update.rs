@@ -25,8 +25,20 @@
 //! path: new pivot² ≤ 4 ε · old pivot²) is refused with [`LinalgError::UpdateFailed`] and
 //! every factor column is restored — none of the `k` modifications is applied.
 //!
+//! Speed (measured, `examples/bench_linalg.rs`, 200K-unknown grid, 61 penalties along a
+//! curve; and the refined horse of `fieldtex-fields/examples/bench_orientation.rs`): about
+//! the time of the 61 rank-1 updates in turn (100–112 ms vs 98–101 ms on the grid), not
+//! faster. The path of one penalty (~0.5 M entries, ~6 MB) stays in cache, so sequential
+//! rank-1 updates are bound by arithmetic (~5 flops per entry and modification), not by
+//! memory traffic, and reading each column once saves little; the serial recurrence of
+//! each row over the `k` modifications costs latency. Versions tried and dropped: rows
+//! gathered into 4-row interleaved groups (with and without AVX2, with rayon over the
+//! rows of long columns) — no faster under a shared 2-core load.
+//!
 //! Not implemented: multiple-rank modifications by general (non-diagonal) vectors, which
-//! can create fill (use [`Cholesky::update`] per vector).
+//! can create fill (use [`Cholesky::update`] per vector); a SIMD form (e.g. the
+//! recurrence over a chunk of modifications written as a small triangular matrix–vector
+//! product per row, vectorised across modifications).
 
 use crate::LinalgError;
 use crate::cholesky::Cholesky;
