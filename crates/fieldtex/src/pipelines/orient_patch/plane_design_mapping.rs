@@ -18,7 +18,7 @@ const MAX_REGULARIZATION: f64 = 1e-2;
 /// The mesh design of `file`'s weights on `mesh`, with its singularities and strokes
 /// when `with_elements` (a `[domain] kind = "mesh"` file). If the factorisation fails
 /// (jagged or sliver-rich patches can leave the smoothness matrix numerically
-/// indefinite), it is retried with the regularisation raised ×100 up to
+/// indefinite), it is retried with the regularisation raised ×10 up to
 /// [`MAX_REGULARIZATION`], with a warning.
 pub(super) fn build_mesh_design(
     file: &DesignFile,
@@ -34,12 +34,12 @@ pub(super) fn build_mesh_design(
         match FieldDesign::new(Domain::Mesh(mesh.clone()), file.symmetry()?, options) {
             Ok(d) => break d,
             Err(FieldsError::Solve(e)) if eps < MAX_REGULARIZATION => {
-                let next = (eps * 100.0).min(MAX_REGULARIZATION);
+                let next = (eps * 10.0).min(MAX_REGULARIZATION);
                 warnings.push(fieldtex_core::Warning::new(
                     "field-regularized",
                     format!(
                         "the patch's field design matrix could not be factored with \
-                         regularisation {eps:e} ({e}); retried with {next:e}, which smooths \
+                         regularisation {eps:.0e} ({e}); retried with {next:.0e}, which smooths \
                          the field slightly more"
                     ),
                 ));
