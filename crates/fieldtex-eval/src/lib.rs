@@ -3,6 +3,8 @@
 //!
 //! - [`coherence()`] / [`completeness()`]: exact nearest-patch distances output → exemplar
 //!   and back, per pixel and channel;
+//! - [`guided_coherence()`]: coherence with output patches taken in the local frame of a
+//!   direction field (field-guided synthesis);
 //! - [`color_sliced_wasserstein()`]: distance between colour distributions;
 //! - [`orientation_error`]: structure-tensor feature direction vs a guidance field;
 //! - [`singularities()`]: ±1/2 singularities of an orientation map;
@@ -21,6 +23,7 @@ pub mod color_sliced_wasserstein;
 pub mod completeness;
 mod error;
 mod filters;
+pub mod guided_coherence;
 pub mod image_view;
 pub mod nearest_patch;
 pub mod orientation;
@@ -34,6 +37,7 @@ pub use color_sliced_wasserstein::{
 };
 pub use completeness::completeness;
 pub use error::EvalError;
+pub use guided_coherence::{GuidedCoherenceOptions, GuidedCoherenceReport, guided_coherence};
 pub use image_view::{FieldView, ImageView, rgb_buffer};
 pub use nearest_patch::{
     PatchDistanceOptions, PatchDistanceReport, coherence_and_completeness, coherence_map,

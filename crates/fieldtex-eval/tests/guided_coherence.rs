@@ -1,0 +1,175 @@
+//! Calibration and contract tests of `guided_coherence`.
+
+use fieldtex_eval::{
+    FieldView, GuidedCoherenceOptions, ImageView, PatchDistanceOptions, coherence, guided_coherence,
+};
+use std::path::Path;
+
+/// An RGB exemplar from the shared test data as `(data, width, height)`.
+fn exemplar(name: &str) -> (Vec<f32>, usize, usize) {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/exemplars").join(name);
+    let img = image::open(&path).expect("test exemplar").to_rgb8();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    (img.as_raw().iter().map(|&v| v as f32 / 255.0).collect(), w, h)
+}
+
+/// A `size²` image whose exemplar x axis follows the constant direction `deg`:
+/// output pixel `P` copies exemplar pixel `round(Rᵀ (P − centre))` (toroidal), the way
+/// a pixel-copying synthesis lays the exemplar out along a field. With `blocks`, the
+/// exemplar-space plane is a patchwork of 24×24 blocks each shifted by a random
+/// offset (seams like a synthesis output), the same patchwork for every angle.
+fn rotated_copy(ex: &[f32], ew: usize, eh: usize, size: usize, deg: f64, blocks: bool) -> Vec<f32> {
+    let (s, c) = deg.to_radians().sin_cos();
+    let o = size as f64 / 2.0;
+    let mut out = vec![0f32; size * size * 3];
+    for y in 0..size {
+        for x in 0..size {
+            let (px, py) = (x as f64 - o, y as f64 - o);
+            let mut ex_x = (c * px + s * py).round() as i64;
+            let mut ex_y = (-s * px + c * py).round() as i64;
+            if blocks {
+                let b = (ex_x.div_euclid(24) * 1000 + ex_y.div_euclid(24)) as u64;
+                ex_x += (fieldtex_core::rng::hash_unit(3, "blocks", 2 * b) * 1000.0) as i64;
+                ex_y += (fieldtex_core::rng::hash_unit(3, "blocks", 2 * b + 1) * 1000.0) as i64;
+            }
+            let (ix, iy) =
+                (ex_x.rem_euclid(ew as i64) as usize, ex_y.rem_euclid(eh as i64) as usize);
+            for ch in 0..3 {
+                out[(y * size + x) * 3 + ch] = ex[(iy * ew + ix) * 3 + ch];
+            }
+        }
+    }
+    out
+}
+
+fn constant_field(size: usize, deg: f64) -> Vec<f32> {
+    let (s, c) = deg.to_radians().sin_cos();
+    (0..size * size).flat_map(|_| [c as f32, s as f32]).collect()
+}
+
+fn guided(out: &[f32], size: usize, ex: &[f32], ew: usize, eh: usize, field: &[f32]) -> f64 {
+    let o = ImageView::new(out, size, size, 3).unwrap();
+    let e = ImageView::new(ex, ew, eh, 3).unwrap();
+    let f = FieldView::new(field, size, size).unwrap();
+    guided_coherence(&o, &e, &f, &GuidedCoherenceOptions::default()).unwrap().mean
+}
+
+fn exemplar_view(ex: &[f32], ew: usize, eh: usize) -> ImageView<'_> {
+    ImageView::new(ex, ew, eh, 3).unwrap()
+}
+
+#[test]
+fn exact_rotated_copies_score_near_zero_and_noise_scores_high() {
+    let (ex, ew, eh) = exemplar("stripes_Fabric071.png");
+    let size = 96;
+    let mut scores = Vec::new();
+    for deg in [0.0, 30.0, 45.0, 90.0] {
+        let out = rotated_copy(&ex, ew, eh, size, deg, false);
+        scores.push((deg, guided(&out, size, &ex, ew, eh, &constant_field(size, deg))));
+    }
+    let out45 = rotated_copy(&ex, ew, eh, size, 45.0, false);
+    let plain45 = coherence(
+        &ImageView::new(&out45, size, size, 3).unwrap(),
+        &exemplar_view(&ex, ew, eh),
+        &PatchDistanceOptions::default().with_wrap_exemplar(true),
+    )
+    .unwrap()
+    .mean;
+    let noise: Vec<f32> = (0..size * size * 3)
+        .map(|i| fieldtex_core::rng::hash_unit(7, "guided-noise", i as u64) as f32)
+        .collect();
+    let noise_score = guided(&noise, size, &ex, ew, eh, &constant_field(size, 30.0));
+    eprintln!("exact copies: guided {scores:?}, plain 45° {plain45}, noise {noise_score}");
+    // 0° and 90° frames sample exactly what the exemplar patches hold.
+    assert!(scores[0].1 < 1e-9 && scores[3].1 < 1e-9, "{scores:?}");
+    // Oblique frames only pay for the pixel-copy jaggies: far below the plain metric
+    // and below a typical synthesis' 0° coherence on this exemplar (≈ 1.5e-3).
+    for &(deg, v) in &scores {
+        assert!(v < 0.05 * plain45 && v < 1.5e-3, "{deg}°: {v} vs plain 45° {plain45}");
+    }
+    assert!(noise_score > 50.0 * scores[2].1, "noise {noise_score}");
+}
+
+#[test]
+fn rotated_patchworks_score_within_twice_the_unrotated_one() {
+    let (ex, ew, eh) = exemplar("stripes_Fabric071.png");
+    let size = 96;
+    let zero = guided(
+        &rotated_copy(&ex, ew, eh, size, 0.0, true),
+        size,
+        &ex,
+        ew,
+        eh,
+        &constant_field(size, 0.0),
+    );
+    let mut scores = Vec::new();
+    for deg in [30.0, 45.0, 90.0] {
+        let out = rotated_copy(&ex, ew, eh, size, deg, true);
+        scores.push((deg, guided(&out, size, &ex, ew, eh, &constant_field(size, deg))));
+    }
+    let out45 = rotated_copy(&ex, ew, eh, size, 45.0, true);
+    let plain45 = coherence(
+        &ImageView::new(&out45, size, size, 3).unwrap(),
+        &exemplar_view(&ex, ew, eh),
+        &PatchDistanceOptions::default().with_wrap_exemplar(true),
+    )
+    .unwrap()
+    .mean;
+    eprintln!("patchworks: 0° {zero}, {scores:?}, plain 45° {plain45}");
+    assert!(zero > 1e-5, "the seams must cost something: {zero}");
+    for &(deg, v) in &scores {
+        assert!(v <= 2.0 * zero && v >= 0.5 * zero, "{deg}°: {v} vs 0°: {zero}");
+    }
+    assert!(scores[1].1 < 0.5 * plain45, "45°: {} vs plain {plain45}", scores[1].1);
+}
+
+#[test]
+fn bit_identical_for_any_thread_count() {
+    let (ex, ew, eh) = exemplar("woodgrain_Wood022.png");
+    let size = 64;
+    let out = rotated_copy(&ex, ew, eh, size, 37.0, true);
+    // A rotating field: every query has its own frame.
+    let field: Vec<f32> = (0..size * size)
+        .flat_map(|i| {
+            let a = (i % size) as f32 * 0.05 + (i / size) as f32 * 0.02;
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
+            let o = ImageView::new(&out, size, size, 3).unwrap();
+            let f = FieldView::new(&field, size, size).unwrap();
+            let opts = GuidedCoherenceOptions { stride: 3, ..Default::default() };
+            guided_coherence(&o, &exemplar_view(&ex, ew, eh), &f, &opts).unwrap()
+        })
+    };
+    let (a, b) = (run(1), run(3));
+    assert_eq!(a, b);
+    assert!(a.queries > 100 && a.mean > 0.0, "{a:?}");
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let (ex, ew, eh) = exemplar("stripes_Fabric071.png");
+    let out = vec![0.5f32; 32 * 32 * 3];
+    let o = ImageView::new(&out, 32, 32, 3).unwrap();
+    let e = exemplar_view(&ex, ew, eh);
+    let small = constant_field(16, 0.0);
+    let f_small = FieldView::new(&small, 16, 16).unwrap();
+    let opts = GuidedCoherenceOptions::default();
+    assert!(guided_coherence(&o, &e, &f_small, &opts).is_err(), "field size");
+    let field = constant_field(32, 0.0);
+    let f = FieldView::new(&field, 32, 32).unwrap();
+    let bad_stride = GuidedCoherenceOptions { stride: 0, ..Default::default() };
+    assert!(guided_coherence(&o, &e, &f, &bad_stride).is_err(), "stride 0");
+    let grey = vec![0.5f32; 32 * 32];
+    let g = ImageView::new(&grey, 32, 32, 1).unwrap();
+    assert!(guided_coherence(&g, &e, &f, &opts).is_err(), "channels");
+    // Zero vectors are skipped, not failed.
+    let zeros = vec![0f32; 32 * 32 * 2];
+    let fz = FieldView::new(&zeros, 32, 32).unwrap();
+    let r = guided_coherence(&o, &e, &fz, &opts).unwrap();
+    assert_eq!(r.queries, 0);
+    assert_eq!(r.skipped_no_direction, 64);
+}
