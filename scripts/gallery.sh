@@ -8,6 +8,21 @@ cargo build --release -p fieldtex-cli
 bin=target/release/fieldtex
 ex=../shared/data/exemplars
 mkdir -p docs/gallery out/gallery
+only="${1:-all}"
+# align (paper A): with and without feature-to-feature alignment (like paper A Fig. 7).
+if [ "$only" = all ] || [ "$only" = align ]; then
+  for m in ../shared/data/textured/blub/blub.obj ../shared/data/meshes/fandisk.obj ../shared/data/meshes/rocker-arm.obj; do
+    n="$(basename "$m" .obj)"
+    "$bin" align --mesh "$m" --exemplar "$ex/stripes_Fabric071.png" --size 512 --out "out/gallery/align-$n" --quiet
+    "$bin" align --mesh "$m" --exemplar "$ex/stripes_Fabric071.png" --size 512 --no-feature-align --out "out/gallery/align-$n-nofa" --quiet
+    cp "out/gallery/align-$n/preview.png" "docs/gallery/align-$n.png"
+    cp "out/gallery/align-$n-nofa/preview.png" "docs/gallery/align-$n-nofa.png"
+  done
+  "$bin" orient --preset whorl --exemplar "$ex/stripes_Fabric071.png" --mesh ../shared/data/meshes/demosthenes-bust-open.obj \
+    --patch 0.18,1.6,0.9,0.8 --size 512 --out out/gallery/orient-patch --quiet
+  cp out/gallery/orient-patch/preview.png docs/gallery/orient-patch.png
+  [ "$only" = align ] && { echo "gallery (align, patch) written to docs/gallery/"; exit 0; }
+fi
 for p in arch tented-arch left-loop right-loop whorl; do
   "$bin" orient --preset "$p" --exemplar "$ex/stripes_Fabric071.png" --size 384 --out "out/gallery/orient-$p" --quiet
   cp "out/gallery/orient-$p/preview.png" "docs/gallery/orient-$p.png"

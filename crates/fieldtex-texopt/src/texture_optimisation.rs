@@ -261,9 +261,16 @@ pub fn optimise(
                 })
             })
             .collect();
+        // λ_p = 1/(d + 1e-6) (paper A §5.2, d in exemplar pixels), with d capped at the
+        // largest patch width: beyond it a curve has no local influence, and the cap keeps
+        // far (or unreachable, d = +∞) samples from getting a zero weight, which would
+        // leave carriers that only they cover without colour.
+        let d_cap = max_w as f64;
         let lambda: Vec<f64> = samples
             .iter()
-            .map(|&c| curve.map_or(1.0, |cd| 1.0 / (cd[c as usize].max(0.0) / h + 1e-6)))
+            .map(|&c| {
+                curve.map_or(1.0, |cd| 1.0 / ((cd[c as usize].max(0.0) / h).min(d_cap) + 1e-6))
+            })
             .collect();
         let ctx = LevelContext {
             domain,

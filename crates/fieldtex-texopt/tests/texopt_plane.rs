@@ -282,3 +282,36 @@ fn curved_closed_surface_runs_with_a_swirling_field() {
         && s[1] >= 0.0
         && s[1] <= wood.height as f32));
 }
+
+/// Carriers the curves cannot reach (`+∞` distance) still get colour: their samples'
+/// weight λ is capped, not zero (a zero weight left such regions black).
+#[test]
+fn unreachable_carriers_still_get_colour() {
+    let stripes = load_exemplar("stripes_Fabric071.png");
+    let (w, h) = (stripes.width, stripes.height);
+    let exemplar_distance: Vec<f32> = (0..w * h).map(|i| ((i / w) as f32 - 58.0).abs()).collect();
+    let size = 64;
+    let (domain, vertices) = plane(size, 0.0);
+    // Only rows within 6 of y = 31 know their distance; everything else is unreachable.
+    let carrier_curve_distance: Vec<f64> = vertices
+        .iter()
+        .map(|&v| {
+            let d = ((v as usize / size) as f64 - 31.0).abs();
+            if d <= 6.0 { d } else { f64::INFINITY }
+        })
+        .collect();
+    let features = FeatureAlignment { exemplar_distance, carrier_curve_distance };
+    let r = optimise(&domain, &stripes, &quick_options(), Some(&features), &NoProgress).unwrap();
+    let mean = |f: &dyn Fn(usize) -> bool| {
+        let sel: Vec<f32> = (0..vertices.len())
+            .filter(|&c| f(vertices[c] as usize / size))
+            .map(|c| r.colors[c][0] + r.colors[c][1] + r.colors[c][2])
+            .collect();
+        sel.iter().sum::<f32>() / sel.len() as f32
+    };
+    let far = mean(&|row| row < 10);
+    let near = mean(&|row| (28..35).contains(&row));
+    // The stripes exemplar's mean brightness is well above black everywhere.
+    assert!(far > 0.5 && near > 0.5, "mean RGB sum far {far:.3}, near {near:.3}");
+    assert!(r.colors.iter().all(|c| c.iter().all(|v| v.is_finite())));
+}
