@@ -20,6 +20,10 @@ pub enum Guidance {
 #[derive(Debug, Clone, Serialize)]
 pub struct ImageMetrics {
     pub coherence: ev::PatchDistanceReport,
+    /// Coherence with the output patches taken in the guidance field's frame
+    /// (`fieldtex_eval::guided_coherence`, default stride 4); only with a field.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub guided_coherence: Option<ev::GuidedCoherenceReport>,
     pub completeness: ev::PatchDistanceReport,
     pub color_sliced_wasserstein: ev::SlicedWassersteinReport,
     pub orientation_error: Option<ev::OrientationErrorReport>,
@@ -71,6 +75,12 @@ pub(crate) fn image_metrics(
         (None, Some(a)) => Some(ev::OrientationReference::ConstantDeg(a)),
         _ => None,
     };
+    let guided_coherence = match &reference {
+        Some(ev::OrientationReference::Field(f)) => {
+            Some(ev::guided_coherence(&o, &e, f, &ev::GuidedCoherenceOptions::default())?)
+        }
+        _ => None,
+    };
     let orientation_error = match reference {
         Some(r) => Some(ev::orientation_error(&o, &r, &ev::OrientationErrorOptions::default())?),
         None => {
@@ -102,6 +112,7 @@ pub(crate) fn image_metrics(
     };
     Ok(ImageMetrics {
         coherence,
+        guided_coherence,
         completeness,
         color_sliced_wasserstein,
         orientation_error,
