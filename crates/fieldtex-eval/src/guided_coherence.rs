@@ -35,10 +35,12 @@
 //!    neighbour; the minimum is exact and every candidate's sum is taken in the same
 //!    order, so the result is bit-identical for any thread count.
 //!
-//! Cost: `queries × W·H × 2` candidate tests, most exiting after one or two rows. With
-//! the default stride 4 a 512² output (≈16 000 queries) against a 128² exemplar takes
-//! a second or two on two cores (measured numbers in the crate's report); stride 1
-//! evaluates every pixel (16× longer).
+//! Cost: `queries × W·H × 2` candidate tests with early exit after each patch row.
+//! Measured (`examples/bench_guided_coherence`, shared busy 2-core VM): stride 4 on a
+//! 512² orient output vs the 116² stripes exemplar (15 876 queries) took 29–34 s
+//! wall, ≈ 2 ms per query — so the default stride is 8 (≈ 4 000 queries, ≈ 8 s);
+//! stride 16 takes ≈ 2 s. Stride 1 evaluates every pixel (64× the default). TODO: a
+//! faster exact search (e.g. the displacement scan of `nearest_patch` per angle bin).
 //!
 //! Not implemented: anisotropic scale (the field is taken as unit length: its
 //! magnitude is ignored), mirror frames, and per-sample frames (one frame per patch,
@@ -59,8 +61,8 @@ use serde::Serialize;
 pub struct GuidedCoherenceOptions {
     /// Patch side `N` in pixels. Default 7 (as [`crate::PatchDistanceOptions`]).
     pub patch_size: usize,
-    /// Step between query pixels along x and y. Default 4 (a 512² output has about
-    /// 16 000 queries: a second or two on two cores against a 128² exemplar).
+    /// Step between query pixels along x and y. Default 8 (a 512² output has about
+    /// 4 000 queries: ≈ 8 s on the shared 2-core VM against a 116² exemplar).
     pub stride: usize,
     /// Exemplar patches wrap around its edges (tileable exemplar), as the facade's
     /// plain coherence. Default true.
@@ -72,7 +74,7 @@ pub struct GuidedCoherenceOptions {
 
 impl Default for GuidedCoherenceOptions {
     fn default() -> Self {
-        Self { patch_size: 7, stride: 4, wrap_exemplar: true, sign_free: true }
+        Self { patch_size: 7, stride: 8, wrap_exemplar: true, sign_free: true }
     }
 }
 

@@ -52,7 +52,9 @@ fn guided(out: &[f32], size: usize, ex: &[f32], ew: usize, eh: usize, field: &[f
     let o = ImageView::new(out, size, size, 3).unwrap();
     let e = ImageView::new(ex, ew, eh, 3).unwrap();
     let f = FieldView::new(field, size, size).unwrap();
-    guided_coherence(&o, &e, &f, &GuidedCoherenceOptions::default()).unwrap().mean
+    guided_coherence(&o, &e, &f, &GuidedCoherenceOptions { stride: 4, ..Default::default() })
+        .unwrap()
+        .mean
 }
 
 fn exemplar_view(ex: &[f32], ew: usize, eh: usize) -> ImageView<'_> {
@@ -157,7 +159,7 @@ fn bad_inputs_are_errors() {
     let e = exemplar_view(&ex, ew, eh);
     let small = constant_field(16, 0.0);
     let f_small = FieldView::new(&small, 16, 16).unwrap();
-    let opts = GuidedCoherenceOptions::default();
+    let opts = GuidedCoherenceOptions { stride: 4, ..Default::default() };
     assert!(guided_coherence(&o, &e, &f_small, &opts).is_err(), "field size");
     let field = constant_field(32, 0.0);
     let f = FieldView::new(&field, 32, 32).unwrap();

@@ -21,7 +21,7 @@ pub enum Guidance {
 pub struct ImageMetrics {
     pub coherence: ev::PatchDistanceReport,
     /// Coherence with the output patches taken in the guidance field's frame
-    /// (`fieldtex_eval::guided_coherence`, default stride 4); only with a field.
+    /// (`fieldtex_eval::guided_coherence`, default stride 8); only with a field.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub guided_coherence: Option<ev::GuidedCoherenceReport>,
     pub completeness: ev::PatchDistanceReport,
