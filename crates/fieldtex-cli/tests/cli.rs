@@ -599,6 +599,34 @@ fn align_outputs_determinism_and_valid_glb() {
     assert!(levels.iter().all(|l| l["samples"].as_u64().unwrap() > 0));
     assert!(r["metrics"]["texopt"]["feature_align"].as_bool().unwrap());
     assert_eq!(validator_errors(&a.join("model.glb")), 0);
+    // Quality (issue targets, at this small atlas): an exemplar feature line lies on
+    // most of the crest-line length, far more than without alignment, and the stripes
+    // follow the field on the surface.
+    let coverage = r["metrics"]["feature_coverage"]["fraction"].as_f64().unwrap();
+    let error = r["metrics"]["orientation_error"]["surface"]["mean_deg"].as_f64().unwrap();
+    assert!(coverage >= 0.8, "feature coverage {coverage}");
+    assert!(error <= 15.0, "surface orientation error {error}°");
+    let c = tmp("align-nofa");
+    let o = run(
+        &[
+            "align",
+            "--mesh",
+            mesh.to_str().unwrap(),
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--size",
+            "256",
+            "--no-feature-align",
+            "--out",
+            c.to_str().unwrap(),
+            "--quiet",
+        ],
+        Duration::from_secs(300),
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let ablation =
+        report_without_timings(&c)["metrics"]["feature_coverage"]["fraction"].as_f64().unwrap();
+    assert!(ablation + 0.3 < coverage, "ablation {ablation} vs aligned {coverage}");
 }
 
 /// A sphere has no crest lines: `align` still textures it, with a warning naming the
