@@ -103,6 +103,47 @@ pub(crate) fn salient_curves(
     Ok((curves, source))
 }
 
+/// The covered texels of `map` (row-major indices) and their surface points as colour
+/// carriers, in the same order.
+pub(crate) fn atlas_carriers(map: &fieldtex_param::TexelMap) -> (Vec<usize>, Vec<Carrier>) {
+    let covered: Vec<usize> = (0..map.width * map.height)
+        .filter(|&i| map.is_covered(i) && map.entries[i].is_some())
+        .collect();
+    let carriers = covered
+        .iter()
+        .filter_map(|&i| map.entries[i])
+        .map(|e| Carrier {
+            triangle: e.triangle,
+            barycentric: [e.bary[0] as f64, e.bary[1] as f64, e.bary[2] as f64],
+        })
+        .collect();
+    (covered, carriers)
+}
+
+/// The atlas texture from the carriers' colours: covered texels get their carrier's
+/// colour, dilated gutter texels copy their source texel, empty texels are grey. Also
+/// returns, per texel, the carrier index (`u32::MAX` for none).
+pub(crate) fn carrier_texture(
+    map: &fieldtex_param::TexelMap,
+    covered: &[usize],
+    colors: &[[f32; 4]],
+) -> (Image, Vec<u32>) {
+    let n = map.width * map.height;
+    let mut texture = Image::new(map.width, map.height, [0.5, 0.5, 0.5, 1.0]);
+    let mut carrier_of_texel = vec![u32::MAX; n];
+    for (k, &i) in covered.iter().enumerate() {
+        texture.pixels[i] = colors[k];
+        carrier_of_texel[i] = k as u32;
+    }
+    for i in 0..n {
+        let s = map.source[i];
+        if s != u32::MAX && s as usize != i {
+            texture.pixels[i] = texture.pixels[s as usize];
+        }
+    }
+    (texture, carrier_of_texel)
+}
+
 /// Preview of the textured model, optionally with the curves drawn.
 fn preview_with_curves(
     mesh: &TriMesh,
@@ -316,21 +357,13 @@ pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) ->
             fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
         })
         .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
-    let covered: Vec<usize> = (0..size * size).filter(|&i| map.is_covered(i)).collect();
-    let carriers: Vec<Carrier> = covered
-        .iter()
-        .filter_map(|&i| map.entries[i])
-        .map(|e| Carrier {
-            triangle: e.triangle,
-            barycentric: [e.bary[0] as f64, e.bary[1] as f64, e.bary[2] as f64],
-        })
-        .collect();
+    let (covered, carriers) = atlas_carriers(&map);
     let (domain, dwarn) = report
         .time("domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
         .map_err(|e| Error::Internal(format!("surface domain: {e}")))?;
     report.warnings.extend(dwarn);
     let topts = TexOptOptions {
-        pixel_size: Some(domain.carrier_spacing() / options.scale),
+        pixel_size: Some(domain.carrier_spacing() * options.scale),
         feature_align: options.feature_align,
         seed: options.seed,
         ..Default::default()
@@ -387,18 +420,7 @@ pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) ->
             e => Error::Internal(format!("texture optimisation: {e}")),
         })?;
     report.warnings.extend(result.warnings.iter().cloned());
-    let mut texture = Image::new(size, size, [0.5, 0.5, 0.5, 1.0]);
-    let mut carrier_of_texel = vec![u32::MAX; size * size];
-    for (k, &i) in covered.iter().enumerate() {
-        texture.pixels[i] = result.colors[k];
-        carrier_of_texel[i] = k as u32;
-    }
-    for i in 0..size * size {
-        let s = map.source[i];
-        if s != u32::MAX && s as usize != i {
-            texture.pixels[i] = texture.pixels[s as usize];
-        }
-    }
+    let (texture, carrier_of_texel) = carrier_texture(&map, &covered, &result.colors);
     // 6. Metrics.
     let coverage_samples: Vec<fieldtex_eval::CurveSample> = curve_points
         .iter()
