@@ -6,9 +6,7 @@
 
 use fieldtex_core::{Image, NoProgress};
 use fieldtex_mesh::primitives::grid;
-use fieldtex_texopt::{
-    SurfaceDomain, TexOptOptions, dominant_orientation, line_angle_difference, optimise,
-};
+use fieldtex_texopt::{SurfaceDomain, TexOptOptions, optimise};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -96,4 +94,18 @@ fn main() {
         );
     }
     println!("wrote {}", out.display());
+}
+
+/// Dominant line orientation (radians in `[0, π)`) and coherence of a luminance image,
+/// by fieldtex-eval's structure tensor.
+fn dominant_orientation(luma: &[f32], w: usize, h: usize) -> Option<(f64, f64)> {
+    let view = fieldtex_eval::ImageView::new(luma, w, h, 1).ok()?;
+    let (deg, coherence) = fieldtex_eval::dominant_orientation(&view).ok()?;
+    Some((deg.to_radians(), coherence))
+}
+
+/// Smallest angle between two line orientations (radians, modulo π).
+fn line_angle_difference(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(std::f64::consts::PI);
+    d.min(std::f64::consts::PI - d)
 }

@@ -15,7 +15,6 @@
 //!   or strided scan + coherence + random candidates, §5.2 constrained candidates) and
 //!   the robust blend ([`robust_blend`]: IRLS weights `|x_p − z_p|^(r−2)`, `r = 0.8`,
 //!   Kwatra 2005 eq. 2–3; `λ_p = 1/(d + 10⁻⁶)`, paper A eq. 4).
-//! - [`dominant_orientation`]: structure-tensor orientation, for measurements.
 //!
 //! # Conventions
 //! - Units: `h` ([`TexOptOptions::pixel_size`]) is the surface length of one exemplar
@@ -62,7 +61,6 @@ mod options;
 pub mod patch_search;
 pub mod robust_blend;
 mod sample_set;
-mod structure_tensor;
 mod surface_domain;
 pub mod texture_optimisation;
 mod uniform_grid;
@@ -70,7 +68,6 @@ mod uniform_grid;
 pub use error::TexOptError;
 pub use options::{FeatureAlignment, TexOptOptions};
 pub use sample_set::sample_set;
-pub use structure_tensor::{dominant_orientation, line_angle_difference};
 pub use surface_domain::{Carrier, SurfaceDomain, vertex_carriers};
 pub use texture_optimisation::{LevelStats, TexOptResult, optimise};
 pub use uniform_grid::UniformGrid;

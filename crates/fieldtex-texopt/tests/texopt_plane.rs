@@ -4,8 +4,7 @@
 use fieldtex_core::{Image, NoProgress};
 use fieldtex_mesh::primitives::grid;
 use fieldtex_texopt::{
-    Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, dominant_orientation,
-    line_angle_difference, optimise, sample_set,
+    Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, optimise, sample_set,
 };
 use std::path::Path;
 
@@ -43,6 +42,20 @@ fn quick_options() -> TexOptOptions {
         .with_patch_sizes(vec![16, 8])
         .with_pixel_size(1.0)
         .with_max_iterations(3)
+}
+
+/// Dominant line orientation (radians in `[0, π)`) and coherence of a luminance image,
+/// by fieldtex-eval's structure tensor.
+fn dominant_orientation(luma: &[f32], w: usize, h: usize) -> Option<(f64, f64)> {
+    let view = fieldtex_eval::ImageView::new(luma, w, h, 1).ok()?;
+    let (deg, coherence) = fieldtex_eval::dominant_orientation(&view).ok()?;
+    Some((deg.to_radians(), coherence))
+}
+
+/// Smallest angle between two line orientations (radians, modulo π).
+fn line_angle_difference(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(std::f64::consts::PI);
+    d.min(std::f64::consts::PI - d)
 }
 
 /// Orientation error (degrees) of a run on a `size²` plane with field angle `angle`.
