@@ -365,6 +365,10 @@ impl Cholesky {
             return;
         }
         let values = match &self.dynamic {
+            Some(d) if d.has_supernodal_layout() && k <= 8 => {
+                d.solve_supernodal_in_place(x, k);
+                return;
+            }
             Some(d) if !d.faer_layout => {
                 d.solve_block_in_place(x, k);
                 return;

@@ -77,6 +77,10 @@ pub(crate) struct DynamicFactor {
     pub(crate) backup: Vec<f64>,
     /// Compact slot of each column on a multiple-rank path (`crate::multiple_rank_update`).
     pub(crate) slot: Vec<u32>,
+    /// First column of each of faer's supernodes, then `n` (empty for a simplicial
+    /// factor); used by `crate::supernodal_solve` while [`DynamicFactor::faer_layout`]
+    /// holds.
+    pub(crate) supernodes: Vec<usize>,
 }
 
 impl DynamicFactor {
@@ -97,6 +101,7 @@ impl DynamicFactor {
         let mut rows: Vec<u32>;
         let mut vals = values;
         let mut faer_layout = true;
+        let mut supernodes = Vec::new();
         match sym.raw() {
             fc::SymbolicCholeskyRaw::Simplicial(s) => {
                 let (cp, ri) = (s.col_ptr(), s.row_idx());
@@ -151,6 +156,10 @@ impl DynamicFactor {
                         }
                     }
                 });
+                if (0..ns).all(|sn| end[sn] == if sn + 1 < ns { begin[sn + 1] } else { n }) {
+                    supernodes.extend_from_slice(&begin[..ns]);
+                    supernodes.push(n);
+                }
                 for sn in 0..ns {
                     let (b, e) = (begin[sn], end[sn]);
                     let nrows = (e - b) + s.supernode(sn).pattern().len();
@@ -182,6 +191,7 @@ impl DynamicFactor {
             path: Vec::new(),
             backup: Vec::new(),
             slot: Vec::new(),
+            supernodes,
         }
     }
 
@@ -536,6 +546,26 @@ impl Cholesky {
     pub fn update_path_cost(&self, i: usize) -> Option<(usize, usize)> {
         let d = self.dynamic.as_ref()?;
         (i < d.n()).then(|| d.path_cost(d.inv[i]))
+    }
+
+    /// Columns and stored entries on the union of the elimination-tree paths of `indices`
+    /// (original numbering; out-of-range indices are ignored): the cost of a multiple-rank
+    /// update at those unknowns, or of a sparse triangular solve reaching them. `None`
+    /// before the first update.
+    pub fn union_path_cost(&self, indices: &[usize]) -> Option<(usize, usize)> {
+        let d = self.dynamic.as_ref()?;
+        let mut seen = vec![false; d.n()];
+        let (mut cols, mut entries) = (0, 0);
+        for &i in indices.iter().filter(|&&i| i < d.n()) {
+            let mut j = d.inv[i];
+            while j != NONE && !seen[j] {
+                seen[j] = true;
+                cols += 1;
+                entries += d.len[j];
+                j = d.parent[j];
+            }
+        }
+        Some((cols, entries))
     }
 
     /// Whether the factor has been taken over for rank-1 updates.

@@ -34,6 +34,7 @@ mod least_squares;
 mod multi_rhs_solve;
 mod multiple_rank_update;
 mod sparse_matrix;
+mod supernodal_solve;
 
 pub use cholesky::{Cholesky, CholeskyOptions, FactorLayout, SymbolicCholesky};
 pub use cholesky_update::UpdateSign;

@@ -15,45 +15,36 @@
 //! their upper part (the separators near the root), as the vertices of one curve do.
 //!
 //! Work vectors live only on the union path (every row of a path column is an ancestor,
-//! hence on the path): a compact `u × k` row-major array, `u` the union size. The
-//! modifications are processed in chunks of [`CHUNK`] (a fixed-width inner loop); a
-//! chunk whose work entries at column `j` are all zero is skipped there, a zero entry of
-//! an active chunk is an identity step (exactly what the rank-1 code does for it).
+//! hence on the path): a compact `k × u` array (`u` the union size), one contiguous
+//! vector per modification indexed by the column's slot in the sorted union. At column
+//! `j` the modifications whose work entry there is nonzero are applied (a zero entry is
+//! an identity step, exactly what the rank-1 code does for it), **modification by
+//! modification, each sweeping the rows of the column**: a row sees the modifications in
+//! the same order and with the same IEEE operations as the one-row recurrence, so the
+//! result is bit-identical to it, but the rows of a sweep are independent. The rows of a
+//! column are grouped into runs of consecutive slots (a supernode's dense block is one
+//! run, its pattern a few), so a sweep is a contiguous loop that the AVX2 build (chosen
+//! at run time, same operations, no FMA contraction) vectorises.
 //!
 //! A diagonal penalty never creates fill, so the pattern and the elimination tree stay.
 //! Failure: a downdate that would make the matrix indefinite (same test as the rank-1
 //! path: new pivot² ≤ 4 ε · old pivot²) is refused with [`LinalgError::UpdateFailed`] and
 //! every factor column is restored — none of the `k` modifications is applied.
 //!
-//! Speed (measured, `examples/bench_linalg.rs`, 200K-unknown grid, 61 penalties along a
-//! curve; and the refined horse of `fieldtex-fields/examples/bench_orientation.rs`): about
-//! the time of the 61 rank-1 updates in turn (100–112 ms vs 98–101 ms on the grid), not
-//! faster. The path of one penalty (~0.5 M entries, ~6 MB) stays in cache, so sequential
-//! rank-1 updates are bound by arithmetic (~5 flops per entry and modification), not by
-//! memory traffic, and reading each column once saves little; the serial recurrence of
-//! each row over the `k` modifications costs latency. Versions tried and dropped: rows
-//! gathered into 4-row interleaved groups (with and without AVX2, with rayon over the
-//! rows of long columns), and four rows interleaved in place (89 ms vs 80 ms for the
-//! rank-1 updates in turn) — no faster under a shared 2-core load.
+//! Speed (refined horse, 194K unknowns, 40 crest curves of 5–200 penalties each, via
+//! `fieldtex-fields/examples/bench_orientation.rs`): the earlier row-by-row form (all
+//! modifications of a row in a chain, latency-bound) took 3.5 s for the 40 updates; the
+//! sweep form 1.2 s, same factor bit for bit. An AVX-512 build gave nothing more.
 //!
 //! Not implemented: multiple-rank modifications by general (non-diagonal) vectors, which
-//! can create fill (use [`Cholesky::update`] per vector); a SIMD form (e.g. the
-//! recurrence over a chunk of modifications written as a small triangular matrix–vector
-//! product per row, vectorised across modifications).
+//! can create fill (use [`Cholesky::update`] per vector); a blocked (matrix–matrix) form
+//! over whole supernodes.
 
 use crate::LinalgError;
 use crate::cholesky::Cholesky;
 use crate::cholesky_update::{DynamicFactor, NONE, check_alpha};
 
-/// Modifications processed together in the inner loop.
-pub const CHUNK: usize = 8;
-
 const NO_SLOT: u32 = u32::MAX;
-
-/// Per-modification scalars of one column: `(α, δ, γ)` with identity `(0, 1, 0)`.
-type Params = ([f64; CHUNK], [f64; CHUNK], [f64; CHUNK]);
-
-const IDENTITY: Params = ([0.0; CHUNK], [1.0; CHUNK], [0.0; CHUNK]);
 
 impl DynamicFactor {
     /// Multiple-rank modification by `w_t = v_t e_{f_t}` (`f_t` permuted column, `v_t ≠ 0`)
@@ -86,16 +77,21 @@ impl DynamicFactor {
         for (s, &j) in union.iter().enumerate() {
             self.slot[j] = s as u32;
         }
-        let n_chunks = k.div_ceil(CHUNK);
-        let kp = n_chunks * CHUNK;
-        let mut work = vec![0.0f64; union.len() * kp];
+        // work vectors column-major by modification: `work[t · u + slot]`
+        let u = union.len();
+        let mut work = vec![0.0f64; u * k];
         for (t, &(f, v)) in cols.iter().enumerate() {
-            work[self.slot[f] as usize * kp + t] = v;
+            work[t * u + self.slot[f] as usize] = v;
         }
-        let mut beta = vec![1.0f64; kp];
+        let mut beta = vec![1.0f64; k];
         let sigma = if up { 1.0 } else { -1.0 };
-        let mut params: Vec<Params> = vec![IDENTITY; n_chunks];
-        let mut active: Vec<usize> = Vec::with_capacity(n_chunks);
+        // per column: the modifications that change it, with their `(t, α, δ, γ)`
+        let mut steps: Vec<(usize, f64, f64, f64)> = Vec::with_capacity(k);
+        let mut runs: Vec<(usize, u32, u32)> = Vec::new();
+        #[cfg(target_arch = "x86_64")]
+        let avx2 = std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx2 = false;
         self.backup.clear();
         let mut failure = None;
         'columns: for (step, &j) in union.iter().enumerate() {
@@ -103,83 +99,56 @@ impl DynamicFactor {
             if !up {
                 self.backup.extend_from_slice(&self.vals[s..s + l]);
             }
-            let row_j = self.slot[j] as usize * kp;
+            let row_j = self.slot[j] as usize;
             let mut d = self.vals[s];
-            active.clear();
-            for c in 0..n_chunks {
-                let wj = &mut work[row_j + c * CHUNK..row_j + (c + 1) * CHUNK];
-                if wj.iter().all(|&x| x == 0.0) {
+            steps.clear();
+            for t in 0..k {
+                let w = work[t * u + row_j];
+                if w == 0.0 {
                     continue;
                 }
-                let p = &mut params[c];
-                *p = IDENTITY;
-                let mut changes = false;
-                for t in 0..CHUNK {
-                    let w = wj[t];
-                    if w == 0.0 {
-                        continue;
-                    }
-                    wj[t] = 0.0;
-                    let b = beta[c * CHUNK + t];
-                    let alpha = w / d;
-                    let beta2_sq = b * b + sigma * alpha * alpha;
-                    if beta2_sq.is_nan()
-                        || beta2_sq <= 4.0 * f64::EPSILON * b * b
-                        || !beta2_sq.is_finite()
-                    {
-                        failure = Some((step, j, beta2_sq / (b * b)));
-                        break 'columns;
-                    }
-                    let beta2 = beta2_sq.sqrt();
-                    let (delta, gamma) =
-                        (if up { b / beta2 } else { beta2 / b }, sigma * alpha / (beta2 * b));
-                    let new_d = delta * d + if up { gamma * w } else { 0.0 };
-                    if !new_d.is_finite() || new_d <= 0.0 {
-                        failure = Some((step, j, f64::NAN));
-                        break 'columns;
-                    }
-                    d = new_d;
-                    beta[c * CHUNK + t] = beta2;
-                    if alpha == 0.0 && delta == 1.0 {
-                        continue;
-                    }
-                    (p.0[t], p.1[t], p.2[t]) = (alpha, delta, gamma);
-                    changes = true;
+                work[t * u + row_j] = 0.0;
+                let b = beta[t];
+                let alpha = w / d;
+                let beta2_sq = b * b + sigma * alpha * alpha;
+                if beta2_sq.is_nan()
+                    || beta2_sq <= 4.0 * f64::EPSILON * b * b
+                    || !beta2_sq.is_finite()
+                {
+                    failure = Some((step, j, beta2_sq / (b * b)));
+                    break 'columns;
                 }
-                if changes {
-                    active.push(c);
+                let beta2 = beta2_sq.sqrt();
+                let (delta, gamma) =
+                    (if up { b / beta2 } else { beta2 / b }, sigma * alpha / (beta2 * b));
+                let new_d = delta * d + if up { gamma * w } else { 0.0 };
+                if !new_d.is_finite() || new_d <= 0.0 {
+                    failure = Some((step, j, f64::NAN));
+                    break 'columns;
                 }
+                d = new_d;
+                beta[t] = beta2;
+                if alpha == 0.0 && delta == 1.0 {
+                    continue;
+                }
+                steps.push((t, alpha, delta, gamma));
             }
             self.vals[s] = d;
-            if active.is_empty() {
+            if steps.is_empty() {
                 continue;
             }
-            let rows = &self.rows[s + 1..s + l];
-            let vals = &mut self.vals[s + 1..s + l];
-            for (&i, v) in rows.iter().zip(vals.iter_mut()) {
-                let row = self.slot[i as usize] as usize * kp;
-                let mut x = *v;
-                for &c in &active {
-                    let (a, dl, g) = &params[c];
-                    let w: &mut [f64; CHUNK] = (&mut work[row + c * CHUNK..row + (c + 1) * CHUNK])
-                        .try_into()
-                        .expect("chunk width");
-                    if up {
-                        for t in 0..CHUNK {
-                            let w1 = w[t];
-                            w[t] = w1 - a[t] * x;
-                            x = dl[t] * x + g[t] * w1;
-                        }
-                    } else {
-                        for t in 0..CHUNK {
-                            let w2 = w[t] - a[t] * x;
-                            w[t] = w2;
-                            x = dl[t] * x + g[t] * w2;
-                        }
-                    }
+            // the column's rows as runs of consecutive slots `(first row, first slot, len)`
+            // (the dense block of a supernode is one run; its pattern a few)
+            runs.clear();
+            for (q, &i) in self.rows[s + 1..s + l].iter().enumerate() {
+                let o = self.slot[i as usize];
+                match runs.last_mut() {
+                    Some((q0, o0, m)) if *o0 + *m == o && *q0 + *m as usize == q => *m += 1,
+                    _ => runs.push((q, o, 1)),
                 }
-                *v = x;
             }
+            let vals = &mut self.vals[s + 1..s + l];
+            apply_steps(&steps, &runs, vals, &mut work, u, up, avx2);
         }
         for &j in &union {
             self.slot[j] = NO_SLOT;
@@ -205,6 +174,79 @@ impl DynamicFactor {
             return Err((j, reason));
         }
         Ok(())
+    }
+}
+
+/// Applies the modifications `steps` (`(t, α, δ, γ)` in order) of one column to its
+/// off-diagonal values `vals` and the work vectors `work[t · u + slot]`, the rows given as
+/// `runs` of consecutive slots. Modifications outer, rows inner: each row sees the
+/// modifications in the same order and with the same IEEE operations as the one-row
+/// recurrence (bit-identical results), but the rows of a sweep are independent and
+/// contiguous within a run, so the sweep vectorises instead of waiting on the
+/// recurrence's latency.
+fn apply_steps(
+    steps: &[(usize, f64, f64, f64)],
+    runs: &[(usize, u32, u32)],
+    vals: &mut [f64],
+    work: &mut [f64],
+    u: usize,
+    up: bool,
+    avx2: bool,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: the caller checked that the CPU supports AVX2.
+        unsafe { apply_steps_avx2(steps, runs, vals, work, u, up) };
+        return;
+    }
+    let _ = avx2;
+    apply_steps_impl(steps, runs, vals, work, u, up);
+}
+
+/// [`apply_steps_impl`] compiled for AVX2 (the same IEEE operations, no FMA contraction:
+/// bit-identical to the baseline build).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn apply_steps_avx2(
+    steps: &[(usize, f64, f64, f64)],
+    runs: &[(usize, u32, u32)],
+    vals: &mut [f64],
+    work: &mut [f64],
+    u: usize,
+    up: bool,
+) {
+    apply_steps_impl(steps, runs, vals, work, u, up);
+}
+
+#[inline(always)]
+fn apply_steps_impl(
+    steps: &[(usize, f64, f64, f64)],
+    runs: &[(usize, u32, u32)],
+    vals: &mut [f64],
+    work: &mut [f64],
+    u: usize,
+    up: bool,
+) {
+    for &(t, a, dl, g) in steps {
+        let w = &mut work[t * u..(t + 1) * u];
+        for &(q0, o0, m) in runs {
+            let (o0, m) = (o0 as usize, m as usize);
+            let ws = &mut w[o0..o0 + m];
+            let vs = &mut vals[q0..q0 + m];
+            if up {
+                for (wv, v) in ws.iter_mut().zip(vs.iter_mut()) {
+                    let w1 = *wv;
+                    *wv = w1 - a * *v;
+                    *v = dl * *v + g * w1;
+                }
+            } else {
+                for (wv, v) in ws.iter_mut().zip(vs.iter_mut()) {
+                    let w2 = *wv - a * *v;
+                    *wv = w2;
+                    *v = dl * *v + g * w2;
+                }
+            }
+        }
     }
 }
 
@@ -272,5 +314,41 @@ impl Cholesky {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_sweep_is_bit_identical_to_baseline() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let u = 50;
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let steps: Vec<(usize, f64, f64, f64)> =
+            (0..5).map(|t| (t, next(), 1.0 + 0.1 * next(), next())).collect();
+        // rows: a run of 13 consecutive slots, two short runs, single rows
+        let runs = vec![(0, 2, 13), (13, 20, 3), (16, 30, 1), (17, 40, 7)];
+        let vals: Vec<f64> = (0..24).map(|_| next()).collect();
+        let work: Vec<f64> = (0..5 * u).map(|_| next()).collect();
+        for up in [true, false] {
+            let (mut v1, mut w1) = (vals.clone(), work.clone());
+            let (mut v2, mut w2) = (vals.clone(), work.clone());
+            apply_steps_impl(&steps, &runs, &mut v1, &mut w1, u, up);
+            // SAFETY: AVX2 checked above.
+            unsafe { apply_steps_avx2(&steps, &runs, &mut v2, &mut w2, u, up) };
+            let same =
+                |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(p, q)| p.to_bits() == q.to_bits());
+            assert!(same(&v1, &v2) && same(&w1, &w2));
+            assert!(v1 != vals, "the sweep changed the values");
+        }
     }
 }
