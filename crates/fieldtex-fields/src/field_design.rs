@@ -59,13 +59,14 @@ use std::sync::Arc;
 
 use fieldtex_core::Warnings;
 use fieldtex_core::vec3::{add, scale};
-use fieldtex_linalg::{Cholesky, CholeskyOptions, SparseMatrix, SymbolicCholesky};
+use fieldtex_linalg::SparseMatrix;
 use fieldtex_mesh::TriMesh;
 use rayon::prelude::*;
 
 use crate::FieldsError;
 use crate::dec::Dec;
 use crate::design_elements::{Singularity, SingularityKind, Stroke, Symmetry};
+use crate::design_factor::DesignFactor;
 use crate::domain::{Frame, PlaneGrid, locate_in_mesh};
 pub use crate::field_design_options::{FieldDesignOptions, SingularityModel};
 use crate::normal_equations::NormalEquations;
@@ -123,16 +124,13 @@ pub struct FieldDesign {
     frames: Vec<Frame>,
     reference_radius: f64,
     equations: NormalEquations,
-    symbolic: SymbolicCholesky,
-    /// Numeric factor of `A` with `factored_stroke_diag` (made lazily on the first solve).
-    factor: Option<Cholesky>,
-    factored_stroke_diag: Vec<f64>,
+    /// Factor of `A₀ + diag(stroke_diag)`, kept current by updates or refactorisation.
+    factor: DesignFactor,
+    /// Summed stroke weights per edge (`#E`), in stroke-id order; `None` after an edit.
+    stroke_diag: Option<Vec<f64>>,
     singularities: Vec<Option<SingularityEntry>>,
     strokes: Vec<Option<(Stroke, Vec<EdgeConstraint>)>>,
     warnings: Warnings,
-    refactor_count: usize,
-    rank1_update_count: usize,
-    updates_since_factor: usize,
 }
 
 impl std::fmt::Debug for FieldDesign {
@@ -196,7 +194,7 @@ impl FieldDesign {
             }
         }
         let equations = NormalEquations::new(&dec, &options)?;
-        let symbolic = SymbolicCholesky::analyze(&equations.matrix)?;
+        let factor = DesignFactor::new(&equations.matrix)?;
         let area: f64 = dec.face_areas.iter().sum();
         let reference_radius = 0.25 * area.sqrt();
         let mut design = Self {
@@ -204,24 +202,20 @@ impl FieldDesign {
             plane,
             symmetry,
             reference_radius,
-            factored_stroke_diag: vec![0.0; dec.n_edges()],
             dec,
             options,
             equations,
-            symbolic,
-            factor: None,
+            factor,
+            stroke_diag: None,
             singularities: Vec::new(),
             strokes: Vec::new(),
             warnings,
-            refactor_count: 0,
-            rank1_update_count: 0,
-            updates_since_factor: 0,
         };
         design.frames = if design.plane.is_some() {
             vec![([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]); design.dec.n_faces()]
         } else {
             design.refactor_if_needed()?;
-            reference_frames(&design.dec, design.factor.as_ref().expect("just factored"))?
+            reference_frames(&design.dec, design.factor.factor().expect("just factored"))?
         };
         Ok(design)
     }
@@ -250,11 +244,11 @@ impl FieldDesign {
     }
     /// Number of numeric factorisations done so far (the first one included).
     pub fn refactor_count(&self) -> usize {
-        self.refactor_count
+        self.factor.refactor_count
     }
     /// Number of rank-1 factor updates done for stroke edits so far.
     pub fn rank1_update_count(&self) -> usize {
-        self.rank1_update_count
+        self.factor.rank1_update_count
     }
     /// Magnitude scale of singularity model fields: a quarter of `sqrt(area)`.
     pub fn reference_radius(&self) -> f64 {
@@ -432,6 +426,7 @@ impl FieldDesign {
             )?
         };
         self.strokes.push(Some((stroke, constraints)));
+        self.stroke_diag = None;
         Ok(StrokeId(index as u32))
     }
 
@@ -440,6 +435,7 @@ impl FieldDesign {
         match self.strokes.get_mut(id.0 as usize) {
             Some(s @ Some(_)) => {
                 *s = None;
+                self.stroke_diag = None;
                 Ok(())
             }
             _ => Err(FieldsError::UnknownId { what: "stroke", id: id.0 }),
@@ -464,6 +460,7 @@ impl FieldDesign {
             )?
         };
         self.strokes[id.0 as usize] = Some((stroke, constraints));
+        self.stroke_diag = None;
         Ok(())
     }
 
@@ -479,76 +476,45 @@ impl FieldDesign {
     }
 
     /// Brings the numeric factorisation up to date with the strokes (no-op when it is;
-    /// the first call makes it). A stroke edit changes `A` by `Σ Δw_e e_e e_eᵀ`: when
-    /// `updates + 2 × downdates` is at most [`FieldDesignOptions::rank1_update_limit`]
-    /// (edges gaining and losing weight), the factor gets one multiple-rank update for the
-    /// additions and one multiple-rank downdate for the removals
-    /// (`Cholesky::add_diagonal_penalties`, Davis & Hager 2001); otherwise, if a downdate is refused, or after
-    /// `16 ×` that many updates since the last factorisation (to bound rounding drift),
-    /// it is refactored numerically with the kept symbolic analysis.
+    /// the first call makes it). A stroke edit changes `A` by `Σ Δw_e e_e e_eᵀ`: when at
+    /// most [`FieldDesignOptions::rank1_update_limit`] edges change weight, the factor
+    /// gets one multiple-rank update for the edges gaining weight and one multiple-rank
+    /// downdate for those losing it (`Cholesky::add_diagonal_penalties`, Davis & Hager
+    /// 2001); otherwise, if a downdate is refused, or after `16 ×` that many
+    /// modifications since the last factorisation (to bound rounding drift), it is
+    /// refactored numerically with the kept symbolic analysis
+    /// ([`crate::design_factor`]).
     pub fn refactor_if_needed(&mut self) -> Result<(), FieldsError> {
-        let d = self.stroke_diagonal();
-        if self.factor.is_some() && d == self.factored_stroke_diag {
-            return Ok(());
+        if self.stroke_diag.is_none() {
+            self.stroke_diag = Some(self.stroke_diagonal());
         }
-        let limit = self.options.rank1_update_limit;
-        if let Some(factor) = self.factor.as_mut() {
-            let changes: Vec<(usize, f64)> = d
-                .iter()
-                .zip(&self.factored_stroke_diag)
-                .enumerate()
-                .filter(|(_, (a, b))| a != b)
-                .map(|(e, (a, b))| (e, a - b))
-                .collect();
-            let n_down = changes.iter().filter(|c| c.1 < 0.0).count();
-            let cost = changes.len() + n_down;
-            if cost <= limit && self.updates_since_factor + changes.len() <= 16 * limit {
-                let ups: Vec<(usize, f64)> =
-                    changes.iter().copied().filter(|c| c.1 > 0.0).collect();
-                let downs: Vec<(usize, f64)> =
-                    changes.iter().filter(|c| c.1 < 0.0).map(|&(e, d)| (e, -d)).collect();
-                factor.add_diagonal_penalties(&ups)?;
-                // a refused downdate leaves the factor as it was: refactor below
-                if factor.remove_diagonal_penalties(&downs).is_ok() {
-                    self.updates_since_factor += changes.len();
-                    self.rank1_update_count += changes.len();
-                    self.factored_stroke_diag = d;
-                    return Ok(());
-                }
-            }
-        }
-        let a = self.equations.matrix.add_diagonal(&d);
-        // Stroke weights are of the order of the matrix diagonal (not 1e8 penalties), so a
-        // downdate loses nothing measurable: skip the forced refinement step after one;
-        // every solve still checks its residual and refines above 1e-11.
-        let options =
-            CholeskyOptions { refine_after_downdate: false, ..CholeskyOptions::default() };
-        self.factor = Some(Cholesky::factor_with(&self.symbolic, &a)?.with_options(options));
-        self.factored_stroke_diag = d;
-        self.refactor_count += 1;
-        self.updates_since_factor = 0;
-        Ok(())
+        let diag = self.stroke_diag.as_deref().expect("just made");
+        self.factor.sync(&self.equations.matrix, diag, self.options.rank1_update_limit)
     }
 
-    /// Refactors numerically now (e.g. when a front end is idle after many stroke edits:
-    /// solves after rank-1 downdates take an extra refinement step until then).
+    /// Refactors numerically now (e.g. when a front end is idle after many stroke edits,
+    /// to drop the rounding drift of the accumulated updates and downdates).
     pub fn refresh_factorization(&mut self) -> Result<(), FieldsError> {
-        self.factor = None;
+        self.factor.invalidate();
         self.refactor_if_needed()
     }
 
     /// Model 1-forms summed (`ω*`, `None` without model singularities), point divergence
-    /// (`#V`) and point curl (`#F`) of `PointDelta` poles, and whether there are any of
-    /// the latter. Model fields of new or moved singularities are computed (in parallel
-    /// over edges) and cached; the others are reused.
+    /// (`#V`) and point curl (`#F`) of `PointDelta` poles (empty for the model-field
+    /// model), and whether there are any of the latter. Model fields of new or moved
+    /// singularities are computed (in parallel over edges) and cached; the others are
+    /// reused and summed in id order (the same sum for any edit history).
     fn singular_terms(&mut self) -> (Option<Vec<f64>>, Vec<f64>, Vec<f64>, bool) {
         let ne = self.dec.n_edges();
         let floor = 1e-3 * self.dec.mean_edge_length;
         let mut model: Option<Vec<f64>> = None;
-        let mut s_point = vec![0.0; self.dec.n_vertices()];
-        let mut c_point = vec![0.0; self.dec.n_faces()];
-        let mut any_point = false;
         let point = self.options.singularity_model == SingularityModel::PointDelta;
+        let (mut s_point, mut c_point) = if point {
+            (vec![0.0; self.dec.n_vertices()], vec![0.0; self.dec.n_faces()])
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let mut any_point = false;
         for i in 0..self.singularities.len() {
             let Some(entry) = &self.singularities[i] else { continue };
             let s = entry.singularity;
@@ -617,7 +583,7 @@ impl FieldDesign {
     pub fn solve(&mut self) -> Result<SolvedField, FieldsError> {
         self.refactor_if_needed()?;
         let (model, s_point, c_point, any_point) = self.singular_terms();
-        let factor = self.factor.as_ref().expect("refactor_if_needed made the factor");
+        let factor = self.factor.factor().expect("refactor_if_needed made the factor");
         let (one_form, residual) = match model {
             Some(model) if !any_point => {
                 let mut b = vec![0.0; self.dec.n_edges()];

@@ -32,13 +32,12 @@ pub struct FieldDesignOptions {
     pub regularization: f64,
     /// How singularities enter. Default [`SingularityModel::ModelField`].
     pub singularity_model: SingularityModel,
-    /// Stroke edits whose cost `updates + 2 × downdates` (edges whose weight grows,
-    /// edges whose weight shrinks) is at most this update the factorisation by rank-1
-    /// modifications instead of refactoring (0: always refactor). Default 160: on the
-    /// 128² grid (49K unknowns, 2.3M factor entries) one update measured 0.27–0.45 ms,
-    /// one downdate 0.4–0.8 ms and a numeric refactorisation 90–140 ms on 2 loaded cores
-    /// (`examples/bench_fields.rs`), so short strokes (up to ~160 edges) are updated and
-    /// a typical ~240-edge stroke is refactored — the two cost about the same there.
+    /// Stroke edits that change the weight of at most this many edges update the
+    /// factorisation by multiple-rank modifications instead of refactoring (0: always
+    /// refactor). Default 640: on the 128² grid (49K unknowns, 2.3M factor entries) an
+    /// update or downdate measured ~0.15–0.25 ms per edge and a numeric refactorisation
+    /// 90–150 ms on 2 loaded cores (`examples/bench_fields.rs`), so adding, removing and
+    /// dragging a ~250 px stroke (~250–500 changed edges) are updated.
     pub rank1_update_limit: usize,
 }
 
@@ -51,7 +50,7 @@ impl Default for FieldDesignOptions {
             stroke_weight: 4.0,
             regularization: 1e-6,
             singularity_model: SingularityModel::ModelField,
-            rank1_update_limit: 160,
+            rank1_update_limit: 640,
         }
     }
 }

@@ -51,6 +51,7 @@
 
 pub mod dec;
 pub mod design_elements;
+mod design_factor;
 pub mod design_file;
 pub mod domain;
 pub mod error;

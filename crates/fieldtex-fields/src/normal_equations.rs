@@ -83,7 +83,8 @@ impl NormalEquations {
     }
 
     /// `b` for the model 1-form `model` (`ω*`, `None` if there is none), point divergence
-    /// `s_point` (`#V`) and curl `c_point` (`#F`), and the stroke constraints.
+    /// `s_point` (`#V`, or empty for none) and curl `c_point` (`#F`, or empty), and the
+    /// stroke constraints.
     pub fn right_hand_side<'a>(
         &self,
         dec: &Dec,
@@ -102,10 +103,10 @@ impl NormalEquations {
             None => vec![0.0; dec.n_faces()],
         };
         for (v, sv) in s.iter_mut().enumerate() {
-            *sv = ws * (*sv + s_point[v]) / dec.star0[v];
+            *sv = ws * (*sv + s_point.get(v).copied().unwrap_or(0.0)) / dec.star0[v];
         }
         for (f, cf) in c.iter_mut().enumerate() {
-            *cf = ws * (*cf + c_point[f]) * dec.star2[f];
+            *cf = ws * (*cf + c_point.get(f).copied().unwrap_or(0.0)) * dec.star2[f];
         }
         let mut b = self.div_t.mul_vec(&s);
         for (bi, ci) in b.iter_mut().zip(self.d1_t.mul_vec(&c)) {

@@ -191,31 +191,55 @@ pub fn sample_plane_into(
     let (cols, rows) = (axis(width, nx), axis(height, ny));
     out.clear();
     out.resize(width * height, [0.0; 2]);
-    out.par_chunks_mut(width).zip(rows.par_iter()).for_each(|(row, &(j, v))| {
-        for (px, &(i, u)) in row.iter_mut().zip(&cols) {
-            // Cell corners a=(i,j) b=(i+1,j) c=(i+1,j+1) d=(i,j+1); triangles as in
-            // PlaneGrid::locate.
-            let a = j * (nx + 1) + i;
-            let (za, zb, zc, zd) = (zv[a], zv[a + 1], zv[a + nx + 2], zv[a + nx + 1]);
-            let (w, p, q) = if (i + j).is_multiple_of(2) {
-                if u >= v {
-                    ([1.0 - u, u - v, v], za, [zb, zc])
+    // Rows in fixed groups (disjoint outputs), enough work per task to hide rayon's cost.
+    let group = (1 << 14) / width.max(1) + 1;
+    out.par_chunks_mut(width * group).zip(rows.par_chunks(group)).for_each(|(block, rows)| {
+        // Two passes per row: interpolate (gathers), then the root on plain arrays, a
+        // branch-free loop the compiler vectorises.
+        let (mut xs, mut ys) = (vec![0.0f32; width], vec![0.0f32; width]);
+        for (row, &(j, v)) in block.chunks_mut(width).zip(rows) {
+            let lower = &zv[j * (nx + 1)..(j + 1) * (nx + 1)];
+            let upper = &zv[(j + 1) * (nx + 1)..(j + 2) * (nx + 1)];
+            for ((x, y), &(i, u)) in xs.iter_mut().zip(ys.iter_mut()).zip(&cols) {
+                // Corners a=(i,j) b=(i+1,j) c=(i+1,j+1) d=(i,j+1); triangles as in
+                // PlaneGrid::locate.
+                let (za, zb, zc, zd) = (lower[i], lower[i + 1], upper[i + 1], upper[i]);
+                let (w, p, q, r) = if (i + j) % 2 == 0 {
+                    if u >= v {
+                        ([1.0 - u, u - v, v], za, zb, zc)
+                    } else {
+                        ([1.0 - v, u, v - u], za, zc, zd)
+                    }
+                } else if u + v <= 1.0 {
+                    ([1.0 - u - v, u, v], za, zb, zd)
                 } else {
-                    ([1.0 - v, u, v - u], za, [zc, zd])
-                }
-            } else if u + v <= 1.0 {
-                ([1.0 - u - v, u, v], za, [zb, zd])
-            } else {
-                ([1.0 - v, u + v - 1.0, 1.0 - u], zb, [zc, zd])
-            };
-            let z = [
-                (w[0] * p[0] + w[1] * q[0][0] + w[2] * q[1][0]) as f32,
-                (w[0] * p[1] + w[1] * q[0][1] + w[2] * q[1][1]) as f32,
-            ];
-            *px = nrosy_root_f32(z, symmetry);
+                    ([1.0 - v, u + v - 1.0, 1.0 - u], zb, zc, zd)
+                };
+                *x = (w[0] * p[0] + w[1] * q[0] + w[2] * r[0]) as f32;
+                *y = (w[0] * p[1] + w[1] * q[1] + w[2] * r[1]) as f32;
+            }
+            roots_f32(&xs, &ys, symmetry, row);
         }
     });
     Ok(())
+}
+
+/// [`nrosy_root_f32`] of `(xs[k], ys[k])` into `out[k]` (bit-identical), written without
+/// branches so that it vectorises.
+fn roots_f32(xs: &[f32], ys: &[f32], symmetry: Symmetry, out: &mut [[f32; 2]]) {
+    let half = symmetry == Symmetry::Orientation;
+    for ((o, &x), &y) in out.iter_mut().zip(xs).zip(ys) {
+        let r = (x * x + y * y).sqrt();
+        let valid = r > 0.0 && r <= f32::MAX;
+        let wx = if half { x + r } else { x };
+        let m = (wx * wx + y * y).sqrt();
+        // NaN-safe: a NaN `m` counts as tiny, as in nrosy_root_f32
+        let large = m > 1e-6 * r;
+        let (a, b) = (wx / m, y / m);
+        let a = if large { a } else { 0.0 };
+        let b = if large { b } else { 1.0 };
+        *o = if valid { [a, b] } else { [1.0, 0.0] };
+    }
 }
 
 /// Singularities of the solved field on the design mesh (per-vertex index of the
