@@ -1,15 +1,16 @@
 //! Geometry benchmarks (procedural by default; no files needed).
 //!
 //! `cargo run --release -p fieldtex-mesh --example bench_geometry -- [MESH.obj] [--refine N]
-//! [--rays-only] [--threads N]`
+//! [--rays-only] [--threads N] [--reps N]`
 //!
 //! Without a path the workload is a torus refined once by 1→4 subdivision to
 //! 388,128 triangles (the size of the refined horse of the benchmark suite). With a
 //! path, the OBJ's `v`/`f` lines are read (polygons fanned) and refined `N` times
 //! (default 0). `--rays-only` runs only the BVH entries, `--threads` sets the pool size
-//! (default 2). Prints `BENCH name key=value` lines; ray entries also give `cpu_value`,
+//! (default 2), `--reps` the number of timed runs of each ray entry (default 3). Prints `BENCH name key=value` lines; ray entries also give `cpu_value`,
 //! the rate per CPU-second of this process times the thread count (Linux only), which
-//! is less sensitive to other processes loading the machine than the wall-clock rate.
+//! is less sensitive to other processes loading the machine than the wall-clock rate, and
+//! `best_value`, the wall-clock rate of the fastest run.
 
 use fieldtex_core::rng::hash_unit;
 use fieldtex_core::vec3;
@@ -63,8 +64,9 @@ fn cpu_seconds() -> Option<f64> {
     Some(ticks / 100.0) // USER_HZ is 100 on Linux
 }
 
-/// Median wall-clock milliseconds and median CPU milliseconds of `runs` runs.
-fn median_ms_cpu(runs: usize, mut f: impl FnMut()) -> (f64, Option<f64>) {
+/// Median wall-clock milliseconds, median CPU milliseconds and least wall-clock
+/// milliseconds of `runs` runs.
+fn median_ms_cpu(runs: usize, mut f: impl FnMut()) -> (f64, Option<f64>, f64) {
     f(); // warm-up
     let mut t = Vec::with_capacity(runs);
     let mut c = Vec::with_capacity(runs);
@@ -82,6 +84,7 @@ fn median_ms_cpu(runs: usize, mut f: impl FnMut()) -> (f64, Option<f64>) {
             c.sort_by(f64::total_cmp);
             c[runs / 2]
         }),
+        t[0],
     )
 }
 
@@ -113,6 +116,7 @@ fn main() {
     let mut refine = 0usize;
     let mut threads = 2usize;
     let mut rays_only = false;
+    let mut reps = 3usize;
     let mut i = 0;
     while i < args.len() {
         if args[i] == "--refine" {
@@ -120,6 +124,9 @@ fn main() {
             i += 2;
         } else if args[i] == "--threads" {
             threads = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(2);
+            i += 2;
+        } else if args[i] == "--reps" {
+            reps = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(3).max(1);
             i += 2;
         } else if args[i] == "--rays-only" {
             rays_only = true;
@@ -139,12 +146,12 @@ fn main() {
     mesh.validate().expect("invalid mesh");
     println!("mesh: {} vertices, {} triangles", mesh.n_vertices(), mesh.n_triangles());
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    let rate = |n: usize, (ms, cpu): (f64, Option<f64>)| {
+    let rate = |n: usize, (ms, cpu, best): (f64, Option<f64>, f64)| {
         let wall = n as f64 / (ms * 1e-3);
         let cpu = cpu.map_or(String::new(), |c| {
             format!(" cpu_value={:.0}", n as f64 * threads as f64 / (c.max(1.0) * 1e-3))
         });
-        format!("value={wall:.0}{cpu}")
+        format!("value={wall:.0}{cpu} best_value={:.0}", n as f64 / (best * 1e-3))
     };
     pool.install(|| {
         if !rays_only {
@@ -157,12 +164,12 @@ fn main() {
         let bvh = Bvh::build(&mesh).unwrap();
         let rays = random_rays(&mesh, 1_000_000);
         let mut hits = 0;
-        let m = median_ms_cpu(3, || {
+        let m = median_ms_cpu(reps, || {
             hits = bvh.intersect_many(&rays).iter().filter(|h| h.is_some()).count();
         });
         println!("hit fraction {:.3}", hits as f64 / rays.len() as f64);
         println!("BENCH rays_per_s {}", rate(rays.len(), m));
-        let m = median_ms_cpu(3, || {
+        let m = median_ms_cpu(reps, || {
             std::hint::black_box(bvh.occluded_many(&rays));
         });
         println!("BENCH any_hit_rays_per_s {}", rate(rays.len(), m));

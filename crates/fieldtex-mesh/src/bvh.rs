@@ -3,25 +3,25 @@
 //!
 //! Built with obvhs 0.4: a PLOC binary BVH (Meister & Bittner 2018, "Parallel
 //! Locally-Ordered Clustering for Bounding Volume Hierarchy Construction") refined by
-//! parallel reinsertion and converted to a compressed 8-wide BVH (Ylitie, Karras & Laine
-//! 2017, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs"), whose
+//! parallel reinsertion, then collapsed into an own 4-wide BVH (module `bvh_wide`) whose
 //! SIMD traversal casts the rays. The binary BVH is kept for closest-point queries, which
 //! obvhs does not offer: an own best-first descent with `f64` point–triangle distances
 //! (Ericson 2005, "Real-Time Collision Detection", §5.1.5).
 //!
-//! **Precision.** Traversal is `f32` (obvhs); the mesh is translated so its bounding box
-//! is centred at the origin first, which keeps `f32` relative precision for meshes far
-//! from the origin. Ray–triangle tests use the watertight algorithm of Woop, Benthin &
-//! Wald 2013 ("Watertight Ray/Triangle Intersection", JCGT 2(1); module `bvh_watertight`,
-//! on triangles stored by coordinate rows in BVH leaf order), so a ray through a
-//! shared edge or vertex never slips between triangles; the winning triangle's `t` and
-//! barycentric coordinates are then recomputed in `f64`. Ties (same `t`) go to the lower
-//! triangle index, so results do not depend on the tree layout or the thread count.
-//! Known limit: obvhs's `f32` slab test may miss an exactly axis-parallel ray lying in a
-//! face plane of the mesh's bounding box (grazing the outermost boundary).
+//! **Precision.** Traversal is `f32` with conservative box tests; the mesh is translated
+//! so its bounding box is centred at the origin first, which keeps `f32` relative
+//! precision for meshes far from the origin, and a ray direction far outside the `f32`
+//! range is scaled by a power of two. Ray–triangle tests use the watertight algorithm of
+//! Woop, Benthin & Wald 2013 ("Watertight Ray/Triangle Intersection", JCGT 2(1); module
+//! `bvh_watertight`, on triangles stored by coordinate rows in BVH leaf order), so a ray
+//! through a shared edge or vertex never slips between triangles; the winning
+//! triangle's `t` and barycentric coordinates are then recomputed in `f64` (from `f64`
+//! corners stored in leaf order, prefetched while traversal goes on). Ties (same `t`)
+//! go to the lower triangle index, so results do not depend on the tree layout or the
+//! thread count.
 //!
 //! **Batches.** [`Bvh::intersect_many`] and [`Bvh::occluded_many`] answer large batches
-//! in a cache-coherent order (rays sorted by box entry point and direction, module
+//! in a cache-coherent order (rays radix sorted by box entry point and direction, module
 //! `bvh_ray_order`) over fixed chunks in parallel; every ray is still answered alone, so
 //! results equal the single-ray queries for any thread count.
 //!
@@ -33,13 +33,12 @@
 
 use crate::{MeshError, TriMesh};
 use bvh_watertight::{RowTriangle, Shear};
+use bvh_wide::{RayBoxes, WideBvh};
 use fieldtex_core::vec3::{self, V3};
-use glam::{UVec2, Vec3A};
+use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::node::Bvh2Node;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
-use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray as ORay;
 use obvhs::triangle::Triangle;
@@ -85,18 +84,21 @@ pub struct ClosestPoint {
 /// Ray-casting and closest-point acceleration structure (module docs).
 #[derive(Clone)]
 pub struct Bvh {
-    cwbvh: CwBvh,
+    wide: WideBvh,
     /// `f32` triangles in BVH primitive order (translated by `-centre`).
     prim_tris: Vec<RowTriangle>,
     /// Mesh triangle of each BVH primitive.
     prim_ids: Vec<u32>,
-    /// Binary BVH for closest-point queries (boxes translated by `-centre`).
+    /// Binary BVH for closest-point queries (boxes translated by `-centre`) and the
+    /// primitive (leaf-order index) of each of its leaf entries.
     nodes2: Vec<Bvh2Node>,
     prim_ids2: Vec<u32>,
     centre: V3,
     /// Inverse half extents of the mesh box (finite, positive), for ray ordering.
     inv_half: V3,
-    /// `f64` corners of every mesh triangle (untranslated).
+    /// Largest half extent of the mesh box (`f32`), for traversal slack.
+    scene_half: f32,
+    /// `f64` corners (untranslated) of every BVH primitive, in leaf order.
     corners: Vec<[V3; 3]>,
     /// Slack added to `f32` boxes in closest-point pruning.
     box_slack: f64,
@@ -107,7 +109,7 @@ impl std::fmt::Debug for Bvh {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Bvh")
             .field("triangles", &self.prim_ids.len())
-            .field("nodes", &self.cwbvh.nodes.len())
+            .field("wide", &self.wide)
             .field("skipped", &self.n_skipped)
             .finish()
     }
@@ -154,8 +156,8 @@ impl Bvh {
             })
             .collect();
         let params = BvhBuildParams::medium_build();
-        let (cwbvh, nodes2, prim_ids2, prim_tris, prim_ids) = if tris.is_empty() {
-            (CwBvh::default(), Vec::new(), Vec::new(), Vec::new(), Vec::new())
+        let (wide, nodes2, prim_ids2, prim_tris, prim_ids) = if tris.is_empty() {
+            (WideBvh::default(), Vec::new(), Vec::new(), Vec::new(), Vec::new())
         } else {
             let mut bvh2 = PlocBuilder::with_capacity(tris.len()).build(
                 params.ploc_search_distance,
@@ -165,17 +167,26 @@ impl Bvh {
                 params.search_depth_threshold,
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-            let cw = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
+            let (wide, order) = WideBvh::build(&bvh2);
             let prim_tris: Vec<RowTriangle> =
-                cw.primitive_indices.iter().map(|&i| RowTriangle::new(&tris[i as usize])).collect();
-            let prim_ids: Vec<u32> =
-                cw.primitive_indices.iter().map(|&i| keep[i as usize]).collect();
+                order.iter().map(|&i| RowTriangle::new(&tris[i as usize])).collect();
+            let prim_ids: Vec<u32> = order.iter().map(|&i| keep[i as usize]).collect();
+            let mut slot = vec![0u32; tris.len()];
+            for (k, &i) in order.iter().enumerate() {
+                slot[i as usize] = k as u32;
+            }
             let prim_ids2: Vec<u32> =
-                bvh2.primitive_indices.iter().map(|&i| keep[i as usize]).collect();
-            (cw, bvh2.nodes, prim_ids2, prim_tris, prim_ids)
+                bvh2.primitive_indices.iter().map(|&i| slot[i as usize]).collect();
+            (wide, bvh2.nodes, prim_ids2, prim_tris, prim_ids)
         };
+        let corners: Vec<[V3; 3]> = prim_ids.iter().map(|&f| corners[f as usize]).collect();
+        let scene_half = mesh
+            .bounding_box()
+            .map_or(1.0, |b| (0..3).map(|k| 0.5 * (b.max[k] - b.min[k])).fold(0.0, f64::max))
+            as f32;
         Ok(Self {
-            cwbvh,
+            wide,
+            scene_half: if scene_half.is_finite() { scene_half } else { f32::MAX },
             prim_tris,
             prim_ids,
             nodes2,
@@ -203,8 +214,9 @@ impl Bvh {
         self.occluded(&Ray { origin, dir, tmin: 0.0, tmax })
     }
 
-    /// The `f32` obvhs ray, or `None` for a degenerate query.
-    fn oray(&self, r: &Ray) -> Option<ORay> {
+    /// The `f32` obvhs ray, translated, with its direction scaled by a power of two `s`
+    /// into `f32` range (ray parameter `t / s`), and `s`; `None` for a degenerate query.
+    fn oray(&self, r: &Ray) -> Option<(ORay, f64)> {
         let ok = vec3::is_finite(r.origin)
             && vec3::is_finite(r.dir)
             && vec3::norm2(r.dir) > 0.0
@@ -212,70 +224,43 @@ impl Bvh {
             && !r.tmax.is_nan()
             && r.tmin <= r.tmax
             && !self.prim_tris.is_empty();
-        ok.then(|| {
-            let d = Vec3A::new(r.dir[0] as f32, r.dir[1] as f32, r.dir[2] as f32);
-            ORay::new(to_f32(r.origin, self.centre), d, r.tmin.max(0.0) as f32, r.tmax as f32)
-        })
+        if !ok {
+            return None;
+        }
+        let m = r.dir.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let s =
+            if (1e-30..=1e30).contains(&m) { 1.0 } else { 2f64.powi(-(m.log2().round() as i32)) };
+        let d = Vec3A::new((r.dir[0] * s) as f32, (r.dir[1] * s) as f32, (r.dir[2] * s) as f32);
+        let o = to_f32(r.origin, self.centre);
+        if !o.is_finite() {
+            return None;
+        }
+        let ray = ORay::new(o, d, (r.tmin.max(0.0) / s) as f32, (r.tmax / s) as f32);
+        Some((ray, s))
     }
 
     /// Closest hit of a ray with a `[tmin, tmax]` range.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let oray = self.oray(ray)?;
-        let mut best_t = f32::INFINITY;
-        let mut best_prim = u32::MAX;
+        let (oray, s) = self.oray(ray)?;
         let mut shear = Shear::new(&oray);
-        let mut traverse_ray = oray;
-        let mut state = self.cwbvh.new_traversal(oray.direction);
-        let mut node;
-        obvhs::traverse!(
-            self.cwbvh,
-            node,
-            state,
-            node.intersect_ray(&traverse_ray, state.oct_inv4),
-            {
-                let p = state.primitive_id;
-                let t = shear.intersect(&self.prim_tris[p as usize]);
-                if t < best_t
-                    || (t == best_t
-                        && t.is_finite()
-                        && self.prim_ids[p as usize] < self.prim_ids[best_prim as usize])
-                {
-                    best_t = t;
-                    best_prim = p;
-                    traverse_ray.tmax = t;
-                    shear.tmax = t;
-                }
-            }
-        );
-        if best_prim == u32::MAX {
-            return None;
-        }
+        let rb = RayBoxes::new(oray.origin, oray.direction, oray.tmin, self.scene_half);
+        let (best_prim, best_t) =
+            self.wide.closest(&rb, &mut shear, &self.prim_tris, &self.prim_ids, &self.corners)?;
         let tri = self.prim_ids[best_prim as usize];
-        let (t, bary) =
-            refine_hit(self.corners[tri as usize], ray.origin, ray.dir).unwrap_or_else(|| {
+        let (t, bary) = refine_hit(self.corners[best_prim as usize], ray.origin, ray.dir)
+            .unwrap_or_else(|| {
                 let b = self.prim_tris[best_prim as usize].triangle().compute_barycentric(&oray);
-                (best_t as f64, [1.0 - (b.x + b.y) as f64, b.x as f64, b.y as f64])
+                (best_t as f64 * s, [1.0 - (b.x + b.y) as f64, b.x as f64, b.y as f64])
             });
         Some(Hit { triangle: tri, t, barycentric: bary })
     }
 
     /// Whether a ray with a `[tmin, tmax]` range hits anything.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(oray) = self.oray(ray) else { return false };
+        let Some((oray, _)) = self.oray(ray) else { return false };
         let shear = Shear::new(&oray);
-        let mut state = self.cwbvh.new_traversal(oray.direction);
-        let mut node;
-        let mut hit = false;
-        // A plain `break` would only leave the macro's inner primitive loop.
-        'traversal: {
-            obvhs::traverse!(self.cwbvh, node, state, node.intersect_ray(&oray, state.oct_inv4), {
-                if shear.intersect(&self.prim_tris[state.primitive_id as usize]).is_finite() {
-                    hit = true;
-                    break 'traversal;
-                }
-            });
-        }
-        hit
+        let rb = RayBoxes::new(oray.origin, oray.direction, oray.tmin, self.scene_half);
+        self.wide.any(&rb, &shear, &self.prim_tris)
     }
 
     /// [`Bvh::intersect`] for many rays, in parallel (deterministic).
@@ -306,8 +291,8 @@ impl Bvh {
             let node = &self.nodes2[ni as usize];
             if node.is_leaf() {
                 let start = node.first_index as usize;
-                for &tri in &self.prim_ids2[start..start + node.prim_count as usize] {
-                    let c = self.corners[tri as usize];
+                for &slot in &self.prim_ids2[start..start + node.prim_count as usize] {
+                    let (tri, c) = (self.prim_ids[slot as usize], self.corners[slot as usize]);
                     let (cp, bary) = closest_point_on_triangle(p, c);
                     let dd = vec3::norm2(vec3::sub(cp, p));
                     let better =
@@ -463,6 +448,9 @@ pub fn closest_point_on_triangle(p: V3, c: [V3; 3]) -> (V3, [f64; 3]) {
 
 #[path = "bvh_watertight.rs"]
 mod bvh_watertight;
+
+#[path = "bvh_wide.rs"]
+mod bvh_wide;
 
 #[path = "bvh_ray_order.rs"]
 mod bvh_ray_order;

@@ -16,14 +16,10 @@ use rayon::prelude::*;
 const CHUNK: usize = 256;
 /// Batches below this size are answered in input order (sorting would not pay off).
 const MIN_SORTED: usize = 8192;
-/// Rays sorted together (positions must fit the low 32 bits of a sort key).
-const BLOCK: usize = 1 << 31;
 /// Bits per key dimension (5 dimensions: entry point x, y, z, octahedral direction u, v).
 const BITS: u32 = 6;
-/// Fixed input parts for the parallel bucket passes.
-const PARTS: usize = 16;
-/// Key bits below the bucket digit (the top 10 bits pick one of 1024 buckets).
-const LOW: u32 = 5 * BITS - 10;
+/// Bits per radix-sort pass (three passes cover the 30-bit key).
+const RADIX: u32 = 10;
 
 /// `SPREAD[b]` holds the bits of `b` at every fifth position (5-D Morton interleave).
 const SPREAD: [u32; 1 << BITS] = {
@@ -44,11 +40,11 @@ const SPREAD: [u32; 1 << BITS] = {
 /// results in input order. The scene box has centre `centre` and half extents
 /// `1 / inv_half` (all positive).
 ///
-/// Large arrays are only read or written in sequential streams (at most one per bucket):
-/// rays are first copied into 1024 buckets by the top key bits, each bucket is sorted on
-/// its own, and results go back through the same buckets. Random access into the whole
-/// batch (slow on virtual machines with small pages) is avoided.
-pub(super) fn map_coherent<T: Copy + Send + Sync>(
+/// Sort keys `key << 32 | index` are radix sorted (stable, so equal keys keep the input
+/// order); every chunk gathers its rays first (independent loads that overlap) and
+/// answers them; the results are then scattered back to input order in one sequential
+/// pass. Batches of more than `u32::MAX` rays are answered in blocks.
+pub(super) fn map_coherent<T: Copy + Default + Send + Sync>(
     rays: &[Ray],
     centre: V3,
     inv_half: V3,
@@ -60,93 +56,91 @@ pub(super) fn map_coherent<T: Copy + Send + Sync>(
     let c = Vec3A::new(centre[0] as f32, centre[1] as f32, centre[2] as f32);
     let ih = Vec3A::new(inv_half[0] as f32, inv_half[1] as f32, inv_half[2] as f32);
     let mut out = Vec::with_capacity(rays.len());
-    for block in rays.chunks(BLOCK) {
+    for block in rays.chunks(u32::MAX as usize) {
         map_block(block, c, ih, &f, &mut out);
     }
     out
 }
 
-/// [`map_coherent`] for at most [`BLOCK`] rays, results appended to `out`.
-fn map_block<T: Copy + Send + Sync>(
+/// [`map_coherent`] for at most `u32::MAX` rays, results appended to `out`.
+fn map_block<T: Copy + Default + Send + Sync>(
     block: &[Ray],
     c: Vec3A,
     ih: Vec3A,
     f: &(impl Fn(&Ray) -> T + Sync + Send),
     out: &mut Vec<T>,
 ) {
-    const NB: usize = 1 << 10;
     let n = block.len();
-    let keys: Vec<u32> = block.par_iter().with_min_len(4096).map(|r| ray_key(r, c, ih)).collect();
-    let digit = |k: u32| (k >> LOW) as usize;
-    // Bucket counts per fixed part of the input (independent of the thread count), then
-    // each part's first position in every bucket.
-    let part_len = n.div_ceil(PARTS);
-    let mut cursors: Vec<Vec<usize>> = keys
-        .par_chunks(part_len)
-        .map(|ks| {
-            let mut h = vec![0usize; NB];
-            for &k in ks {
-                h[digit(k)] += 1;
-            }
-            h
-        })
-        .collect();
-    let mut start = vec![0usize; NB + 1];
-    for b in 0..NB {
-        let mut sum = start[b];
-        for h in cursors.iter_mut() {
-            (h[b], sum) = (sum, sum + h[b]);
-        }
-        start[b + 1] = sum;
-    }
-    // Input index of every bucket position (stable), then rays and sort keys by bucket:
-    // the gathers read the input in one ascending stream per bucket.
-    let mut src = vec![0u32; n];
-    let mut cur = start.clone();
-    for (i, &k) in keys.iter().enumerate() {
-        let d = digit(k);
-        src[cur[d]] = i as u32;
-        cur[d] += 1;
-    }
-    let brays: Vec<Ray> = src.par_iter().with_min_len(4096).map(|&i| block[i as usize]).collect();
-    let mut bkeys: Vec<u64> = src
+    let keys: Vec<u64> = block
         .par_iter()
         .enumerate()
         .with_min_len(4096)
-        .map(|(q, &i)| (u64::from(keys[i as usize] & ((1 << LOW) - 1)) << 32) | q as u64)
+        .map(|(i, r)| (u64::from(ray_key(r, c, ih)) << 32) | i as u64)
         .collect();
-    drop(src);
-    let mut parts = Vec::with_capacity(NB);
-    let mut rest = bkeys.as_mut_slice();
-    for b in 0..NB {
-        let (head, tail) = rest.split_at_mut(start[b + 1] - start[b]);
-        parts.push(head);
-        rest = tail;
+    let keys = radix_sort(keys);
+    // Answer in sorted order, each result written straight to its input position.
+    let base = out.len();
+    out.resize(base + n, T::default());
+    let dst = OutPtr(out[base..].as_mut_ptr());
+    keys.par_chunks(CHUNK).for_each(|ks| {
+        // Gather first: independent loads overlap, unlike loads inside traversal.
+        let mut local = [Ray::new([0.0; 3], [0.0; 3]); CHUNK];
+        for (l, &k) in local.iter_mut().zip(ks) {
+            *l = block[k as u32 as usize];
+        }
+        for (l, &k) in local.iter().zip(ks) {
+            let r = f(l);
+            dst.write(k as u32 as usize, n, r);
+        }
+    });
+}
+
+/// The output of a batch, written by all tasks at disjoint positions.
+#[derive(Clone, Copy)]
+struct OutPtr<T>(*mut T);
+
+impl<T: Copy> OutPtr<T> {
+    /// Writes element `i` of the `n` elements.
+    #[inline(always)]
+    fn write(&self, i: usize, n: usize, value: T) {
+        assert!(i < n);
+        // SAFETY: `i < n`, so the write stays inside the batch's `n` elements of `out`,
+        // which live (and are not otherwise accessed) until the parallel loop returns;
+        // the indices of the sorted keys are a permutation of `0..n` (radix sorting
+        // permutes them), so no two writes touch the same element; `T: Copy` has no
+        // drop to skip.
+        unsafe { self.0.add(i).write(value) };
     }
-    parts.into_par_iter().with_min_len(16).for_each(|p| p.sort_unstable());
-    // Answer in sorted order; the gathers stay inside one bucket.
-    let sorted: Vec<T> = bkeys
-        .par_chunks(CHUNK)
-        .flat_map_iter(|ch| {
-            // Gather first: independent loads overlap, unlike loads inside traversal.
-            let local: Vec<Ray> = ch.iter().map(|&k| brays[k as u32 as usize]).collect();
-            local.iter().map(f).collect::<Vec<T>>()
-        })
-        .collect();
-    drop(brays);
-    // Sorted index of each bucket position, then results in input order, by part.
-    let mut pos = vec![0u32; n];
-    for (j, &k) in bkeys.iter().enumerate() {
-        pos[k as u32 as usize] = j as u32;
+}
+// SAFETY: tasks write disjoint elements only (see `map_block`); `T: Send`.
+unsafe impl<T: Send> Send for OutPtr<T> {}
+// SAFETY: as above; the pointer itself is never used to read.
+unsafe impl<T: Send> Sync for OutPtr<T> {}
+
+/// Stable least-significant-digit radix sort of `key << 32 | index` values by their
+/// upper 30 bits (the key), [`RADIX`] bits per pass.
+fn radix_sort(mut a: Vec<u64>) -> Vec<u64> {
+    const NB: usize = 1 << RADIX;
+    let mut b = vec![0u64; a.len()];
+    for pass in 0..(5 * BITS).div_ceil(RADIX) {
+        let shift = 32 + pass * RADIX;
+        let digit = |x: u64| ((x >> shift) as usize) & (NB - 1);
+        let mut start = [0usize; NB];
+        for &x in &a {
+            start[digit(x)] += 1;
+        }
+        let mut sum = 0;
+        for s in start.iter_mut() {
+            (*s, sum) = (sum, sum + *s);
+        }
+        for &x in &a {
+            let d = digit(x);
+            b[start[d]] = x;
+            start[d] += 1;
+        }
+        std::mem::swap(&mut a, &mut b);
     }
-    out.par_extend(keys.par_chunks(part_len).zip(cursors).flat_map_iter(|(ks, mut cur)| {
-        let (sorted, pos) = (&sorted, &pos);
-        ks.iter().map(move |&k| {
-            let d = digit(k);
-            cur[d] += 1;
-            sorted[pos[cur[d] - 1] as usize]
-        })
-    }));
+    a
 }
 
 /// 30-bit Morton key of the ray's box entry point and direction (`f32` is plenty for an

@@ -256,3 +256,92 @@ fn rays_aimed_at_vertices_and_edge_midpoints_never_miss() {
         }
     }
 }
+
+#[test]
+fn random_rays_with_ranges_and_duplicates_match_brute_force() {
+    // Every triangle twice (same corners): hits must go to the lower index. Random
+    // ranges, axis-parallel directions (zero components) and tiny or huge direction
+    // lengths; batches must equal single queries for 1 and 2 threads.
+    let orig = torus(2.0, 0.7, 30, 12);
+    let n = orig.triangles.len() as u32;
+    let mut m = orig.clone();
+    let scale = |i: u64| if i.is_multiple_of(2) { 1e-35 } else { 1e35 };
+    let dup: Vec<[u32; 3]> = m.triangles.clone();
+    m.triangles.extend(dup);
+    let bvh = Bvh::build(&m).unwrap();
+    let mut rs = rays(&m, 9000);
+    for (i, r) in rs.iter_mut().enumerate() {
+        let i = i as u64;
+        match i % 5 {
+            1 => r.dir[(i / 5 % 3) as usize] = 0.0,
+            2 => {
+                let k = (i / 5 % 3) as usize;
+                r.dir = [0.0; 3];
+                r.dir[k] = if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+                r.origin[k] = if i.is_multiple_of(2) { -5.0 } else { 5.0 };
+            }
+            3 => r.dir = vec3::scale(r.dir, scale(i)),
+            _ => {}
+        }
+        if i.is_multiple_of(3) {
+            let len = vec3::norm(r.dir);
+            let a = 4.0 * hash_unit(6, "tmin", i) / len;
+            *r = r.with_range(a, a + 3.0 * hash_unit(6, "tlen", i) / len);
+        }
+    }
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| (bvh.intersect_many(&rs), bvh.occluded_many(&rs)))
+    };
+    let (hits, occ) = run(1);
+    assert_eq!((hits.clone(), occ.clone()), run(2));
+    let mut n_hits = 0;
+    for (i, r) in rs.iter().enumerate() {
+        assert_eq!(hits[i], bvh.intersect(r), "ray {i}");
+        assert_eq!(occ[i], hits[i].is_some(), "ray {i}");
+        if i % 5 == 3 {
+            // Same as the ray with its usual length.
+            let r0 = Ray { dir: vec3::scale(r.dir, 1.0 / scale(i as u64)), ..*r };
+            let h0 = bvh.intersect(&r0);
+            assert_eq!(hits[i].map(|h| h.triangle), h0.map(|h| h.triangle), "ray {i}");
+            if let (Some(h), Some(h0)) = (hits[i], h0) {
+                assert!((h.t * scale(i as u64) - h0.t).abs() < 1e-9 * h0.t, "ray {i}");
+            }
+        } else if i % 3 != 0 {
+            // Brute force over the originals only (the copies tie).
+            let bf = brute_hit(&orig, r.origin, r.dir, r.tmax);
+            match (hits[i], bf) {
+                (Some(h), Some((_, t))) => {
+                    assert!(h.triangle < n, "ray {i}: the copy {} won", h.triangle);
+                    assert!((h.t - t).abs() <= 1e-6 * t.max(1.0 / vec3::norm(r.dir)), "ray {i}");
+                    n_hits += 1;
+                }
+                (None, None) => {}
+                (h, bf) => {
+                    // Only a ray grazing an edge may disagree with the non-watertight
+                    // brute force; its hit must then lie on a triangle's border.
+                    let h = h.unwrap_or_else(|| panic!("ray {i}: missed {bf:?}"));
+                    assert!(h.barycentric.iter().any(|&b| b < 1e-7), "ray {i}: {h:?}");
+                }
+            }
+        } else if let Some(h) = hits[i] {
+            assert!(h.triangle < n && h.t >= r.tmin && h.t <= r.tmax * (1.0 + 1e-12), "ray {i}");
+        }
+    }
+    assert!(n_hits > 1500, "{n_hits}");
+}
+
+#[test]
+fn grid_boundary_is_hit_by_axis_parallel_rays() {
+    // Rays along -z in the bounding-box faces of a flat grid (x or y at its extremes).
+    let m = crate::primitives::grid(4, 4, 1.0, 1.0);
+    let bvh = Bvh::build(&m).unwrap();
+    for j in 0..=8 {
+        let s = j as f64 / 8.0;
+        for (x, y) in [(0.0, s), (1.0, s), (s, 0.0), (s, 1.0)] {
+            let h = bvh.closest_hit([x, y, 1.0], [0.0, 0.0, -1.0], f64::INFINITY);
+            assert!(h.is_some_and(|h| (h.t - 1.0).abs() < 1e-12), "miss at ({x}, {y})");
+            assert!(bvh.any_hit([x, y, 1.0], [0.0, 0.0, -1.0], 2.0), "({x}, {y})");
+        }
+    }
+}

@@ -1,0 +1,417 @@
+//! 4-wide BVH for ray casting: a binary BVH collapsed into nodes of up to four children
+//! whose boxes are stored by coordinate (one SIMD register per bound), tested against a
+//! ray all four at once (the layout of Wald, Benthin & Boulos 2008, "Getting Rid of
+//! Packets: Efficient SIMD Single-Ray Traversal using Multi-branching BVHs", and of
+//! Dammertz, Hanika & Keller 2008, "Shallow Bounding Volume Hierarchies for Fast SIMD Ray
+//! Tracing of Incoherent Rays").
+//!
+//! Collapse: starting from a binary node's two children, the child with the largest box
+//! is repeatedly replaced by its own two children until four slots are used; a subtree
+//! with at most [`LEAF_MAX`] triangles becomes a leaf. Nodes are stored depth first
+//! (a node's first inner child directly follows it) and leaf triangles in traversal
+//! order, so the triangle rows of a leaf are contiguous.
+//!
+//! Traversal visits the hit children nearest first and prunes by the current closest
+//! hit. Box tests are conservative: the far slab distance is enlarged by `1 + 2γ₃`
+//! (Ize 2013, "Robust BVH Ray Traversal", JCGT 2(2)), a zero direction component is
+//! replaced by a tiny one of the same sign while the stored boxes are one ulp wider than
+//! their contents (a ray lying in a box face stays inside), and the pruning distance
+//! carries a slack of
+//! a few hundred ulps of the scene size, so a triangle tying the best hit is still
+//! visited. Results therefore do not depend on the tree layout.
+
+use super::bvh_watertight::{RowTriangle, Shear};
+use glam::{Vec3A, Vec4};
+use obvhs::bvh2::Bvh2;
+
+/// Largest number of triangles in a leaf.
+pub(super) const LEAF_MAX: usize = 3;
+/// Entries of the fixed traversal stack; deeper trees use a heap stack.
+const FIXED_STACK: usize = 96;
+
+/// A node: boxes of four children by bound (`b[0..6]` = min x, max x, min y, max y,
+/// min z, max z) and the children. `count[i] == 0`: `child[i]` is a node index;
+/// otherwise child `i` is a leaf of `count[i]` triangles starting at `child[i]`. Empty
+/// slots have inverted (+∞, −∞) boxes, which no ray hits.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(super) struct Node4 {
+    b: [[f32; 4]; 6],
+    child: [u32; 4],
+    count: [u32; 4],
+}
+
+/// A 4-wide BVH over triangles stored by rows in leaf order.
+#[derive(Clone, Debug, Default)]
+pub(super) struct WideBvh {
+    nodes: Vec<Node4>,
+    /// Upper bound of the traversal stack size (3 per level + 1).
+    stack_len: usize,
+}
+
+/// Per-ray constants of the box test.
+#[derive(Clone, Copy)]
+pub(super) struct RayBoxes {
+    org: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// Bound index (into `Node4::b`) of the near and far plane per axis.
+    near: [usize; 3],
+    far: [usize; 3],
+    tmin: f32,
+    /// Pruning slack added to the best hit distance.
+    slack: f32,
+}
+
+impl RayBoxes {
+    /// `org`, `dir`: the `f32` ray (finite); `scene_half`: largest half extent of the
+    /// (translated, centred) scene box.
+    pub(super) fn new(org: Vec3A, dir: Vec3A, tmin: f32, scene_half: f32) -> Self {
+        let safe = |x: f32| if x.abs() < 1e-30 { 1e30f32.copysign(x) } else { 1.0 / x };
+        let inv = Vec3A::new(safe(dir.x), safe(dir.y), safe(dir.z));
+        let nf = |k: usize| if inv[k] >= 0.0 { (2 * k, 2 * k + 1) } else { (2 * k + 1, 2 * k) };
+        let (n0, f0) = nf(0);
+        let (n1, f1) = nf(1);
+        let (n2, f2) = nf(2);
+        let scale = (org.abs().max_element() + scene_half) / dir.abs().max_element();
+        Self {
+            org: [Vec4::splat(org.x), Vec4::splat(org.y), Vec4::splat(org.z)],
+            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            near: [n0, n1, n2],
+            far: [f0, f1, f2],
+            tmin,
+            slack: scale * (1.0 / 65536.0),
+        }
+    }
+
+    /// Entry distances of the four boxes and the mask of those entered within
+    /// `[tmin, tlimit]`.
+    #[inline(always)]
+    fn test(&self, n: &Node4, tlimit: f32) -> (Vec4, u32) {
+        // 1 + 2γ₃ with γ₃ = 3ε / (1 − 3ε), ε = 2⁻²⁴, rounded up.
+        const GROW: f32 = 1.0 + 2.0 * 3.0 * (f32::EPSILON * 0.5) * 1.000_001;
+        let slab = |k: usize, i: usize| (Vec4::from_array(n.b[i]) - self.org[k]) * self.inv[k];
+        let tn = slab(0, self.near[0])
+            .max(slab(1, self.near[1]))
+            .max(slab(2, self.near[2]).max(Vec4::splat(self.tmin)));
+        let tf = slab(0, self.far[0]).min(slab(1, self.far[1])).min(slab(2, self.far[2]))
+            * Vec4::splat(GROW);
+        let tf = tf.min(Vec4::splat(tlimit));
+        (tn, tn.cmple(tf).bitmask())
+    }
+}
+
+/// Hints the cache to load the `lines` 64-byte lines from `r` on (no effect elsewhere
+/// than on x86-64).
+#[inline(always)]
+fn prefetch<T>(r: &T, lines: usize) {
+    #[cfg(target_arch = "x86_64")]
+    for k in 0..lines {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let p = (r as *const T).cast::<i8>().wrapping_add(64 * k);
+        // SAFETY: a prefetch never faults and reads nothing into the program, whatever
+        // the address; SSE is part of the x86-64 baseline.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (r, lines);
+}
+
+impl Node4 {
+    /// Prefetches child `i` (a node or a leaf's triangles).
+    #[inline(always)]
+    fn prefetch_child(&self, i: usize, nodes: &[Node4], tris: &[RowTriangle]) {
+        let c = self.child[i] as usize;
+        if self.count[i] == 0 {
+            if let Some(n) = nodes.get(c) {
+                prefetch(n, 2);
+            }
+        } else if let Some(t) = tris.get(c) {
+            prefetch(t, (self.count[i] as usize * size_of::<RowTriangle>()).div_ceil(64));
+        }
+    }
+}
+
+#[derive(Clone, Copy, Default)]
+struct Entry {
+    child: u32,
+    count: u32,
+    tn: f32,
+}
+
+impl WideBvh {
+    /// Collapses `bvh2` (primitive indices into `tris`); returns the BVH and the
+    /// primitive (index into `tris`) of every leaf slot, in leaf order.
+    pub(super) fn build(bvh2: &Bvh2) -> (Self, Vec<u32>) {
+        let n2 = &bvh2.nodes;
+        let mut nodes: Vec<Node4> = Vec::with_capacity(n2.len() / 3 + 1);
+        let mut order: Vec<u32> = Vec::with_capacity(bvh2.primitive_indices.len());
+        if n2.is_empty() {
+            return (Self::default(), order);
+        }
+        // Work: (binary node, parent node, slot, depth); the root has no parent.
+        let mut work: Vec<(u32, u32, usize, usize)> = vec![(0, u32::MAX, 0, 1)];
+        let mut max_depth = 1;
+        let mut small = Vec::with_capacity(LEAF_MAX);
+        while let Some((bi, parent, slot, depth)) = work.pop() {
+            let me = nodes.len() as u32;
+            if parent != u32::MAX {
+                nodes[parent as usize].child[slot] = me;
+            }
+            max_depth = max_depth.max(depth);
+            let mut cands: Vec<u32> = if n2[bi as usize].is_leaf() {
+                vec![bi]
+            } else {
+                let f = n2[bi as usize].first_index;
+                vec![f, f + 1]
+            };
+            while cands.len() < 4 {
+                let pick = cands
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| !n2[**c as usize].is_leaf())
+                    .max_by(|a, b| {
+                        let area = |c: &u32| n2[*c as usize].aabb().half_area();
+                        area(a.1).total_cmp(&area(b.1)).then(b.0.cmp(&a.0))
+                    })
+                    .map(|(k, _)| k);
+                let Some(k) = pick else { break };
+                let f = n2[cands[k] as usize].first_index;
+                cands[k] = f;
+                cands.insert(k + 1, f + 1);
+            }
+            let mut node = Node4 {
+                b: [
+                    [f32::INFINITY; 4],
+                    [f32::NEG_INFINITY; 4],
+                    [f32::INFINITY; 4],
+                    [f32::NEG_INFINITY; 4],
+                    [f32::INFINITY; 4],
+                    [f32::NEG_INFINITY; 4],
+                ],
+                child: [u32::MAX; 4],
+                count: [0; 4],
+            };
+            let mut inner = Vec::new();
+            for (i, &c) in cands.iter().enumerate() {
+                let bn = &n2[c as usize];
+                let bb = bn.aabb();
+                // One ulp wider, so a ray with a zero direction component lying in a
+                // box face is still inside that slab.
+                for k in 0..3 {
+                    node.b[2 * k][i] = bb.min[k].next_down();
+                    node.b[2 * k + 1][i] = bb.max[k].next_up();
+                }
+                small.clear();
+                if gather_small(bvh2, c, &mut small) {
+                    node.child[i] = order.len() as u32;
+                    node.count[i] = small.len() as u32;
+                    order.extend_from_slice(&small);
+                } else {
+                    inner.push((c, i));
+                }
+            }
+            nodes.push(node);
+            // Reverse, so the first inner child is built next (directly after `me`).
+            for &(c, i) in inner.iter().rev() {
+                work.push((c, me, i, depth + 1));
+            }
+        }
+        (Self { nodes, stack_len: 3 * max_depth + 1 }, order)
+    }
+
+    /// Closest hit: `(slot, t)` of the hit with the least `t` (ties: least `ids[slot]`),
+    /// or `None`. `shear.tmax` bounds the hits; it is lowered while traversing. The
+    /// winner's entry of `refine` (indexed by slot) is prefetched.
+    #[inline]
+    pub(super) fn closest<R>(
+        &self,
+        rb: &RayBoxes,
+        shear: &mut Shear,
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+    ) -> Option<(u32, f32)> {
+        if self.stack_len <= FIXED_STACK {
+            let mut stack = [Entry::default(); FIXED_STACK];
+            self.closest_with(rb, shear, tris, ids, refine, &mut stack)
+        } else {
+            let mut stack = vec![Entry::default(); self.stack_len];
+            self.closest_with(rb, shear, tris, ids, refine, &mut stack)
+        }
+    }
+
+    /// Whether any triangle is hit within `[shear.tmin, shear.tmax]`.
+    #[inline]
+    pub(super) fn any(&self, rb: &RayBoxes, shear: &Shear, tris: &[RowTriangle]) -> bool {
+        if self.stack_len <= FIXED_STACK {
+            let mut stack = [Entry::default(); FIXED_STACK];
+            self.any_with(rb, shear, tris, &mut stack)
+        } else {
+            let mut stack = vec![Entry::default(); self.stack_len];
+            self.any_with(rb, shear, tris, &mut stack)
+        }
+    }
+
+    #[inline(always)]
+    fn closest_with<R>(
+        &self,
+        rb: &RayBoxes,
+        shear: &mut Shear,
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+        stack: &mut [Entry],
+    ) -> Option<(u32, f32)> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let mut best: Option<(u32, f32)> = None;
+        let mut tlimit = shear.tmax;
+        let mut sp = 0usize;
+        let mut cur = Entry { child: 0, count: 0, tn: 0.0 };
+        loop {
+            if cur.count == 0 {
+                let node = &self.nodes[cur.child as usize];
+                let (tn, mask) = rb.test(node, tlimit);
+                if mask != 0 {
+                    let tn = tn.to_array();
+                    let first = mask.trailing_zeros() as usize;
+                    let rest = mask & (mask - 1);
+                    let at =
+                        |i: usize| Entry { child: node.child[i], count: node.count[i], tn: tn[i] };
+                    if rest == 0 {
+                        node.prefetch_child(first, &self.nodes, tris);
+                        cur = at(first);
+                        continue;
+                    }
+                    // Two or more: push all but the nearest, farthest first.
+                    let mut hits = [Entry::default(); 4];
+                    let mut nh = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        node.prefetch_child(i, &self.nodes, tris);
+                        // Insertion by entry distance (descending).
+                        let e = at(i);
+                        let mut j = nh;
+                        while j > 0 && hits[j - 1].tn < e.tn {
+                            hits[j] = hits[j - 1];
+                            j -= 1;
+                        }
+                        hits[j] = e;
+                        nh += 1;
+                    }
+                    stack[sp..sp + nh - 1].copy_from_slice(&hits[..nh - 1]);
+                    sp += nh - 1;
+                    cur = hits[nh - 1];
+                    continue;
+                }
+            } else {
+                for p in cur.child..cur.child + cur.count {
+                    let t = shear.intersect(&tris[p as usize]);
+                    if t.is_finite() {
+                        // A finite `t` is at most `shear.tmax`, the best `t` so far.
+                        let better = match best {
+                            None => true,
+                            Some((bp, bt)) => t < bt || ids[p as usize] < ids[bp as usize],
+                        };
+                        if better {
+                            if let Some(r) = refine.get(p as usize) {
+                                prefetch(r, 2);
+                            }
+                            best = Some((p, t));
+                            shear.tmax = t;
+                            tlimit = t + rb.slack;
+                        }
+                    }
+                }
+            }
+            // Pop the next entry still in range.
+            loop {
+                if sp == 0 {
+                    return best;
+                }
+                sp -= 1;
+                if stack[sp].tn <= tlimit {
+                    cur = stack[sp];
+                    break;
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn any_with(
+        &self,
+        rb: &RayBoxes,
+        shear: &Shear,
+        tris: &[RowTriangle],
+        stack: &mut [Entry],
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let tlimit = shear.tmax;
+        let mut sp = 0usize;
+        let mut cur = Entry { child: 0, count: 0, tn: 0.0 };
+        loop {
+            if cur.count == 0 {
+                let node = &self.nodes[cur.child as usize];
+                let (_, mask) = rb.test(node, tlimit);
+                let mut m = mask;
+                if m != 0 {
+                    let first = m.trailing_zeros() as usize;
+                    node.prefetch_child(first, &self.nodes, tris);
+                    m &= m - 1;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        node.prefetch_child(i, &self.nodes, tris);
+                        stack[sp] = Entry { child: node.child[i], count: node.count[i], tn: 0.0 };
+                        sp += 1;
+                    }
+                    cur = Entry { child: node.child[first], count: node.count[first], tn: 0.0 };
+                    continue;
+                }
+            } else {
+                for p in cur.child..cur.child + cur.count {
+                    if shear.intersect(&tris[p as usize]).is_finite() {
+                        return true;
+                    }
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            cur = stack[sp];
+        }
+    }
+}
+
+/// The primitives of the binary subtree at `c` into `out` when it has at most
+/// [`LEAF_MAX`] of them or is a single leaf (`true`); otherwise `false`.
+fn gather_small(bvh2: &Bvh2, c: u32, out: &mut Vec<u32>) -> bool {
+    let n = &bvh2.nodes[c as usize];
+    if n.is_leaf() {
+        let s = n.first_index as usize;
+        out.extend_from_slice(&bvh2.primitive_indices[s..s + n.prim_count as usize]);
+        return true;
+    }
+    let mut todo = vec![c];
+    while let Some(x) = todo.pop() {
+        let n = &bvh2.nodes[x as usize];
+        if n.is_leaf() {
+            let s = n.first_index as usize;
+            out.extend_from_slice(&bvh2.primitive_indices[s..s + n.prim_count as usize]);
+            if out.len() > LEAF_MAX {
+                return false;
+            }
+        } else {
+            todo.push(n.first_index + 1);
+            todo.push(n.first_index);
+        }
+    }
+    true
+}
