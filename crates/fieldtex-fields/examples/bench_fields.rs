@@ -10,14 +10,15 @@
 //! - `field_full_solve`: design → pixel field on the factored design: every singularity
 //!   re-placed (all model fields recomputed), solve, sample 512²;
 //! - `field_move_singularity`: move one wedge, re-solve (right-hand side only), sample;
-//! - `field_add_stroke`: add one ~250 px stroke (rank-1 factor updates per changed edge,
-//!   see `FieldDesignOptions::rank1_update_limit`), solve, sample;
-//! - `field_move_stroke`: move that stroke by 2–6 px (`set_stroke`: updates for the
-//!   edges that change, downdates for those it leaves), solve, sample;
-//! - `field_remove_stroke`: remove it (downdates), solve, sample;
+//! - `field_add_stroke`: add one ~250 px stroke (~250 changed edges: one multiple-rank
+//!   factor update, see `FieldDesignOptions::rank1_update_limit`), solve, sample;
+//! - `field_move_stroke`: move that stroke by 2–6 px (`set_stroke`: an update for the
+//!   edges gaining weight, a downdate for those losing it), solve, sample;
+//! - `field_remove_stroke`: remove it (a downdate), solve, sample;
 //! - `field_add_stroke_refactor`: add with `rank1_update_limit = 0` (numeric
-//!   refactorisation with the kept symbolic analysis);
-//! - `field_add_short_stroke`: a ~18 px stroke (about 20 edges);
+//!   refactorisation with the kept symbolic analysis; the behaviour before the limit
+//!   was raised to 640 edges);
+//! - `field_add_short_stroke`: a ~18 px stroke (about 40 edges);
 //! - `field_numeric_refactor`: the numeric factorisation alone;
 //! - `field_move_singularity_solve_only` / `field_sample_512`: the move split into
 //!   re-solve and pixel sampling.
@@ -149,7 +150,7 @@ fn main() {
         d.rank1_update_count() - updates_before,
         d.refactor_count() - refactors_before
     );
-    // A short stroke (~18 px, about 20 edges): rank-1 updates instead of a refactor.
+    // A short stroke (~18 px, about 40 edges).
     let mut t_short = Vec::new();
     let updates_short = d.rank1_update_count();
     for k in 0..repeats {

@@ -47,13 +47,15 @@
 //! model 1-form is recomputed, the others are cached).
 //!
 //! Factor once: [`FieldDesign::new`] assembles `A` and analyses its pattern; the first
-//! solve factors it. Strokes change the diagonal of `A` by `Σ Δw_e e_e e_eᵀ`: small edits
-//! are rank-1 updates/downdates of the factor, larger ones a numeric refactorisation with
-//! the kept symbolic analysis ([`FieldDesign::refactor_if_needed`]; measured in
-//! `examples/bench_fields.rs` on the 128² grid: one update ~0.27 ms, one downdate
-//! ~0.4–0.8 ms, a refactorisation ~90–140 ms, a typical stroke ~240 edges — so short
-//! strokes are updated and longer edits, beyond
-//! [`FieldDesignOptions::rank1_update_limit`], are refactored).
+//! solve factors it. Strokes change the diagonal of `A` by `Σ Δw_e e_e e_eᵀ`: edits that
+//! change at most [`FieldDesignOptions::rank1_update_limit`] edges (default 640) are
+//! multiple-rank updates/downdates of the factor, larger ones a numeric refactorisation
+//! with the kept symbolic analysis ([`crate::design_factor`], with the measurements).
+//! Cost of one interactive edit on the 128² grid (49K unknowns), what a front end sees
+//! (`examples/bench_fields.rs`): moving a singularity is one solve with the kept factor
+//! (~12–20 ms on 2 cores, faer's supernodal triangular solves) plus the 512² sampling;
+//! a ~250 px stroke changes 250–500 edges, whose update costs 40–100 ms — issue 3's
+//! 20 ms for stroke edits is not reached (see the module docs of `design_factor`).
 
 use std::sync::Arc;
 
