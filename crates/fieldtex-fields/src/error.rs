@@ -48,4 +48,8 @@ pub enum FieldsError {
         "field array has {found} entries for a {width}×{height} image; expected width·height = {expected}"
     )]
     FieldSize { width: usize, height: usize, expected: usize, found: usize },
+    #[error(
+        "the curve field is current at only some vertices ({stale} stale after an incremental solve); call CurveFieldSolver::solve first"
+    )]
+    StaleSolution { stale: usize },
 }

@@ -192,8 +192,11 @@ pub struct SolveReport {
     /// Components re-solved (only those whose constraints changed).
     pub components_solved: usize,
     pub seconds: f64,
-    /// Largest relative residual `‖(L+P)x − Pb‖ / ‖Pb‖` over the right-hand sides.
+    /// Largest relative residual `‖(L+P)x − Pb‖ / ‖Pb‖` over the right-hand sides of the
+    /// full solves.
     pub max_residual: f64,
+    /// Components updated incrementally ([`CurveFieldSolver::solve_at`]; no residual).
+    pub incremental: usize,
 }
 
 struct Block {
@@ -204,6 +207,16 @@ struct Block {
     factor: Option<Cholesky>,
     dirty: bool,
     failed: bool,
+    /// `raw` on this block solves the system of the last solve (full or incremental),
+    /// at least at the vertices marked in `CurveFieldSolver::current`.
+    solved: bool,
+    /// Vertices that got their first penalty since the last solve (global indices).
+    fresh: Vec<u32>,
+    /// A change an incremental solve does not cover (first factorisation, a target
+    /// moved by `Average`): the next solve of the block is a full one.
+    needs_full: bool,
+    /// The last solve was incremental: `raw` is stale outside its `needed` vertices.
+    partial: bool,
 }
 
 /// Uniform grid over vertex positions for nearest-vertex queries.
@@ -317,6 +330,9 @@ pub struct CurveFieldSolver<'m> {
     /// Constrained vertices in the order they were added.
     constrained: Vec<u32>,
     raw: Vec<V3>,
+    /// Whether `raw[v]` is current (false outside the `needed` set of an incremental
+    /// solve, [`CurveFieldSolver::solve_at`]).
+    current: Vec<bool>,
     mean_edge: f64,
     grid: VertexGrid,
     warnings: Vec<Warning>,
@@ -392,6 +408,10 @@ impl<'m> CurveFieldSolver<'m> {
                     factor: None,
                     dirty: false,
                     failed: false,
+                    solved: false,
+                    fresh: Vec::new(),
+                    needs_full: true,
+                    partial: false,
                 })
             })
             .collect::<Result<Vec<_>, FieldsError>>()?;
@@ -407,6 +427,7 @@ impl<'m> CurveFieldSolver<'m> {
             targets: vec![None; nv],
             constrained: Vec::new(),
             raw: vec![[0.0; 3]; nv],
+            current: vec![true; nv],
             mean_edge,
             grid,
             warnings,
@@ -556,11 +577,13 @@ impl<'m> CurveFieldSolver<'m> {
                             *target = u;
                         }
                         self.blocks[c].dirty = true;
+                        self.blocks[c].needs_full = true;
                     }
                     (slot @ None, _) => {
                         *slot = Some((t, t));
                         self.constrained.push(v);
                         fresh[c].push(v);
+                        self.blocks[c].fresh.push(v);
                         report.new_vertices += 1;
                     }
                 }
@@ -583,6 +606,9 @@ impl<'m> CurveFieldSolver<'m> {
                 report.rank1_updates += verts.len();
                 continue;
             }
+            if block.factor.is_none() {
+                block.needs_full = true;
+            }
             let t0 = Instant::now();
             let result = factor_block(block, &self.targets, alpha);
             report.factor_seconds += t0.elapsed().as_secs_f64();
@@ -603,37 +629,132 @@ impl<'m> CurveFieldSolver<'m> {
     }
 
     /// Solves `(L + P) x = P b` (3 right-hand sides) on every component whose constraints
-    /// changed since the last solve.
+    /// changed since the last solve or whose last solve was incremental (full solves
+    /// with the residual check of `fieldtex_linalg`).
     pub fn solve(&mut self) -> Result<SolveReport, FieldsError> {
         let t0 = Instant::now();
         let mut report = SolveReport::default();
-        let alpha = self.options.penalty;
-        for block in self.blocks.iter_mut().filter(|b| b.dirty) {
-            block.dirty = false;
-            let Some(factor) = block.factor.as_ref() else { continue };
-            let rhs = block_rhs(&block.vertices, &self.targets, alpha);
-            let x = factor.solve_many(&rhs)?;
-            report.max_residual = report.max_residual.max(factor.last_residual());
-            for (i, &v) in block.vertices.iter().enumerate() {
-                self.raw[v as usize] = [x[0][i], x[1][i], x[2][i]];
+        for c in 0..self.blocks.len() {
+            if self.blocks[c].dirty || self.blocks[c].partial {
+                self.full_solve(c, &mut report)?;
             }
+        }
+        report.seconds = t0.elapsed().as_secs_f64();
+        Ok(report)
+    }
+
+    fn full_solve(&mut self, c: usize, report: &mut SolveReport) -> Result<(), FieldsError> {
+        let alpha = self.options.penalty;
+        let block = &mut self.blocks[c];
+        block.dirty = false;
+        let Some(factor) = block.factor.as_ref() else { return Ok(()) };
+        let rhs = block_rhs(&block.vertices, &self.targets, alpha);
+        let x = factor.solve_many(&rhs)?;
+        report.max_residual = report.max_residual.max(factor.last_residual());
+        for (i, &v) in block.vertices.iter().enumerate() {
+            self.raw[v as usize] = [x[0][i], x[1][i], x[2][i]];
+            self.current[v as usize] = true;
+        }
+        block.solved = true;
+        block.partial = false;
+        block.fresh.clear();
+        block.needs_full = false;
+        report.components_solved += 1;
+        Ok(())
+    }
+
+    /// Brings the solution up to date **at the vertices `needed` only** (an incremental
+    /// solve for the greedy orientation, which scores curves on their own vertices).
+    /// If `x` solved the system before the new penalties, the new solution is
+    /// `x' = x + (L + P')⁻¹ r` with `r = α (b_v − x_v)` on the newly constrained vertices
+    /// `v` and zero elsewhere; `fieldtex_linalg::Cholesky::solve_sparse_at` computes the
+    /// correction at `needed` from the two elimination-tree reaches alone. This needs
+    /// `x` current at the new vertices and at `needed` (all of them in the `needed` of
+    /// every incremental solve since the last full one — the greedy loop's pending
+    /// curves only shrink); otherwise, and after a first factorisation or an `Average`
+    /// target change, the component gets a full solve. Elsewhere the solution is left
+    /// stale ([`CurveFieldSolver::tangent_at`] gives `None` there) until the next
+    /// [`CurveFieldSolver::solve`]; [`CurveFieldSolver::field`] refuses stale vertices.
+    /// No residual check for the incremental part (`max_residual` covers the full solves
+    /// only); the final full solve checks it.
+    pub fn solve_at(&mut self, needed: &[u32]) -> Result<SolveReport, FieldsError> {
+        let t0 = Instant::now();
+        let mut report = SolveReport::default();
+        let alpha = self.options.penalty;
+        let mut per_block: Vec<Vec<u32>> = vec![Vec::new(); self.blocks.len()];
+        for &v in needed {
+            if let Some(&c) = self.component.get(v as usize).filter(|&&c| c != NONE) {
+                per_block[c as usize].push(v);
+            }
+        }
+        // a vertex on two pending curves must get its correction once
+        for need in &mut per_block {
+            need.sort_unstable();
+            need.dedup();
+        }
+        for (c, need) in per_block.iter().enumerate() {
+            let need_current = need.iter().all(|&v| self.current[v as usize]);
+            if !self.blocks[c].dirty && need_current {
+                continue;
+            }
+            let block = &self.blocks[c];
+            let incremental = block.factor.is_some()
+                && block.solved
+                && !block.needs_full
+                && need_current
+                && block.fresh.iter().all(|&v| self.current[v as usize]);
+            if !incremental {
+                self.full_solve(c, &mut report)?;
+                continue;
+            }
+            let residuals: Vec<(usize, [f64; 3])> = block
+                .fresh
+                .iter()
+                .filter_map(|&v| {
+                    let (t, _) = self.targets[v as usize]?;
+                    let x = self.raw[v as usize];
+                    let r = [0, 1, 2].map(|k| alpha * (t[k] - x[k]));
+                    Some((self.local[v as usize] as usize, r))
+                })
+                .collect();
+            let rhs: Vec<(usize, &[f64])> = residuals.iter().map(|(i, r)| (*i, &r[..])).collect();
+            let local: Vec<usize> = need.iter().map(|&v| self.local[v as usize] as usize).collect();
+            let block = &mut self.blocks[c];
+            let factor = block.factor.as_mut().expect("checked above");
+            let z = factor.solve_sparse_at(&rhs, &local, 3)?;
+            for &v in &block.vertices {
+                self.current[v as usize] = false;
+            }
+            for (q, &v) in need.iter().enumerate() {
+                let x = &mut self.raw[v as usize];
+                for k in 0..3 {
+                    x[k] += z[q * 3 + k];
+                }
+                self.current[v as usize] = true;
+            }
+            block.fresh.clear();
+            block.dirty = false;
+            block.partial = true;
             report.components_solved += 1;
+            report.incremental += 1;
         }
         report.seconds = t0.elapsed().as_secs_f64();
         Ok(report)
     }
 
     /// The last ambient solution `x` (`#V × 3`, before projection; 0 outside solved
-    /// components).
+    /// components; stale outside the `needed` set of an incremental
+    /// [`CurveFieldSolver::solve_at`] until the next full [`CurveFieldSolver::solve`]).
     pub fn raw_solution(&self) -> &[V3] {
         &self.raw
     }
 
     /// The unit tangent field at `v` from the last solve, `None` where it is not defined
-    /// (component without factor, isolated or degenerate vertex).
+    /// (component without factor, isolated or degenerate vertex, or left stale by an
+    /// incremental [`CurveFieldSolver::solve_at`]).
     pub fn tangent_at(&self, v: usize) -> Option<V3> {
         let c = self.component[v];
-        if c == NONE || self.blocks[c as usize].factor.is_none() {
+        if c == NONE || self.blocks[c as usize].factor.is_none() || !self.current[v] {
             return None;
         }
         project_unit(self.raw[v], self.normals[v])
@@ -665,6 +786,16 @@ impl<'m> CurveFieldSolver<'m> {
     /// components without constraints (module docs) and warnings about both.
     pub fn field(&self) -> Result<CurveField, FieldsError> {
         let nv = self.raw.len();
+        let stale = self
+            .blocks
+            .iter()
+            .filter(|b| b.factor.is_some())
+            .flat_map(|b| &b.vertices)
+            .filter(|&&v| !self.current[v as usize])
+            .count();
+        if stale > 0 {
+            return Err(FieldsError::StaleSolution { stale });
+        }
         let mut vectors = vec![[0.0; 3]; nv];
         let mut status = vec![VertexFieldStatus::Isolated; nv];
         let mut warnings = self.warnings.clone();

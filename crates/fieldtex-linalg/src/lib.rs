@@ -33,6 +33,7 @@ mod dense;
 mod least_squares;
 mod multi_rhs_solve;
 mod multiple_rank_update;
+mod partial_solve;
 mod sparse_matrix;
 mod supernodal_solve;
 
