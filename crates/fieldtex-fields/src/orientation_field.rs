@@ -189,7 +189,7 @@ pub fn sample_plane_into(
             .collect()
     };
     let (cols, rows) = (axis(width, nx), axis(height, ny));
-    out.clear();
+    // every pixel is written below: no clearing of a kept buffer of the right size
     out.resize(width * height, [0.0; 2]);
     // Rows in fixed groups (disjoint outputs), enough work per task to hide rayon's cost.
     let group = (1 << 14) / width.max(1) + 1;
