@@ -77,6 +77,14 @@ pub(crate) struct DynamicFactor {
     pub(crate) backup: Vec<f64>,
     /// Compact slot of each column on a multiple-rank path (`crate::multiple_rank_update`).
     pub(crate) slot: Vec<u32>,
+    /// Off-diagonal rows of each column as runs of consecutive row indices
+    /// `(offset past the diagonal, first row, length)`; column `j`'s runs are
+    /// `runs[run_ptr[j].0 ..][.. run_ptr[j].1]`. Every row of a column is an ancestor of
+    /// it, so on any union of elimination-tree paths that holds the column, a run's rows
+    /// have consecutive positions (the update and the partial solve use this to loop over
+    /// contiguous memory).
+    pub(crate) runs: Vec<(u32, u32, u32)>,
+    pub(crate) run_ptr: Vec<(u32, u32)>,
     /// First column of each of faer's supernodes, then `n` (empty for a simplicial
     /// factor); used by `crate::supernodal_solve` while [`DynamicFactor::faer_layout`]
     /// holds.
@@ -171,9 +179,12 @@ impl DynamicFactor {
             }
         }
         let mut parent = vec![NONE; n];
+        let mut runs = Vec::new();
+        let mut run_ptr = Vec::with_capacity(n);
         for j in 0..n {
             let col = &rows[start[j] + 1..start[j] + len[j]];
             parent[j] = col.iter().map(|&r| r as usize).min().unwrap_or(NONE);
+            run_ptr.push(push_runs(col, &mut runs));
         }
         Self {
             faer_layout,
@@ -191,6 +202,8 @@ impl DynamicFactor {
             path: Vec::new(),
             backup: Vec::new(),
             slot: Vec::new(),
+            runs,
+            run_ptr,
             supernodes,
         }
     }
@@ -292,6 +305,8 @@ impl DynamicFactor {
             self.vals[at + t] = 0.0;
         }
         self.len[j] = need;
+        let s = self.start[j];
+        self.run_ptr[j] = push_runs(&self.rows[s + 1..s + need], &mut self.runs);
     }
 
     /// Symbolic phase: walks the path of the modified elimination tree from `f`,
@@ -577,6 +592,20 @@ impl Cholesky {
     pub fn updated_factor_nnz(&self) -> Option<usize> {
         self.dynamic.as_ref().map(DynamicFactor::nnz)
     }
+}
+
+/// Appends the runs of consecutive row indices of `rows` to `runs` (see
+/// [`DynamicFactor::runs`]) and returns `(first run, count)`.
+fn push_runs(rows: &[u32], runs: &mut Vec<(u32, u32, u32)>) -> (u32, u32) {
+    let first = runs.len();
+    for (q, &r) in rows.iter().enumerate() {
+        let own = runs.len() > first;
+        match runs.last_mut() {
+            Some((q0, r0, m)) if own && *r0 + *m == r && *q0 + *m == q as u32 => *m += 1,
+            _ => runs.push((q as u32, r, 1)),
+        }
+    }
+    (first as u32, (runs.len() - first) as u32)
 }
 
 pub(crate) fn check_alpha(alpha: f64) -> Result<(), LinalgError> {

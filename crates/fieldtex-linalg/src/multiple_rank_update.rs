@@ -137,16 +137,14 @@ impl DynamicFactor {
             if steps.is_empty() {
                 continue;
             }
-            // the column's rows as runs of consecutive slots `(first row, first slot, len)`
-            // (the dense block of a supernode is one run; its pattern a few)
+            // the column's rows as runs of consecutive slots (module docs)
             runs.clear();
-            for (q, &i) in self.rows[s + 1..s + l].iter().enumerate() {
-                let o = self.slot[i as usize];
-                match runs.last_mut() {
-                    Some((q0, o0, m)) if *o0 + *m == o && *q0 + *m as usize == q => *m += 1,
-                    _ => runs.push((q, o, 1)),
-                }
-            }
+            let (r0, rn) = self.run_ptr[j];
+            runs.extend(
+                self.runs[r0 as usize..(r0 + rn) as usize]
+                    .iter()
+                    .map(|&(q, r, m)| (q as usize, self.slot[r as usize], m)),
+            );
             let vals = &mut self.vals[s + 1..s + l];
             apply_steps(&steps, &runs, vals, &mut work, u, up, avx2);
         }

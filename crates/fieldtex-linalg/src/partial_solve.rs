@@ -44,12 +44,36 @@ impl DynamicFactor {
 
     /// Module docs; `rhs` as `(permuted row, k values)`, result row-major
     /// `needed.len() × k` for permuted `needed`.
-    fn partial_solve<const W: usize>(
+    fn partial_solve(&self, rhs: &[(usize, [f64; 4])], needed: &[usize], k: usize) -> Vec<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked above).
+            return unsafe { self.partial_solve_avx2(rhs, needed, k) };
+        }
+        self.partial_solve_impl(rhs, needed, k)
+    }
+
+    /// [`DynamicFactor::partial_solve_impl`] compiled for AVX2 (same IEEE operations, no
+    /// FMA contraction: bit-identical to the baseline build).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn partial_solve_avx2(
         &self,
-        rhs: &[(usize, [f64; W])],
+        rhs: &[(usize, [f64; 4])],
         needed: &[usize],
         k: usize,
     ) -> Vec<f64> {
+        self.partial_solve_impl(rhs, needed, k)
+    }
+
+    #[inline(always)]
+    fn partial_solve_impl(
+        &self,
+        rhs: &[(usize, [f64; 4])],
+        needed: &[usize],
+        k: usize,
+    ) -> Vec<f64> {
+        const W: usize = 4;
         let n = self.n();
         let mut slot_f = vec![u32::MAX; n];
         let forward = self.reach(rhs.iter().map(|&(i, _)| i), &mut slot_f);
@@ -61,17 +85,22 @@ impl DynamicFactor {
             }
         }
         for (s, &j) in forward.iter().enumerate() {
-            let (st, l) = (self.start[j], self.len[j]);
+            let st = self.start[j];
             let mut yj = y[s];
             let d = self.vals[st];
             for v in yj.iter_mut() {
                 *v /= d;
             }
             y[s] = yj;
-            for (&r, &lv) in self.rows[st + 1..st + l].iter().zip(&self.vals[st + 1..st + l]) {
-                let t = &mut y[slot_f[r as usize] as usize];
-                for w in 0..W {
-                    t[w] -= lv * yj[w];
+            let vals = &self.vals[st + 1..];
+            let (r0, rn) = self.run_ptr[j];
+            for &(q, r, m) in &self.runs[r0 as usize..(r0 + rn) as usize] {
+                let (q, m) = (q as usize, m as usize);
+                let base = slot_f[r as usize] as usize;
+                for (t, &lv) in y[base..base + m].iter_mut().zip(&vals[q..q + m]) {
+                    for w in 0..W {
+                        t[w] -= lv * yj[w];
+                    }
                 }
             }
         }
@@ -79,15 +108,26 @@ impl DynamicFactor {
         let backward = self.reach(needed.iter().copied(), &mut slot_b);
         let mut z = vec![[0.0f64; W]; backward.len()];
         for (s, &j) in backward.iter().enumerate().rev() {
-            let (st, l) = (self.start[j], self.len[j]);
+            let st = self.start[j];
+            let vals = &self.vals[st + 1..];
             let mut part = [[0.0f64; W]; 2];
-            let rows = &self.rows[st + 1..st + l];
-            let vals = &self.vals[st + 1..st + l];
-            for (q, (&r, &lv)) in rows.iter().zip(vals).enumerate() {
-                let zr = &z[slot_b[r as usize] as usize];
-                let p = &mut part[q & 1];
-                for w in 0..W {
-                    p[w] += lv * zr[w];
+            let (r0, rn) = self.run_ptr[j];
+            for &(q, r, m) in &self.runs[r0 as usize..(r0 + rn) as usize] {
+                let (q, m) = (q as usize, m as usize);
+                let base = slot_b[r as usize] as usize;
+                let (zs, ls) = (&z[base..base + m], &vals[q..q + m]);
+                let pairs = m / 2 * 2;
+                for (zp, lp) in zs[..pairs].chunks_exact(2).zip(ls[..pairs].chunks_exact(2)) {
+                    for t in 0..2 {
+                        for w in 0..W {
+                            part[t][w] += lp[t] * zp[t][w];
+                        }
+                    }
+                }
+                if pairs < m {
+                    for w in 0..W {
+                        part[0][w] += ls[pairs] * zs[pairs][w];
+                    }
                 }
             }
             let mut acc = if slot_f[j] == u32::MAX { [0.0; W] } else { y[slot_f[j] as usize] };
@@ -155,7 +195,7 @@ impl Cholesky {
             })
             .collect();
         let needed_p: Vec<usize> = needed.iter().map(|&i| d.inv[i]).collect();
-        let out = d.partial_solve::<4>(&rows, &needed_p, k);
+        let out = d.partial_solve(&rows, &needed_p, k);
         if out.iter().any(|v| !v.is_finite()) {
             return Err(LinalgError::SolveFailed {
                 size: n,
