@@ -146,7 +146,35 @@ impl DynamicFactor {
                     .map(|&(q, r, m)| (q as usize, self.slot[r as usize], m)),
             );
             let vals = &mut self.vals[s + 1..s + l];
-            apply_steps(&steps, &runs, vals, &mut work, u, up, avx2);
+            let total = (l - 1) * steps.len();
+            let split = if total >= PARALLEL_WORK && rayon::current_num_threads() > 1 {
+                split_point(&runs)
+            } else {
+                None
+            };
+            match split {
+                None => apply_steps(&steps, &runs, vals, &mut work, u, up, avx2),
+                Some((p, q_p, o_p)) => {
+                    // two halves with disjoint rows (values) and slots (work entries):
+                    // every entry sees the same operations, so the result is the same
+                    let (v_lo, v_hi) = vals.split_at_mut(q_p);
+                    let mut lo: Vec<&mut [f64]> = Vec::with_capacity(k);
+                    let mut hi: Vec<&mut [f64]> = Vec::with_capacity(k);
+                    for w in work.chunks_mut(u) {
+                        let (a, b) = w.split_at_mut(o_p);
+                        lo.push(a);
+                        hi.push(b);
+                    }
+                    let runs_hi: Vec<(usize, u32, u32)> =
+                        runs[p..].iter().map(|&(q, o, m)| (q - q_p, o - o_p as u32, m)).collect();
+                    let steps = &steps;
+                    let runs_lo = &runs[..p];
+                    rayon::join(
+                        || apply_steps_split(steps, runs_lo, v_lo, &mut lo, up, avx2),
+                        || apply_steps_split(steps, &runs_hi, v_hi, &mut hi, up, avx2),
+                    );
+                }
+            }
         }
         for &j in &union {
             self.slot[j] = NO_SLOT;
@@ -172,6 +200,99 @@ impl DynamicFactor {
             return Err((j, reason));
         }
         Ok(())
+    }
+}
+
+/// Work (rows × modifications) of one column above which its rows are split in two
+/// halves that run in parallel.
+const PARALLEL_WORK: usize = 1 << 15;
+
+/// Where to split a column's runs into two halves of about equal rows, as
+/// `(first run of the upper half, its row offset, its slot)`: only if the runs increase in
+/// both row offset and slot (always, unless fill appended rows out of order) and both
+/// halves are non-empty.
+fn split_point(runs: &[(usize, u32, u32)]) -> Option<(usize, usize, usize)> {
+    let monotone = runs.windows(2).all(|p| p[0].0 < p[1].0 && p[0].1 + p[0].2 <= p[1].1);
+    if !monotone || runs.len() < 2 {
+        return None;
+    }
+    let total: usize = runs.iter().map(|r| r.2 as usize).sum();
+    let mut acc = 0;
+    for (p, r) in runs.iter().enumerate() {
+        if p > 0 && 2 * acc >= total {
+            return Some((p, r.0, r.1 as usize));
+        }
+        acc += r.2 as usize;
+    }
+    let p = runs.len() - 1;
+    Some((p, runs[p].0, runs[p].1 as usize))
+}
+
+/// [`apply_steps`] for one half of a split column: `work[t]` is modification `t`'s work
+/// vector restricted to the half's slots.
+fn apply_steps_split(
+    steps: &[(usize, f64, f64, f64)],
+    runs: &[(usize, u32, u32)],
+    vals: &mut [f64],
+    work: &mut [&mut [f64]],
+    up: bool,
+    avx2: bool,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: the caller checked that the CPU supports AVX2.
+        unsafe { apply_steps_split_avx2(steps, runs, vals, work, up) };
+        return;
+    }
+    let _ = avx2;
+    for &(t, a, dl, g) in steps {
+        sweep(&mut work[t][..], runs, vals, a, dl, g, up);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn apply_steps_split_avx2(
+    steps: &[(usize, f64, f64, f64)],
+    runs: &[(usize, u32, u32)],
+    vals: &mut [f64],
+    work: &mut [&mut [f64]],
+    up: bool,
+) {
+    for &(t, a, dl, g) in steps {
+        sweep(&mut work[t][..], runs, vals, a, dl, g, up);
+    }
+}
+
+/// One modification `(α, δ, γ)` over the rows `runs` of a column: the recurrence of
+/// Davis & Hager's method C1 on each row.
+#[inline(always)]
+fn sweep(
+    w: &mut [f64],
+    runs: &[(usize, u32, u32)],
+    vals: &mut [f64],
+    a: f64,
+    dl: f64,
+    g: f64,
+    up: bool,
+) {
+    for &(q0, o0, m) in runs {
+        let (o0, m) = (o0 as usize, m as usize);
+        let ws = &mut w[o0..o0 + m];
+        let vs = &mut vals[q0..q0 + m];
+        if up {
+            for (wv, v) in ws.iter_mut().zip(vs.iter_mut()) {
+                let w1 = *wv;
+                *wv = w1 - a * *v;
+                *v = dl * *v + g * w1;
+            }
+        } else {
+            for (wv, v) in ws.iter_mut().zip(vs.iter_mut()) {
+                let w2 = *wv - a * *v;
+                *wv = w2;
+                *v = dl * *v + g * w2;
+            }
+        }
     }
 }
 
@@ -226,25 +347,7 @@ fn apply_steps_impl(
     up: bool,
 ) {
     for &(t, a, dl, g) in steps {
-        let w = &mut work[t * u..(t + 1) * u];
-        for &(q0, o0, m) in runs {
-            let (o0, m) = (o0 as usize, m as usize);
-            let ws = &mut w[o0..o0 + m];
-            let vs = &mut vals[q0..q0 + m];
-            if up {
-                for (wv, v) in ws.iter_mut().zip(vs.iter_mut()) {
-                    let w1 = *wv;
-                    *wv = w1 - a * *v;
-                    *v = dl * *v + g * w1;
-                }
-            } else {
-                for (wv, v) in ws.iter_mut().zip(vs.iter_mut()) {
-                    let w2 = *wv - a * *v;
-                    *wv = w2;
-                    *v = dl * *v + g * w2;
-                }
-            }
-        }
+        sweep(&mut work[t * u..(t + 1) * u], runs, vals, a, dl, g, up);
     }
 }
 
