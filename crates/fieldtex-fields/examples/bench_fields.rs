@@ -2,8 +2,9 @@
 //!
 //! `cargo run --release -p fieldtex-fields --example bench_fields [-- REPEATS]`
 //!
-//! Every interactive timing is what a front end sees: the edit, the re-solve and the
-//! 512² pixel sample into a kept buffer (`sample_plane_into`). Prints medians as
+//! Every interactive timing is what a front end sees, called from the main thread (not
+//! a rayon worker): the edit, then `FieldDesign::solve_and_sample_into` — the re-solve
+//! and the 512² pixel sample into a kept buffer as one job in the rayon pool. Prints medians as
 //! `BENCH <name> median_ms=<value>` lines:
 //! - `field_factor`: from nothing to a factored design: DEC operators, assembly, symbolic
 //!   analysis, the preset's strokes, numeric factorisation (once per domain);
@@ -76,8 +77,7 @@ fn main() {
         for (id, s) in ids.iter().zip(&singularities) {
             d.set_singularity(*id, *s).unwrap();
         }
-        let f = d.solve().unwrap();
-        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
         t_full.push(ms(t));
         assert_eq!(buf.len(), size * size);
     }
@@ -92,8 +92,7 @@ fn main() {
         ];
         let t = Instant::now();
         d.move_singularity(ids[0], p).unwrap();
-        let f = d.solve().unwrap();
-        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
         t_move.push(ms(t));
         assert_eq!(buf.len(), size * size);
     }
@@ -123,8 +122,7 @@ fn main() {
     for k in 0..repeats {
         let t = Instant::now();
         let sid = d.add_stroke(stroke_at(k)).unwrap();
-        let f = d.solve().unwrap();
-        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
         t_stroke.push(ms(t));
         // Drag it by a few pixels (a front end re-solves on every mouse event).
         let dy = 2.0 + (k % 3) as f64 * 2.0;
@@ -135,13 +133,11 @@ fn main() {
         ]);
         let t = Instant::now();
         d.set_stroke(sid, moved).unwrap();
-        let f = d.solve().unwrap();
-        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
         t_move_stroke.push(ms(t));
         let t = Instant::now();
         d.remove_stroke(sid).unwrap();
-        let f = d.solve().unwrap();
-        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
         t_remove_stroke.push(ms(t));
         assert_eq!(buf.len(), size * size);
     }
@@ -157,8 +153,7 @@ fn main() {
         let y = 150.0 + 10.0 * k as f64;
         let t = Instant::now();
         let sid = d.add_stroke(Stroke::from_pixels(&[[60.0, y], [78.0, y - 3.0]])).unwrap();
-        let f = d.solve().unwrap();
-        sample_plane_into(&d, &f, size, size, &mut buf).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
         t_short.push(ms(t));
         assert_eq!(buf.len(), size * size);
         d.remove_stroke(sid).unwrap();
@@ -188,8 +183,7 @@ fn main() {
     for k in 0..repeats {
         let t = Instant::now();
         let sid = refactoring.add_stroke(stroke_at(k)).unwrap();
-        let f = refactoring.solve().unwrap();
-        sample_plane_into(&refactoring, &f, size, size, &mut buf).unwrap();
+        refactoring.solve_and_sample_into(size, size, &mut buf).unwrap();
         t_stroke_refactor.push(ms(t));
         assert_eq!(buf.len(), size * size);
         refactoring.remove_stroke(sid).unwrap();

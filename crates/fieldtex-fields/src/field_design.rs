@@ -491,7 +491,8 @@ impl FieldDesign {
             self.stroke_diag = Some(self.stroke_diagonal());
         }
         let diag = self.stroke_diag.as_deref().expect("just made");
-        self.factor.sync(&self.equations.matrix, diag, self.options.rank1_update_limit)
+        let (factor, matrix) = (&mut self.factor, &self.equations.matrix);
+        in_pool(|| factor.sync(matrix, diag, self.options.rank1_update_limit))
     }
 
     /// Refactors numerically now (e.g. when a front end is idle after many stroke edits,
@@ -582,7 +583,29 @@ impl FieldDesign {
     /// edges only: no sparse products, and no solve at all without strokes (`δ = 0`).
     /// `residual` is then the relative residual of the deviation system. With point
     /// poles the full `b` of [`FieldDesign::right_hand_side`] is solved.
+    ///
+    /// The whole solve runs as one job in the rayon pool ([`in_pool`]).
     pub fn solve(&mut self) -> Result<SolvedField, FieldsError> {
+        in_pool(|| self.solve_in_pool())
+    }
+
+    /// [`FieldDesign::solve`], then the field sampled on a `width × height` pixel grid
+    /// into `pixels` ([`crate::orientation_field::sample_plane_into`]), in one job in the
+    /// rayon pool: one interactive frame (plane designs only).
+    pub fn solve_and_sample_into(
+        &mut self,
+        width: usize,
+        height: usize,
+        pixels: &mut Vec<[f32; 2]>,
+    ) -> Result<SolvedField, FieldsError> {
+        in_pool(|| {
+            let field = self.solve_in_pool()?;
+            crate::orientation_field::sample_plane_into(self, &field, width, height, pixels)?;
+            Ok(field)
+        })
+    }
+
+    fn solve_in_pool(&mut self) -> Result<SolvedField, FieldsError> {
         self.refactor_if_needed()?;
         let (model, s_point, c_point, any_point) = self.singular_terms();
         let factor = self.factor.factor().expect("refactor_if_needed made the factor");
@@ -619,6 +642,15 @@ impl FieldDesign {
         let face_vectors = self.dec.face_vectors(&one_form);
         Ok(SolvedField { symmetry: self.symmetry, one_form, face_vectors, residual })
     }
+}
+
+/// Runs `op` as one job in the current rayon pool (inline when already on one of its
+/// threads). Called from a thread outside the pool — a front end's UI thread — every
+/// parallel loop would otherwise be handed over separately and wait for the sleeping
+/// workers to be scheduled: on 2 loaded cores that measured ~1.5 ms per loop, 7.8 ms
+/// instead of 2.5 ms for a 512² sampling (3 loops). Results do not change.
+pub(crate) fn in_pool<R: Send>(op: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| op())
 }
 
 /// Kinds valid for a symmetry (for UIs and the design file).

@@ -157,8 +157,19 @@ pub fn sample_plane(
 ///
 /// Point location is separable on the regular grid: each column's cell and `u`, and
 /// each row's cell and `v`, are computed once; rows are sampled in parallel (disjoint
-/// outputs, so the result does not depend on the thread count).
+/// outputs, so the result does not depend on the thread count), as one job in the rayon
+/// pool (see [`FieldDesign::solve_and_sample_into`] for a whole frame).
 pub fn sample_plane_into(
+    design: &FieldDesign,
+    field: &SolvedField,
+    width: usize,
+    height: usize,
+    out: &mut Vec<[f32; 2]>,
+) -> Result<(), FieldsError> {
+    crate::field_design::in_pool(|| sample_in_pool(design, field, width, height, out))
+}
+
+fn sample_in_pool(
     design: &FieldDesign,
     field: &SolvedField,
     width: usize,

@@ -177,3 +177,24 @@ fn edits_and_sampling_are_identical_for_one_and_two_threads() {
     assert_eq!(bits(&one), bits(&two));
     assert!(one.iter().all(|p| ((p[0] * p[0] + p[1] * p[1]) - 1.0).abs() < 1e-5));
 }
+
+#[test]
+fn solve_and_sample_is_one_frame_of_solve_then_sample() {
+    let mut d = preset("right-loop", 160.0, 120.0, 40).unwrap().build(None).unwrap();
+    let mut frame = Vec::new();
+    let f = d.solve_and_sample_into(123, 91, &mut frame).unwrap();
+    let g = d.solve().unwrap();
+    assert_eq!(f, g);
+    assert_eq!(frame, sample_plane(&d, &g, 123, 91).unwrap());
+    assert!(d.solve_and_sample_into(0, 91, &mut frame).is_err());
+    // Mesh designs have no pixel grid: the solve works, the sampling is an error.
+    let mut m = FieldDesign::new(
+        Domain::Mesh(disk_mesh(1.0, 6)),
+        Symmetry::Vector,
+        FieldDesignOptions::default(),
+    )
+    .unwrap();
+    m.add_singularity(Singularity::new(SingularityKind::Source, [0.1, 0.0, 0.0])).unwrap();
+    assert!(m.solve().is_ok());
+    assert!(m.solve_and_sample_into(16, 16, &mut frame).is_err());
+}
