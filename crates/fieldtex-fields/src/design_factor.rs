@@ -11,11 +11,17 @@
 //! the result of an edit sequence does not depend on the machine.
 //!
 //! Measured on the 128² grid of the interactive benchmark (49K unknowns, 2.3M factor
-//! entries, 2 loaded cores, `examples/bench_fields.rs`): a multiple-rank update costs
-//! ~0.15–0.25 ms per changed edge, a downdate about the same, a numeric refactorisation
-//! 90–150 ms; a ~250 px stroke changes ~250–500 edges. Hence the default
+//! entries, 2 cores under a load average of ~2.7, `examples/bench_fields.rs`): a
+//! multiple-rank update or downdate costs ~0.15–0.25 ms per changed edge, a numeric
+//! refactorisation 80–150 ms; a ~250 px stroke changes ~250 edges when added or removed
+//! and ~300–500 when dragged by a few pixels. Hence the default
 //! [`crate::FieldDesignOptions::rank1_update_limit`] of 640 changed edges: additions,
-//! removals and drags of such strokes are updated, wholesale changes refactored.
+//! removals and drags of such strokes are updated (add/remove + solve + 512² sampling
+//! 55–90 ms, drag 75–125 ms, against 100–160 ms with a refactorisation), wholesale
+//! changes refactored. Issue 3's 20 ms is out of reach for long strokes either way: the
+//! update of `k` edges costs `k` sweeps over the factor columns on the edges'
+//! elimination-tree paths, which for a 2-D grid always include the top separators
+//! (dense blocks of a few hundred rows), ~0.2 ms per edge here.
 //!
 //! Not implemented: a Woodbury (capacitance-matrix) correction of the solve instead of a
 //! factor modification: it needs `A⁻¹` at the stroke's ~250–500 edges, i.e. as many

@@ -51,11 +51,13 @@
 //! change at most [`FieldDesignOptions::rank1_update_limit`] edges (default 640) are
 //! multiple-rank updates/downdates of the factor, larger ones a numeric refactorisation
 //! with the kept symbolic analysis ([`crate::design_factor`], with the measurements).
-//! Cost of one interactive edit on the 128² grid (49K unknowns), what a front end sees
-//! (`examples/bench_fields.rs`): moving a singularity is one solve with the kept factor
-//! (~12–20 ms on 2 cores, faer's supernodal triangular solves) plus the 512² sampling;
-//! a ~250 px stroke changes 250–500 edges, whose update costs 40–100 ms — issue 3's
-//! 20 ms for stroke edits is not reached (see the module docs of `design_factor`).
+//! Cost of one interactive frame on the 128² grid (49K unknowns) as a front end sees it
+//! (edit, then [`FieldDesign::solve_and_sample_into`] at 512², from a thread outside the
+//! rayon pool; `examples/bench_fields.rs`, 2 cores under a load average of ~2.7):
+//! moving a singularity ~17 ms (one solve with the kept factor, ~13–15 ms of it faer's
+//! supernodal triangular solves, plus ~2.5 ms sampling); a ~250 px stroke changes
+//! ~250–500 edges, whose update costs 40–100 ms — issue 3's 20 ms for stroke edits is
+//! not reached (see [`crate::design_factor`]).
 
 use std::sync::Arc;
 
@@ -584,7 +586,9 @@ impl FieldDesign {
     /// `residual` is then the relative residual of the deviation system. With point
     /// poles the full `b` of [`FieldDesign::right_hand_side`] is solved.
     ///
-    /// The whole solve runs as one job in the rayon pool ([`in_pool`]).
+    /// The whole solve runs as one job in the rayon pool: called from a thread outside
+    /// the pool (a front end's UI thread), that is one hand-over instead of one per
+    /// parallel loop, each of which waits for a sleeping worker to be scheduled.
     pub fn solve(&mut self) -> Result<SolvedField, FieldsError> {
         in_pool(|| self.solve_in_pool())
     }

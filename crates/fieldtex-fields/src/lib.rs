@@ -11,7 +11,8 @@
 //!   Dirichlet energy (paper D §2.2).
 //! - [`singular_model_field`]: exact 1-forms of poles and saddles.
 //! - [`stroke_constraints`]: polylines → weighted edge constraints.
-//! - [`field_design`]: [`FieldDesign`], the editable design with a kept factorisation;
+//! - [`field_design`]: [`FieldDesign`], the editable design with a kept factorisation
+//!   ([`design_factor`]: stroke edits by multiple-rank updates);
 //!   [`normal_equations`]: its matrix and right-hand side; [`reference_frames`]: frames
 //!   on curved patches.
 //! - [`orientation_field`]: doubled angles, complex roots, sampling to pixels.
@@ -51,7 +52,7 @@
 
 pub mod dec;
 pub mod design_elements;
-mod design_factor;
+pub mod design_factor;
 pub mod design_file;
 pub mod domain;
 pub mod error;
