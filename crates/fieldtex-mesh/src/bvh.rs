@@ -3,7 +3,7 @@
 //!
 //! Built with obvhs 0.4: a PLOC binary BVH (Meister & Bittner 2018, "Parallel
 //! Locally-Ordered Clustering for Bounding Volume Hierarchy Construction") refined by
-//! parallel reinsertion, then collapsed into an own 4-wide BVH (module `bvh_wide`) whose
+//! parallel reinsertion, then collapsed into an own 8-wide BVH (module `bvh_wide`) whose
 //! SIMD traversal casts the rays. The binary BVH is kept for closest-point queries, which
 //! obvhs does not offer: an own best-first descent with `f64` point–triangle distances
 //! (Ericson 2005, "Real-Time Collision Detection", §5.1.5).
@@ -33,7 +33,7 @@
 
 use crate::{MeshError, TriMesh};
 use bvh_watertight::{RowTriangle, Shear};
-use bvh_wide::{RayBoxes, WideBvh};
+use bvh_wide::{RayBoxes, WideBvh, huge_copy};
 use fieldtex_core::vec3::{self, V3};
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
@@ -168,8 +168,9 @@ impl Bvh {
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
             let (wide, order) = WideBvh::build(&bvh2);
-            let prim_tris: Vec<RowTriangle> =
-                order.iter().map(|&i| RowTriangle::new(&tris[i as usize])).collect();
+            let prim_tris: Vec<RowTriangle> = huge_copy(
+                &order.iter().map(|&i| RowTriangle::new(&tris[i as usize])).collect::<Vec<_>>(),
+            );
             let prim_ids: Vec<u32> = order.iter().map(|&i| keep[i as usize]).collect();
             let mut slot = vec![0u32; tris.len()];
             for (k, &i) in order.iter().enumerate() {
@@ -179,7 +180,8 @@ impl Bvh {
                 bvh2.primitive_indices.iter().map(|&i| slot[i as usize]).collect();
             (wide, bvh2.nodes, prim_ids2, prim_tris, prim_ids)
         };
-        let corners: Vec<[V3; 3]> = prim_ids.iter().map(|&f| corners[f as usize]).collect();
+        let corners: Vec<[V3; 3]> =
+            huge_copy(&prim_ids.iter().map(|&f| corners[f as usize]).collect::<Vec<_>>());
         let scene_half = mesh
             .bounding_box()
             .map_or(1.0, |b| (0..3).map(|k| 0.5 * (b.max[k] - b.min[k])).fold(0.0, f64::max))

@@ -1,12 +1,12 @@
-//! 4-wide BVH for ray casting: a binary BVH collapsed into nodes of up to four children
-//! whose boxes are stored by coordinate (one SIMD register per bound), tested against a
-//! ray all four at once (the layout of Wald, Benthin & Boulos 2008, "Getting Rid of
+//! 8-wide BVH for ray casting: a binary BVH collapsed into nodes of up to eight children
+//! whose boxes are stored by coordinate (two 4-lane SIMD registers per bound), tested
+//! against a ray four at a time (the layout of Wald, Benthin & Boulos 2008, "Getting Rid of
 //! Packets: Efficient SIMD Single-Ray Traversal using Multi-branching BVHs", and of
 //! Dammertz, Hanika & Keller 2008, "Shallow Bounding Volume Hierarchies for Fast SIMD Ray
 //! Tracing of Incoherent Rays").
 //!
 //! Collapse: starting from a binary node's two children, the child with the largest box
-//! is repeatedly replaced by its own two children until four slots are used; a subtree
+//! is repeatedly replaced by its own two children until eight slots are used; a subtree
 //! with at most [`LEAF_MAX`] triangles becomes a leaf. Nodes are stored depth first
 //! (a node's first inner child directly follows it) and leaf triangles in traversal
 //! order, so the triangle rows of a leaf are contiguous.
@@ -16,36 +16,42 @@
 //! (Ize 2013, "Robust BVH Ray Traversal", JCGT 2(2)), a zero direction component is
 //! replaced by a tiny one of the same sign while the stored boxes are one ulp wider than
 //! their contents (a ray lying in a box face stays inside), and the pruning distance
-//! carries a slack of
-//! a few hundred ulps of the scene size, so a triangle tying the best hit is still
-//! visited. Results therefore do not depend on the tree layout.
+//! carries a slack of a few hundred ulps of the scene size, so a triangle tying the best
+//! hit is still visited. Results therefore do not depend on the tree layout.
+//!
+//! Memory: the children of every entered node (nodes or leaf triangles) are prefetched
+//! as soon as the node is tested, and the large arrays are asked to live on huge pages
+//! ([`huge_copy`]). Not implemented: compressed (quantised) boxes, AVX 8-lane tests,
+//! packet or stream traversal.
 
 use super::bvh_watertight::{RowTriangle, Shear};
 use glam::{Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
+/// Children per node (a multiple of 4: boxes are tested 4 at a time).
+const W: usize = 8;
 /// Largest number of triangles in a leaf.
 pub(super) const LEAF_MAX: usize = 3;
 /// Entries of the fixed traversal stack; deeper trees use a heap stack.
 const FIXED_STACK: usize = 96;
 
-/// A node: boxes of four children by bound (`b[0..6]` = min x, max x, min y, max y,
+/// A node: boxes of [`W`] children by bound (`b[0..6]` = min x, max x, min y, max y,
 /// min z, max z) and the children. `count[i] == 0`: `child[i]` is a node index;
 /// otherwise child `i` is a leaf of `count[i]` triangles starting at `child[i]`. Empty
 /// slots have inverted (+∞, −∞) boxes, which no ray hits.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(super) struct Node4 {
-    b: [[f32; 4]; 6],
-    child: [u32; 4],
-    count: [u32; 4],
+pub(super) struct Node {
+    b: [[f32; W]; 6],
+    child: [u32; W],
+    count: [u32; W],
 }
 
-/// A 4-wide BVH over triangles stored by rows in leaf order.
+/// A [`W`]-wide BVH over triangles stored by rows in leaf order.
 #[derive(Clone, Debug, Default)]
 pub(super) struct WideBvh {
-    nodes: Vec<Node4>,
-    /// Upper bound of the traversal stack size (3 per level + 1).
+    nodes: Vec<Node>,
+    /// Upper bound of the traversal stack size (`W − 1` per level + 1).
     stack_len: usize,
 }
 
@@ -54,7 +60,7 @@ pub(super) struct WideBvh {
 pub(super) struct RayBoxes {
     org: [Vec4; 3],
     inv: [Vec4; 3],
-    /// Bound index (into `Node4::b`) of the near and far plane per axis.
+    /// Bound index (into `Node::b`) of the near and far plane per axis.
     near: [usize; 3],
     far: [usize; 3],
     tmin: f32,
@@ -83,21 +89,55 @@ impl RayBoxes {
         }
     }
 
-    /// Entry distances of the four boxes and the mask of those entered within
+    /// Entry distances of the children's boxes and the mask of those entered within
     /// `[tmin, tlimit]`.
     #[inline(always)]
-    fn test(&self, n: &Node4, tlimit: f32) -> (Vec4, u32) {
+    fn test(&self, n: &Node, tlimit: f32) -> ([f32; W], u32) {
         // 1 + 2γ₃ with γ₃ = 3ε / (1 − 3ε), ε = 2⁻²⁴, rounded up.
         const GROW: f32 = 1.0 + 2.0 * 3.0 * (f32::EPSILON * 0.5) * 1.000_001;
-        let slab = |k: usize, i: usize| (Vec4::from_array(n.b[i]) - self.org[k]) * self.inv[k];
-        let tn = slab(0, self.near[0])
-            .max(slab(1, self.near[1]))
-            .max(slab(2, self.near[2]).max(Vec4::splat(self.tmin)));
-        let tf = slab(0, self.far[0]).min(slab(1, self.far[1])).min(slab(2, self.far[2]))
-            * Vec4::splat(GROW);
-        let tf = tf.min(Vec4::splat(tlimit));
-        (tn, tn.cmple(tf).bitmask())
+        let mut tns = [0.0; W];
+        let mut mask = 0;
+        for h in 0..W / 4 {
+            let slab = |k: usize, i: usize| {
+                (Vec4::from_slice(&n.b[i][4 * h..4 * h + 4]) - self.org[k]) * self.inv[k]
+            };
+            let tn = slab(0, self.near[0])
+                .max(slab(1, self.near[1]))
+                .max(slab(2, self.near[2]).max(Vec4::splat(self.tmin)));
+            let tf = slab(0, self.far[0]).min(slab(1, self.far[1])).min(slab(2, self.far[2]))
+                * Vec4::splat(GROW);
+            let tf = tf.min(Vec4::splat(tlimit));
+            tn.write_to_slice(&mut tns[4 * h..4 * h + 4]);
+            mask |= tn.cmple(tf).bitmask() << (4 * h);
+        }
+        (tns, mask)
     }
+}
+
+/// A copy of `v` in memory that the kernel is asked to back by huge pages (Linux
+/// transparent huge pages, `madvise(MADV_HUGEPAGE)`; a plain copy elsewhere). Traversal
+/// touches these arrays at random, and with 4 KiB pages nearly every access to the lower
+/// tree levels is also a TLB miss.
+pub(super) fn huge_copy<T: Copy>(v: &[T]) -> Vec<T> {
+    let mut out: Vec<T> = Vec::with_capacity(v.len());
+    #[cfg(target_os = "linux")]
+    {
+        const HUGE: usize = 1 << 21;
+        let bytes = size_of_val(v);
+        if bytes >= 2 * HUGE {
+            let start = out.as_ptr() as usize;
+            let a = start.next_multiple_of(HUGE);
+            let b = (start + bytes) / HUGE * HUGE;
+            if b > a {
+                // SAFETY: `[a, b)` lies inside the allocation of `out` (not yet touched);
+                // MADV_HUGEPAGE changes only how the kernel backs it, never its contents,
+                // and a failure is harmless (the result is ignored).
+                unsafe { libc::madvise(a as *mut libc::c_void, b - a, libc::MADV_HUGEPAGE) };
+            }
+        }
+    }
+    out.extend_from_slice(v);
+    out
 }
 
 /// Hints the cache to load the `lines` 64-byte lines from `r` on (no effect elsewhere
@@ -116,14 +156,14 @@ fn prefetch<T>(r: &T, lines: usize) {
     let _ = (r, lines);
 }
 
-impl Node4 {
+impl Node {
     /// Prefetches child `i` (a node or a leaf's triangles).
     #[inline(always)]
-    fn prefetch_child(&self, i: usize, nodes: &[Node4], tris: &[RowTriangle]) {
+    fn prefetch_child(&self, i: usize, nodes: &[Node], tris: &[RowTriangle]) {
         let c = self.child[i] as usize;
         if self.count[i] == 0 {
             if let Some(n) = nodes.get(c) {
-                prefetch(n, 2);
+                prefetch(n, size_of::<Node>() / 64);
             }
         } else if let Some(t) = tris.get(c) {
             prefetch(t, (self.count[i] as usize * size_of::<RowTriangle>()).div_ceil(64));
@@ -143,7 +183,7 @@ impl WideBvh {
     /// primitive (index into `tris`) of every leaf slot, in leaf order.
     pub(super) fn build(bvh2: &Bvh2) -> (Self, Vec<u32>) {
         let n2 = &bvh2.nodes;
-        let mut nodes: Vec<Node4> = Vec::with_capacity(n2.len() / 3 + 1);
+        let mut nodes: Vec<Node> = Vec::with_capacity(n2.len() / 3 + 1);
         let mut order: Vec<u32> = Vec::with_capacity(bvh2.primitive_indices.len());
         if n2.is_empty() {
             return (Self::default(), order);
@@ -164,7 +204,7 @@ impl WideBvh {
                 let f = n2[bi as usize].first_index;
                 vec![f, f + 1]
             };
-            while cands.len() < 4 {
+            while cands.len() < W {
                 let pick = cands
                     .iter()
                     .enumerate()
@@ -179,17 +219,17 @@ impl WideBvh {
                 cands[k] = f;
                 cands.insert(k + 1, f + 1);
             }
-            let mut node = Node4 {
+            let mut node = Node {
                 b: [
-                    [f32::INFINITY; 4],
-                    [f32::NEG_INFINITY; 4],
-                    [f32::INFINITY; 4],
-                    [f32::NEG_INFINITY; 4],
-                    [f32::INFINITY; 4],
-                    [f32::NEG_INFINITY; 4],
+                    [f32::INFINITY; W],
+                    [f32::NEG_INFINITY; W],
+                    [f32::INFINITY; W],
+                    [f32::NEG_INFINITY; W],
+                    [f32::INFINITY; W],
+                    [f32::NEG_INFINITY; W],
                 ],
-                child: [u32::MAX; 4],
-                count: [0; 4],
+                child: [u32::MAX; W],
+                count: [0; W],
             };
             let mut inner = Vec::new();
             for (i, &c) in cands.iter().enumerate() {
@@ -216,7 +256,7 @@ impl WideBvh {
                 work.push((c, me, i, depth + 1));
             }
         }
-        (Self { nodes, stack_len: 3 * max_depth + 1 }, order)
+        (Self { nodes: huge_copy(&nodes), stack_len: (W - 1) * max_depth + 1 }, order)
     }
 
     /// Closest hit: `(slot, t)` of the hit with the least `t` (ties: least `ids[slot]`),
@@ -274,7 +314,6 @@ impl WideBvh {
                 let node = &self.nodes[cur.child as usize];
                 let (tn, mask) = rb.test(node, tlimit);
                 if mask != 0 {
-                    let tn = tn.to_array();
                     let first = mask.trailing_zeros() as usize;
                     let rest = mask & (mask - 1);
                     let at =
@@ -285,7 +324,7 @@ impl WideBvh {
                         continue;
                     }
                     // Two or more: push all but the nearest, farthest first.
-                    let mut hits = [Entry::default(); 4];
+                    let mut hits = [Entry::default(); W];
                     let mut nh = 0;
                     let mut m = mask;
                     while m != 0 {
