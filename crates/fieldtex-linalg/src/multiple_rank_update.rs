@@ -245,9 +245,7 @@ fn apply_steps_split(
         return;
     }
     let _ = avx2;
-    for &(t, a, dl, g) in steps {
-        sweep(&mut work[t][..], runs, vals, a, dl, g, up);
-    }
+    sweep_steps(steps, runs, vals, work, up);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -259,8 +257,69 @@ fn apply_steps_split_avx2(
     work: &mut [&mut [f64]],
     up: bool,
 ) {
-    for &(t, a, dl, g) in steps {
+    sweep_steps(steps, runs, vals, work, up);
+}
+
+/// The modifications `steps` in order over the rows `runs` of a column, four at a time:
+/// a row's value stays in a register through the four (one load and store of it instead
+/// of four), each row still sees the modifications in the same order with the same
+/// operations. `work[t]`: modification `t`'s work vector.
+#[inline(always)]
+fn sweep_steps(
+    steps: &[(usize, f64, f64, f64)],
+    runs: &[(usize, u32, u32)],
+    vals: &mut [f64],
+    work: &mut [&mut [f64]],
+    up: bool,
+) {
+    let mut chunks = steps.chunks_exact(4);
+    for c in &mut chunks {
+        let [w0, w1, w2, w3] = work
+            .get_disjoint_mut([c[0].0, c[1].0, c[2].0, c[3].0])
+            .expect("distinct modifications");
+        let p = [c[0], c[1], c[2], c[3]].map(|(_, a, dl, g)| (a, dl, g));
+        for &(q0, o0, m) in runs {
+            let (o0, m) = (o0 as usize, m as usize);
+            let ws = [
+                &mut w0[o0..o0 + m],
+                &mut w1[o0..o0 + m],
+                &mut w2[o0..o0 + m],
+                &mut w3[o0..o0 + m],
+            ];
+            sweep4(ws, &mut vals[q0..q0 + m], p, up);
+        }
+    }
+    for &(t, a, dl, g) in chunks.remainder() {
         sweep(&mut work[t][..], runs, vals, a, dl, g, up);
+    }
+}
+
+/// Four modifications over one run (equal lengths).
+#[inline(always)]
+fn sweep4(ws: [&mut [f64]; 4], vs: &mut [f64], p: [(f64, f64, f64); 4], up: bool) {
+    let [w0, w1, w2, w3] = ws;
+    let it =
+        vs.iter_mut().zip(w0.iter_mut()).zip(w1.iter_mut()).zip(w2.iter_mut()).zip(w3.iter_mut());
+    if up {
+        for ((((v, w0), w1), w2), w3) in it {
+            let mut x = *v;
+            for (w, &(a, dl, g)) in [w0, w1, w2, w3].into_iter().zip(&p) {
+                let w1 = *w;
+                *w = w1 - a * x;
+                x = dl * x + g * w1;
+            }
+            *v = x;
+        }
+    } else {
+        for ((((v, w0), w1), w2), w3) in it {
+            let mut x = *v;
+            for (w, &(a, dl, g)) in [w0, w1, w2, w3].into_iter().zip(&p) {
+                let w2 = *w - a * x;
+                *w = w2;
+                x = dl * x + g * w2;
+            }
+            *v = x;
+        }
     }
 }
 
@@ -346,9 +405,8 @@ fn apply_steps_impl(
     u: usize,
     up: bool,
 ) {
-    for &(t, a, dl, g) in steps {
-        sweep(&mut work[t * u..(t + 1) * u], runs, vals, a, dl, g, up);
-    }
+    let mut ws: Vec<&mut [f64]> = work.chunks_mut(u).collect();
+    sweep_steps(steps, runs, vals, &mut ws, up);
 }
 
 impl Cholesky {
