@@ -41,9 +41,9 @@ const SPREAD: [u32; 1 << BITS] = {
 /// `1 / inv_half` (all positive).
 ///
 /// Sort keys `key << 32 | index` are radix sorted (stable, so equal keys keep the input
-/// order); every chunk gathers its rays first (independent loads that overlap) and
-/// answers them; the results are then scattered back to input order in one sequential
-/// pass. Batches of more than `u32::MAX` rays are answered in blocks.
+/// order); every chunk gathers its rays first (independent loads that overlap), answers
+/// them and writes each result straight to its input position. Batches of more than
+/// `u32::MAX` rays are answered in blocks.
 pub(super) fn map_coherent<T: Copy + Default + Send + Sync>(
     rays: &[Ray],
     centre: V3,
@@ -80,7 +80,7 @@ fn map_block<T: Copy + Default + Send + Sync>(
     let keys = radix_sort(keys);
     // Answer in sorted order, each result written straight to its input position.
     let base = out.len();
-    out.resize(base + n, T::default());
+    out.par_extend(rayon::iter::repeat_n(T::default(), n));
     let dst = OutPtr(out[base..].as_mut_ptr());
     keys.par_chunks(CHUNK).for_each(|ks| {
         // Gather first: independent loads overlap, unlike loads inside traversal.
@@ -90,7 +90,10 @@ fn map_block<T: Copy + Default + Send + Sync>(
         }
         for (l, &k) in local.iter().zip(ks) {
             let r = f(l);
-            dst.write(k as u32 as usize, n, r);
+            // SAFETY: the indices of the sorted keys are a permutation of `0..n` (radix
+            // sorting permutes them), so every element is written by one task only, and
+            // `out` is not otherwise accessed until `for_each` returns.
+            unsafe { dst.write(k as u32 as usize, n, r) };
         }
     });
 }
@@ -100,44 +103,66 @@ fn map_block<T: Copy + Default + Send + Sync>(
 struct OutPtr<T>(*mut T);
 
 impl<T: Copy> OutPtr<T> {
-    /// Writes element `i` of the `n` elements.
+    /// Writes element `i` of the `n` elements the pointer points to (panics unless
+    /// `i < n`).
+    ///
+    /// # Safety
+    /// The `n` elements must stay allocated, and no other task may read or write element
+    /// `i` meanwhile.
     #[inline(always)]
-    fn write(&self, i: usize, n: usize, value: T) {
+    unsafe fn write(&self, i: usize, n: usize, value: T) {
         assert!(i < n);
-        // SAFETY: `i < n`, so the write stays inside the batch's `n` elements of `out`,
-        // which live (and are not otherwise accessed) until the parallel loop returns;
-        // the indices of the sorted keys are a permutation of `0..n` (radix sorting
-        // permutes them), so no two writes touch the same element; `T: Copy` has no
-        // drop to skip.
+        // SAFETY: in bounds (`i < n`) and exclusive (the caller's contract); `T: Copy`
+        // has no drop to skip.
         unsafe { self.0.add(i).write(value) };
     }
 }
-// SAFETY: tasks write disjoint elements only (see `map_block`); `T: Send`.
+// SAFETY: tasks write disjoint elements only (the contract of `OutPtr::write`); `T: Send`.
 unsafe impl<T: Send> Send for OutPtr<T> {}
 // SAFETY: as above; the pointer itself is never used to read.
 unsafe impl<T: Send> Sync for OutPtr<T> {}
 
 /// Stable least-significant-digit radix sort of `key << 32 | index` values by their
-/// upper 30 bits (the key), [`RADIX`] bits per pass.
+/// upper 30 bits (the key), [`RADIX`] bits per pass. Each pass counts digits over fixed
+/// parts of the input in parallel, then every part moves its values to its own ranges
+/// (the order is the sequential one, for any thread count).
 fn radix_sort(mut a: Vec<u64>) -> Vec<u64> {
     const NB: usize = 1 << RADIX;
-    let mut b = vec![0u64; a.len()];
+    const PARTS: usize = 16;
+    let n = a.len();
+    let part = n.div_ceil(PARTS).max(1);
+    let mut b = vec![0u64; n];
     for pass in 0..(5 * BITS).div_ceil(RADIX) {
         let shift = 32 + pass * RADIX;
         let digit = |x: u64| ((x >> shift) as usize) & (NB - 1);
-        let mut start = [0usize; NB];
-        for &x in &a {
-            start[digit(x)] += 1;
-        }
+        let mut starts: Vec<Vec<usize>> = a
+            .par_chunks(part)
+            .map(|p| {
+                let mut h = vec![0usize; NB];
+                for &x in p {
+                    h[digit(x)] += 1;
+                }
+                h
+            })
+            .collect();
+        // First position of every (digit, part) range, digits major: stable.
         let mut sum = 0;
-        for s in start.iter_mut() {
-            (*s, sum) = (sum, sum + *s);
+        for d in 0..NB {
+            for h in starts.iter_mut() {
+                (h[d], sum) = (sum, sum + h[d]);
+            }
         }
-        for &x in &a {
-            let d = digit(x);
-            b[start[d]] = x;
-            start[d] += 1;
-        }
+        let dst = OutPtr(b.as_mut_ptr());
+        a.par_chunks(part).zip(starts).for_each(|(p, mut h)| {
+            for &x in p {
+                let d = digit(x);
+                // SAFETY: the (digit, part) ranges are disjoint and each position in a
+                // range is written once; `b` is not otherwise accessed until
+                // `for_each` returns.
+                unsafe { dst.write(h[d], n, x) };
+                h[d] += 1;
+            }
+        });
         std::mem::swap(&mut a, &mut b);
     }
     a
