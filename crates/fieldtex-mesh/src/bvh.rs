@@ -248,13 +248,40 @@ impl Bvh {
         let rb = RayBoxes::new(oray.origin, oray.direction, oray.tmin, self.scene_half);
         let (best_prim, best_t) =
             self.wide.closest(&rb, &mut shear, &self.prim_tris, &self.prim_ids, &self.corners)?;
+        Some(self.hit(ray, &oray, s, best_prim, best_t))
+    }
+
+    /// The hit of `ray` on primitive `best_prim`, refined in `f64` (`oray`, `s`: the
+    /// traversal ray of [`Bvh::oray`]; `best_t`: its `f32` ray parameter).
+    fn hit(&self, ray: &Ray, oray: &ORay, s: f64, best_prim: u32, best_t: f32) -> Hit {
         let tri = self.prim_ids[best_prim as usize];
         let (t, bary) = refine_hit(self.corners[best_prim as usize], ray.origin, ray.dir)
             .unwrap_or_else(|| {
-                let b = self.prim_tris[best_prim as usize].triangle().compute_barycentric(&oray);
+                let b = self.prim_tris[best_prim as usize].triangle().compute_barycentric(oray);
                 (best_t as f64 * s, [1.0 - (b.x + b.y) as f64, b.x as f64, b.y as f64])
             });
-        Some(Hit { triangle: tri, t, barycentric: bary })
+        Hit { triangle: tri, t, barycentric: bary }
+    }
+
+    /// [`Bvh::intersect`] for a chunk of rays, traversed interleaved
+    /// (`WideBvh::closest_many`; same results).
+    fn intersect_chunk(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        let mut jobs = Vec::with_capacity(rays.len());
+        let mut meta = Vec::with_capacity(rays.len());
+        for (i, r) in rays.iter().enumerate() {
+            out[i] = None;
+            if let Some((oray, s)) = self.oray(r) {
+                let rb = RayBoxes::new(oray.origin, oray.direction, oray.tmin, self.scene_half);
+                jobs.push((rb, Shear::new(&oray), None));
+                meta.push((i, oray, s));
+            }
+        }
+        self.wide.closest_many(&mut jobs, &self.prim_tris, &self.prim_ids, &self.corners);
+        for ((_, _, best), (i, oray, s)) in jobs.iter().zip(&meta) {
+            if let Some((p, t)) = *best {
+                out[*i] = Some(self.hit(&rays[*i], oray, *s, p, t));
+            }
+        }
     }
 
     /// Whether a ray with a `[tmin, tmax]` range hits anything.
@@ -267,12 +294,18 @@ impl Bvh {
 
     /// [`Bvh::intersect`] for many rays, in parallel (deterministic).
     pub fn intersect_many(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
-        bvh_ray_order::map_coherent(rays, self.centre, self.inv_half, |r| self.intersect(r))
+        bvh_ray_order::map_coherent(rays, self.centre, self.inv_half, |r, out| {
+            self.intersect_chunk(r, out)
+        })
     }
 
     /// [`Bvh::occluded`] for many rays, in parallel (deterministic).
     pub fn occluded_many(&self, rays: &[Ray]) -> Vec<bool> {
-        bvh_ray_order::map_coherent(rays, self.centre, self.inv_half, |r| self.occluded(r))
+        bvh_ray_order::map_coherent(rays, self.centre, self.inv_half, |r, out| {
+            for (o, r) in out.iter_mut().zip(r) {
+                *o = self.occluded(r);
+            }
+        })
     }
 
     /// The closest surface point to `p` (ties to the lower triangle index); `None` for an

@@ -36,7 +36,8 @@ const SPREAD: [u32; 1 << BITS] = {
     t
 };
 
-/// `f` applied to every ray, in parallel over fixed chunks of a coherent ray order;
+/// `f` applied to every ray (`f(rays, results)` answers a chunk of rays), in parallel over
+/// fixed chunks of a coherent ray order;
 /// results in input order. The scene box has centre `centre` and half extents
 /// `1 / inv_half` (all positive).
 ///
@@ -48,10 +49,12 @@ pub(super) fn map_coherent<T: Copy + Default + Send + Sync>(
     rays: &[Ray],
     centre: V3,
     inv_half: V3,
-    f: impl Fn(&Ray) -> T + Sync + Send,
+    f: impl Fn(&[Ray], &mut [T]) + Sync + Send,
 ) -> Vec<T> {
     if rays.len() < MIN_SORTED {
-        return rays.par_iter().with_min_len(CHUNK).map(f).collect();
+        let mut out = vec![T::default(); rays.len()];
+        out.par_chunks_mut(CHUNK).zip(rays.par_chunks(CHUNK)).for_each(|(o, r)| f(r, o));
+        return out;
     }
     let c = Vec3A::new(centre[0] as f32, centre[1] as f32, centre[2] as f32);
     let ih = Vec3A::new(inv_half[0] as f32, inv_half[1] as f32, inv_half[2] as f32);
@@ -67,7 +70,7 @@ fn map_block<T: Copy + Default + Send + Sync>(
     block: &[Ray],
     c: Vec3A,
     ih: Vec3A,
-    f: &(impl Fn(&Ray) -> T + Sync + Send),
+    f: &(impl Fn(&[Ray], &mut [T]) + Sync + Send),
     out: &mut Vec<T>,
 ) {
     let n = block.len();
@@ -88,8 +91,9 @@ fn map_block<T: Copy + Default + Send + Sync>(
         for (l, &k) in local.iter_mut().zip(ks) {
             *l = block[k as u32 as usize];
         }
-        for (l, &k) in local.iter().zip(ks) {
-            let r = f(l);
+        let mut res = [T::default(); CHUNK];
+        f(&local[..ks.len()], &mut res[..ks.len()]);
+        for (&r, &k) in res.iter().zip(ks) {
             // SAFETY: the indices of the sorted keys are a permutation of `0..n` (radix
             // sorting permutes them), so every element is written by one task only, and
             // `out` is not otherwise accessed until `for_each` returns.

@@ -21,8 +21,10 @@
 //!
 //! Memory: the children of every entered node (nodes or leaf triangles) are prefetched
 //! as soon as the node is tested, and the large arrays are asked to live on huge pages
-//! ([`huge_copy`]). Not implemented: compressed (quantised) boxes, AVX 8-lane tests,
-//! packet or stream traversal.
+//! ([`huge_copy`]). Batches of closest-hit rays are traversed four at a time,
+//! interleaved step by step ([`WideBvh::closest_many`]), so one ray's cache misses
+//! overlap the others' work. Not implemented: compressed (quantised) boxes, AVX 8-lane
+//! tests, packet traversal.
 
 use super::bvh_watertight::{RowTriangle, Shear};
 use glam::{Vec3A, Vec4};
@@ -171,6 +173,25 @@ impl Node {
     }
 }
 
+/// A ray of [`WideBvh::closest_many`]: box constants, triangle test, result.
+pub(super) type ClosestJob = (RayBoxes, Shear, Option<(u32, f32)>);
+
+/// Closest-hit traversal state of one ray (besides its stack).
+#[derive(Clone, Copy)]
+struct Closest {
+    best: Option<(u32, f32)>,
+    /// Entries entered beyond this distance are skipped.
+    tlimit: f32,
+    sp: usize,
+    cur: Entry,
+}
+
+impl Closest {
+    fn new(tmax: f32) -> Self {
+        Self { best: None, tlimit: tmax, sp: 0, cur: Entry { child: 0, count: 0, tn: 0.0 } }
+    }
+}
+
 #[derive(Clone, Copy, Default)]
 struct Entry {
     child: u32,
@@ -305,79 +326,133 @@ impl WideBvh {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best: Option<(u32, f32)> = None;
-        let mut tlimit = shear.tmax;
-        let mut sp = 0usize;
-        let mut cur = Entry { child: 0, count: 0, tn: 0.0 };
+        let mut st = Closest::new(shear.tmax);
+        while self.closest_step(&mut st, rb, shear, tris, ids, refine, stack) {}
+        st.best
+    }
+
+    /// [`WideBvh::closest`] for several rays (`rays[i] = (boxes, shear, result)`),
+    /// traversed interleaved: a few rays advance in turn, one node or leaf at a time, so
+    /// that the memory latency of one ray's next node overlaps the others' work. Every
+    /// ray takes exactly the steps it takes alone, so results are the same.
+    pub(super) fn closest_many<R>(
+        &self,
+        rays: &mut [ClosestJob],
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+    ) {
+        const LANES: usize = 4;
+        if self.stack_len > FIXED_STACK || self.nodes.is_empty() {
+            for (rb, shear, out) in rays.iter_mut() {
+                *out = self.closest(rb, shear, tris, ids, refine);
+            }
+            return;
+        }
+        let mut stacks = [[Entry::default(); FIXED_STACK]; LANES];
+        let mut lanes: [Option<(usize, Closest)>; LANES] = [None; LANES];
+        let mut next = 0;
         loop {
-            if cur.count == 0 {
-                let node = &self.nodes[cur.child as usize];
-                let (tn, mask) = rb.test(node, tlimit);
-                if mask != 0 {
-                    let first = mask.trailing_zeros() as usize;
-                    let rest = mask & (mask - 1);
-                    let at =
-                        |i: usize| Entry { child: node.child[i], count: node.count[i], tn: tn[i] };
-                    if rest == 0 {
-                        node.prefetch_child(first, &self.nodes, tris);
-                        cur = at(first);
-                        continue;
-                    }
-                    // Two or more: push all but the nearest, farthest first.
-                    let mut hits = [Entry::default(); W];
-                    let mut nh = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let i = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        node.prefetch_child(i, &self.nodes, tris);
-                        // Insertion by entry distance (descending).
-                        let e = at(i);
-                        let mut j = nh;
-                        while j > 0 && hits[j - 1].tn < e.tn {
-                            hits[j] = hits[j - 1];
-                            j -= 1;
-                        }
-                        hits[j] = e;
-                        nh += 1;
-                    }
-                    stack[sp..sp + nh - 1].copy_from_slice(&hits[..nh - 1]);
-                    sp += nh - 1;
-                    cur = hits[nh - 1];
-                    continue;
+            let mut busy = false;
+            for (lane, stack) in lanes.iter_mut().zip(stacks.iter_mut()) {
+                if lane.is_none() && next < rays.len() {
+                    *lane = Some((next, Closest::new(rays[next].1.tmax)));
+                    next += 1;
                 }
-            } else {
-                for p in cur.child..cur.child + cur.count {
-                    let t = shear.intersect(&tris[p as usize]);
-                    if t.is_finite() {
-                        // A finite `t` is at most `shear.tmax`, the best `t` so far.
-                        let better = match best {
-                            None => true,
-                            Some((bp, bt)) => t < bt || ids[p as usize] < ids[bp as usize],
-                        };
-                        if better {
-                            if let Some(r) = refine.get(p as usize) {
-                                prefetch(r, 2);
-                            }
-                            best = Some((p, t));
-                            shear.tmax = t;
-                            tlimit = t + rb.slack;
-                        }
-                    }
+                let Some((i, st)) = lane else { continue };
+                busy = true;
+                let (rb, shear, out) = &mut rays[*i];
+                if !self.closest_step(st, rb, shear, tris, ids, refine, stack) {
+                    *out = st.best;
+                    *lane = None;
                 }
             }
-            // Pop the next entry still in range.
-            loop {
-                if sp == 0 {
-                    return best;
+            if !busy {
+                return;
+            }
+        }
+    }
+
+    /// One step of closest-hit traversal: visits `st.cur` (a node or a leaf) and picks
+    /// the next entry; `false` once the traversal is over (result in `st.best`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn closest_step<R>(
+        &self,
+        st: &mut Closest,
+        rb: &RayBoxes,
+        shear: &mut Shear,
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+        stack: &mut [Entry],
+    ) -> bool {
+        let cur = st.cur;
+        if cur.count == 0 {
+            let node = &self.nodes[cur.child as usize];
+            let (tn, mask) = rb.test(node, st.tlimit);
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                let rest = mask & (mask - 1);
+                let at = |i: usize| Entry { child: node.child[i], count: node.count[i], tn: tn[i] };
+                if rest == 0 {
+                    node.prefetch_child(first, &self.nodes, tris);
+                    st.cur = at(first);
+                    return true;
                 }
-                sp -= 1;
-                if stack[sp].tn <= tlimit {
-                    cur = stack[sp];
-                    break;
+                // Two or more: push all but the nearest, farthest first.
+                let mut hits = [Entry::default(); W];
+                let mut nh = 0;
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    node.prefetch_child(i, &self.nodes, tris);
+                    // Insertion by entry distance (descending).
+                    let e = at(i);
+                    let mut j = nh;
+                    while j > 0 && hits[j - 1].tn < e.tn {
+                        hits[j] = hits[j - 1];
+                        j -= 1;
+                    }
+                    hits[j] = e;
+                    nh += 1;
+                }
+                stack[st.sp..st.sp + nh - 1].copy_from_slice(&hits[..nh - 1]);
+                st.sp += nh - 1;
+                st.cur = hits[nh - 1];
+                return true;
+            }
+        } else {
+            for p in cur.child..cur.child + cur.count {
+                let t = shear.intersect(&tris[p as usize]);
+                if t.is_finite() {
+                    // A finite `t` is at most `shear.tmax`, the best `t` so far.
+                    let better = match st.best {
+                        None => true,
+                        Some((bp, bt)) => t < bt || ids[p as usize] < ids[bp as usize],
+                    };
+                    if better {
+                        if let Some(r) = refine.get(p as usize) {
+                            prefetch(r, 2);
+                        }
+                        st.best = Some((p, t));
+                        shear.tmax = t;
+                        st.tlimit = t + rb.slack;
+                    }
                 }
             }
         }
+        // Pop the next entry still in range.
+        while st.sp > 0 {
+            st.sp -= 1;
+            let e = stack[st.sp];
+            if e.tn <= st.tlimit {
+                st.cur = e;
+                return true;
+            }
+        }
+        false
     }
 
     #[inline(always)]
