@@ -74,6 +74,11 @@ impl DesignFactor {
         self.factor.as_ref()
     }
 
+    /// The factor, mutable (sparse solves take it over for updates on first use).
+    pub(crate) fn factor_mut(&mut self) -> Option<&mut Cholesky> {
+        self.factor.as_mut()
+    }
+
     /// Drops the numeric factor; the next sync refactors.
     pub(crate) fn invalidate(&mut self) {
         self.factor = None;

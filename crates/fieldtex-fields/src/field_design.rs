@@ -612,7 +612,7 @@ impl FieldDesign {
     fn solve_in_pool(&mut self) -> Result<SolvedField, FieldsError> {
         self.refactor_if_needed()?;
         let (model, s_point, c_point, any_point) = self.singular_terms();
-        let factor = self.factor.factor().expect("refactor_if_needed made the factor");
+        let factor = self.factor.factor_mut().expect("refactor_if_needed made the factor");
         let (one_form, residual) = match model {
             Some(model) if !any_point => {
                 let mut b = vec![0.0; self.dec.n_edges()];
@@ -624,7 +624,8 @@ impl FieldDesign {
                     }
                 }
                 if any {
-                    let (delta, residual) = factor.solve_with_residual(&b)?;
+                    // `b` lives on the stroke edges: the forward solve visits their reach only
+                    let (delta, residual) = factor.solve_sparse_with_residual(&b)?;
                     let mut omega = model;
                     omega.par_iter_mut().zip(delta.par_iter()).for_each(|(o, d)| *o += d);
                     (omega, residual)
