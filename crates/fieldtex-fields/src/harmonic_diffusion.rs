@@ -45,7 +45,7 @@ use std::time::Instant;
 
 use fieldtex_core::Warning;
 use fieldtex_core::vec3::{self, V3};
-use fieldtex_linalg::{Cholesky, SparseMatrix, SymbolicCholesky};
+use fieldtex_linalg::{Cholesky, FactorLayout, SparseMatrix, SymbolicCholesky};
 use fieldtex_mesh::{
     CotanOptions, CurvatureOptions, MeshError, NormalWeighting, TriMesh, UnionFind,
     cotan_laplacian_with, principal_curvatures, vertex_normals,
@@ -99,6 +99,21 @@ pub struct CurveFieldOptions {
     /// refactorisation from fandisk to the refined horse (`examples/bench_orientation.rs`,
     /// `refactor_over_rank1`). A greedy step (one curve, tens of vertices) stays below.
     pub refactor_above: usize,
+    /// Fill-reducing ordering of each component's factor. Default
+    /// [`FillOrdering::NestedDissection`].
+    pub ordering: FillOrdering,
+}
+
+/// Ordering of the unknowns before factorisation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum FillOrdering {
+    /// Approximate minimum degree (faer).
+    Amd,
+    /// Geometric nested dissection ([`crate::nested_dissection`]): a balanced
+    /// elimination tree with short leaf-to-root paths, which the greedy orientation's
+    /// rank-1 updates and partial solves walk. Default.
+    #[default]
+    NestedDissection,
 }
 
 impl Default for CurveFieldOptions {
@@ -110,6 +125,7 @@ impl Default for CurveFieldOptions {
             overlap: OverlapPolicy::KeepFirst,
             fallback: UnconstrainedFallback::PrincipalDirection,
             refactor_above: 200,
+            ordering: FillOrdering::default(),
         }
     }
 }
@@ -610,7 +626,8 @@ impl<'m> CurveFieldSolver<'m> {
                 block.needs_full = true;
             }
             let t0 = Instant::now();
-            let result = factor_block(block, &self.targets, alpha);
+            let result =
+                factor_block(block, &self.targets, alpha, self.options.ordering, self.mesh);
             report.factor_seconds += t0.elapsed().as_secs_f64();
             report.factorisations += 1;
             if let Err(e) = result {
@@ -925,13 +942,28 @@ fn factor_block(
     block: &mut Block,
     targets: &[Option<(V3, V3)>],
     alpha: f64,
+    ordering: FillOrdering,
+    mesh: &TriMesh,
 ) -> Result<(), FieldsError> {
     let a = penalised_matrix(block, targets, alpha);
     // The pattern of `L + P` is that of `L` (diagonal present), so a kept analysis serves
     // every later refactorisation.
     let symbolic = match block.symbolic.take() {
         Some(s) => s,
-        None => SymbolicCholesky::analyze(&a)?,
+        None => match ordering {
+            FillOrdering::Amd => SymbolicCholesky::analyze(&a)?,
+            FillOrdering::NestedDissection => {
+                let positions: Vec<V3> =
+                    block.vertices.iter().map(|&v| mesh.positions[v as usize]).collect();
+                let l = &block.laplacian;
+                let perm = crate::nested_dissection::nested_dissection_order(
+                    &positions,
+                    l.col_ptr(),
+                    l.row_idx(),
+                );
+                SymbolicCholesky::analyze_with_ordering(&a, FactorLayout::Auto, &perm)?
+            }
+        },
     };
     let factor = Cholesky::factor_with(&symbolic, &a);
     block.symbolic = Some(symbolic);

@@ -80,6 +80,7 @@ pub use singularity_index::DetectedSingularity;
 // Paper A §4: curve-constrained harmonic diffusion, greedy curve orientation, metrics.
 pub mod greedy_curve_orientation;
 pub mod harmonic_diffusion;
+pub mod nested_dissection;
 pub mod surface_field_metrics;
 pub use greedy_curve_orientation::{
     CurveOrientationOptions, CurveOrientationResult, OrientationMode, OrientationScore,

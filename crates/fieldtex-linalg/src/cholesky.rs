@@ -141,6 +141,62 @@ impl SymbolicCholesky {
         })
     }
 
+    /// As [`SymbolicCholesky::analyze_with`], with a given fill-reducing ordering
+    /// instead of AMD: `perm[k]` = original index of the `k`-th eliminated unknown (a
+    /// permutation of `0..n`, else [`LinalgError::InvalidArgument`]).
+    pub fn analyze_with_ordering(
+        a: &SparseMatrix,
+        layout: FactorLayout,
+        perm: &[usize],
+    ) -> Result<Self, LinalgError> {
+        let n = check_square(a)?;
+        let mut inv = vec![usize::MAX; n];
+        for (k, &i) in perm.iter().enumerate() {
+            if i >= n || inv[i] != usize::MAX {
+                return Err(LinalgError::InvalidArgument {
+                    what: "ordering entry",
+                    value: i as f64,
+                    reason: "the ordering must be a permutation of 0..n",
+                });
+            }
+            inv[i] = k;
+        }
+        if perm.len() != n {
+            return Err(LinalgError::Dimension {
+                what: "ordering length",
+                expected: n,
+                found: perm.len(),
+            });
+        }
+        let threshold = match layout {
+            FactorLayout::Auto | FactorLayout::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
+            FactorLayout::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
+        };
+        let params = fc::CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: threshold,
+            ..Default::default()
+        };
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
+        let ordering = faer::perm::PermRef::new_checked(perm, &inv, n);
+        let faer = fc::factorize_symbolic_cholesky(
+            pattern,
+            Side::Lower,
+            fc::SymmetricOrdering::Custom(ordering),
+            params,
+        )
+        .map_err(|e| LinalgError::FactorizationFailed {
+            size: n,
+            reason: format!("symbolic analysis failed: {e:?}"),
+        })?;
+        Ok(Self {
+            inner: Arc::new(SymbolicInner {
+                faer,
+                col_ptr: a.col_ptr().to_vec(),
+                row_idx: a.row_idx().to_vec(),
+            }),
+        })
+    }
+
     /// Matrix size `n`.
     pub fn size(&self) -> usize {
         self.inner.col_ptr.len() - 1

@@ -2,7 +2,7 @@
 
 mod common;
 use common::*;
-use fieldtex_linalg::{Cholesky, LinalgError, SparseMatrix, SymbolicCholesky};
+use fieldtex_linalg::{Cholesky, FactorLayout, LinalgError, SparseMatrix, SymbolicCholesky};
 
 #[test]
 fn penalty_grid_solves_with_small_residual() {
@@ -177,4 +177,24 @@ fn public_types_are_send_and_sync() {
     check::<SparseMatrix>();
     check::<fieldtex_linalg::Pca>();
     check::<LinalgError>();
+}
+
+#[test]
+fn given_ordering_factors_and_rejects_non_permutations() {
+    let (w, h) = (30, 20);
+    let n = w * h;
+    let a = penalty_system(w, h, &every(n, 23), 1e8);
+    let reversed: Vec<usize> = (0..n).rev().collect();
+    let sym = SymbolicCholesky::analyze_with_ordering(&a, FactorLayout::Auto, &reversed).unwrap();
+    assert_eq!(sym.permutation(), reversed);
+    let b = Lcg(3).vec(n);
+    let x = Cholesky::factor_with(&sym, &a).unwrap().solve(&b).unwrap();
+    let reference = Cholesky::factor(&a).unwrap().solve(&b).unwrap();
+    assert!(max_abs_diff(&x, &reference) <= 1e-9 * max_abs(&reference));
+    let mut dup = reversed.clone();
+    dup[0] = dup[1];
+    assert!(SymbolicCholesky::analyze_with_ordering(&a, FactorLayout::Auto, &dup).is_err());
+    assert!(
+        SymbolicCholesky::analyze_with_ordering(&a, FactorLayout::Auto, &reversed[1..]).is_err()
+    );
 }
