@@ -965,8 +965,10 @@ fn factor_block(
             }
         },
     };
-    let factor = Cholesky::factor_with(&symbolic, &a);
+    let mut factor = Cholesky::factor_with(&symbolic, &a)?;
+    // later constraints are rank-1 updates: prepare the factor for them now
+    factor.prepare_updates()?;
     block.symbolic = Some(symbolic);
-    block.factor = Some(factor?);
+    block.factor = Some(factor);
     Ok(())
 }

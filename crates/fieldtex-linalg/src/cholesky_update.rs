@@ -542,6 +542,14 @@ impl Cholesky {
         Ok(self.dynamic.as_mut().expect("created above"))
     }
 
+    /// Takes the factor over for updates now (row indices and runs beside faer's
+    /// values, ~50–90 ms at 200K unknowns) instead of in the first update, so that a
+    /// caller who will update can count that cost with the factorisation. Solves keep
+    /// working. Idempotent.
+    pub fn prepare_updates(&mut self) -> Result<(), LinalgError> {
+        self.ensure_dynamic().map(|_| ())
+    }
+
     /// Adds the penalty `α eᵢ eᵢᵀ` (a soft constraint on unknown `i`); `α` finite, > 0.
     pub fn add_diagonal_penalty(&mut self, i: usize, alpha: f64) -> Result<(), LinalgError> {
         check_alpha(alpha)?;
