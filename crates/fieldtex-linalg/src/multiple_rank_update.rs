@@ -83,6 +83,7 @@ impl DynamicFactor {
         for (t, &(f, v)) in cols.iter().enumerate() {
             work[t * u + self.slot[f] as usize] = v;
         }
+        let mut work: Vec<&mut [f64]> = work.chunks_mut(u).collect();
         let mut beta = vec![1.0f64; k];
         let sigma = if up { 1.0 } else { -1.0 };
         // per column: the modifications that change it, with their `(t, α, δ, γ)`
@@ -103,11 +104,11 @@ impl DynamicFactor {
             let mut d = self.vals[s];
             steps.clear();
             for t in 0..k {
-                let w = work[t * u + row_j];
+                let w = work[t][row_j];
                 if w == 0.0 {
                     continue;
                 }
-                work[t * u + row_j] = 0.0;
+                work[t][row_j] = 0.0;
                 let b = beta[t];
                 let alpha = w / d;
                 let beta2_sq = b * b + sigma * alpha * alpha;
@@ -153,14 +154,14 @@ impl DynamicFactor {
                 None
             };
             match split {
-                None => apply_steps(&steps, &runs, vals, &mut work, u, up, avx2),
+                None => apply_steps(&steps, &runs, vals, &mut work, up, avx2),
                 Some((p, q_p, o_p)) => {
                     // two halves with disjoint rows (values) and slots (work entries):
                     // every entry sees the same operations, so the result is the same
                     let (v_lo, v_hi) = vals.split_at_mut(q_p);
                     let mut lo: Vec<&mut [f64]> = Vec::with_capacity(k);
                     let mut hi: Vec<&mut [f64]> = Vec::with_capacity(k);
-                    for w in work.chunks_mut(u) {
+                    for w in work.iter_mut() {
                         let (a, b) = w.split_at_mut(o_p);
                         lo.push(a);
                         hi.push(b);
@@ -170,8 +171,8 @@ impl DynamicFactor {
                     let steps = &steps;
                     let runs_lo = &runs[..p];
                     rayon::join(
-                        || apply_steps_split(steps, runs_lo, v_lo, &mut lo, up, avx2),
-                        || apply_steps_split(steps, &runs_hi, v_hi, &mut hi, up, avx2),
+                        || apply_steps(steps, runs_lo, v_lo, &mut lo, up, avx2),
+                        || apply_steps(steps, &runs_hi, v_hi, &mut hi, up, avx2),
                     );
                 }
             }
@@ -226,38 +227,6 @@ fn split_point(runs: &[(usize, u32, u32)]) -> Option<(usize, usize, usize)> {
     }
     let p = runs.len() - 1;
     Some((p, runs[p].0, runs[p].1 as usize))
-}
-
-/// [`apply_steps`] for one half of a split column: `work[t]` is modification `t`'s work
-/// vector restricted to the half's slots.
-fn apply_steps_split(
-    steps: &[(usize, f64, f64, f64)],
-    runs: &[(usize, u32, u32)],
-    vals: &mut [f64],
-    work: &mut [&mut [f64]],
-    up: bool,
-    avx2: bool,
-) {
-    #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        // SAFETY: the caller checked that the CPU supports AVX2.
-        unsafe { apply_steps_split_avx2(steps, runs, vals, work, up) };
-        return;
-    }
-    let _ = avx2;
-    sweep_steps(steps, runs, vals, work, up);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn apply_steps_split_avx2(
-    steps: &[(usize, f64, f64, f64)],
-    runs: &[(usize, u32, u32)],
-    vals: &mut [f64],
-    work: &mut [&mut [f64]],
-    up: bool,
-) {
-    sweep_steps(steps, runs, vals, work, up);
 }
 
 /// The modifications `steps` in order over the rows `runs` of a column, four at a time:
@@ -356,7 +325,8 @@ fn sweep(
 }
 
 /// Applies the modifications `steps` (`(t, α, δ, γ)` in order) of one column to its
-/// off-diagonal values `vals` and the work vectors `work[t · u + slot]`, the rows given as
+/// off-diagonal values `vals` and the work vectors (`work[t][slot]`, restricted to the
+/// slots of `runs` — the whole union, or one half of a split column), the rows given as
 /// `runs` of consecutive slots. Modifications outer, rows inner: each row sees the
 /// modifications in the same order and with the same IEEE operations as the one-row
 /// recurrence (bit-identical results), but the rows of a sweep are independent and
@@ -366,22 +336,21 @@ fn apply_steps(
     steps: &[(usize, f64, f64, f64)],
     runs: &[(usize, u32, u32)],
     vals: &mut [f64],
-    work: &mut [f64],
-    u: usize,
+    work: &mut [&mut [f64]],
     up: bool,
     avx2: bool,
 ) {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
         // SAFETY: the caller checked that the CPU supports AVX2.
-        unsafe { apply_steps_avx2(steps, runs, vals, work, u, up) };
+        unsafe { apply_steps_avx2(steps, runs, vals, work, up) };
         return;
     }
     let _ = avx2;
-    apply_steps_impl(steps, runs, vals, work, u, up);
+    sweep_steps(steps, runs, vals, work, up);
 }
 
-/// [`apply_steps_impl`] compiled for AVX2 (the same IEEE operations, no FMA contraction:
+/// [`sweep_steps`] compiled for AVX2 (the same IEEE operations, no FMA contraction:
 /// bit-identical to the baseline build).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
@@ -389,24 +358,10 @@ fn apply_steps_avx2(
     steps: &[(usize, f64, f64, f64)],
     runs: &[(usize, u32, u32)],
     vals: &mut [f64],
-    work: &mut [f64],
-    u: usize,
+    work: &mut [&mut [f64]],
     up: bool,
 ) {
-    apply_steps_impl(steps, runs, vals, work, u, up);
-}
-
-#[inline(always)]
-fn apply_steps_impl(
-    steps: &[(usize, f64, f64, f64)],
-    runs: &[(usize, u32, u32)],
-    vals: &mut [f64],
-    work: &mut [f64],
-    u: usize,
-    up: bool,
-) {
-    let mut ws: Vec<&mut [f64]> = work.chunks_mut(u).collect();
-    sweep_steps(steps, runs, vals, &mut ws, up);
+    sweep_steps(steps, runs, vals, work, up);
 }
 
 impl Cholesky {
@@ -501,9 +456,17 @@ mod tests {
         for up in [true, false] {
             let (mut v1, mut w1) = (vals.clone(), work.clone());
             let (mut v2, mut w2) = (vals.clone(), work.clone());
-            apply_steps_impl(&steps, &runs, &mut v1, &mut w1, u, up);
+            sweep_steps(&steps, &runs, &mut v1, &mut w1.chunks_mut(u).collect::<Vec<_>>(), up);
             // SAFETY: AVX2 checked above.
-            unsafe { apply_steps_avx2(&steps, &runs, &mut v2, &mut w2, u, up) };
+            unsafe {
+                apply_steps_avx2(
+                    &steps,
+                    &runs,
+                    &mut v2,
+                    &mut w2.chunks_mut(u).collect::<Vec<_>>(),
+                    up,
+                )
+            };
             let same =
                 |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(p, q)| p.to_bits() == q.to_bits());
             assert!(same(&v1, &v2) && same(&w1, &w2));
