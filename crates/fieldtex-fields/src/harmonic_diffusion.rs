@@ -223,13 +223,12 @@ struct Block {
     factor: Option<Cholesky>,
     dirty: bool,
     failed: bool,
-    /// `raw` on this block solves the system of the last solve (full or incremental),
-    /// at least at the vertices marked in `CurveFieldSolver::current`.
-    solved: bool,
     /// Vertices that got their first penalty since the last solve (global indices).
     fresh: Vec<u32>,
-    /// A change an incremental solve does not cover (first factorisation, a target
-    /// moved by `Average`): the next solve of the block is a full one.
+    /// No full solve since the first factorisation, or a change an incremental solve
+    /// does not cover (a target moved by `Average`): the next solve of the block is a
+    /// full one. While false, `raw` solves the system of the last solve at the vertices
+    /// marked in `CurveFieldSolver::current`.
     needs_full: bool,
     /// The last solve was incremental: `raw` is stale outside its `needed` vertices.
     partial: bool,
@@ -424,7 +423,6 @@ impl<'m> CurveFieldSolver<'m> {
                     factor: None,
                     dirty: false,
                     failed: false,
-                    solved: false,
                     fresh: Vec::new(),
                     needs_full: true,
                     partial: false,
@@ -672,7 +670,6 @@ impl<'m> CurveFieldSolver<'m> {
             self.raw[v as usize] = [x[0][i], x[1][i], x[2][i]];
             self.current[v as usize] = true;
         }
-        block.solved = true;
         block.partial = false;
         block.fresh.clear();
         block.needs_full = false;
@@ -716,7 +713,6 @@ impl<'m> CurveFieldSolver<'m> {
             }
             let block = &self.blocks[c];
             let incremental = block.factor.is_some()
-                && block.solved
                 && !block.needs_full
                 && need_current
                 && block.fresh.iter().all(|&v| self.current[v as usize]);

@@ -111,45 +111,31 @@ impl SymbolicCholesky {
 
     /// As [`SymbolicCholesky::analyze`], with a forced factor layout.
     pub fn analyze_with(a: &SparseMatrix, layout: FactorLayout) -> Result<Self, LinalgError> {
-        let n = check_square(a)?;
         let threshold = match layout {
             FactorLayout::Auto => SupernodalThreshold::AUTO,
             FactorLayout::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
             FactorLayout::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
         };
-        let params = fc::CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: threshold,
-            ..Default::default()
-        };
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
-        let faer = fc::factorize_symbolic_cholesky(
-            pattern,
-            Side::Lower,
-            fc::SymmetricOrdering::Amd,
-            params,
-        )
-        .map_err(|e| LinalgError::FactorizationFailed {
-            size: n,
-            reason: format!("symbolic analysis failed: {e:?}"),
-        })?;
-        Ok(Self {
-            inner: Arc::new(SymbolicInner {
-                faer,
-                col_ptr: a.col_ptr().to_vec(),
-                row_idx: a.row_idx().to_vec(),
-            }),
-        })
+        Self::analyze_ordered(a, threshold, fc::SymmetricOrdering::Amd)
     }
 
     /// As [`SymbolicCholesky::analyze_with`], with a given fill-reducing ordering
     /// instead of AMD: `perm[k]` = original index of the `k`-th eliminated unknown (a
-    /// permutation of `0..n`, else [`LinalgError::InvalidArgument`]).
+    /// permutation of `0..n`, else [`LinalgError::InvalidArgument`]). `Auto` means
+    /// supernodal here (faer cannot estimate the flops of a given ordering).
     pub fn analyze_with_ordering(
         a: &SparseMatrix,
         layout: FactorLayout,
         perm: &[usize],
     ) -> Result<Self, LinalgError> {
         let n = check_square(a)?;
+        if perm.len() != n {
+            return Err(LinalgError::Dimension {
+                what: "ordering length",
+                expected: n,
+                found: perm.len(),
+            });
+        }
         let mut inv = vec![usize::MAX; n];
         for (k, &i) in perm.iter().enumerate() {
             if i >= n || inv[i] != usize::MAX {
@@ -161,33 +147,30 @@ impl SymbolicCholesky {
             }
             inv[i] = k;
         }
-        if perm.len() != n {
-            return Err(LinalgError::Dimension {
-                what: "ordering length",
-                expected: n,
-                found: perm.len(),
-            });
-        }
         let threshold = match layout {
             FactorLayout::Auto | FactorLayout::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
             FactorLayout::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
         };
+        let ordering = faer::perm::PermRef::new_checked(perm, &inv, n);
+        Self::analyze_ordered(a, threshold, fc::SymmetricOrdering::Custom(ordering))
+    }
+
+    fn analyze_ordered(
+        a: &SparseMatrix,
+        threshold: SupernodalThreshold,
+        ordering: fc::SymmetricOrdering<'_, usize>,
+    ) -> Result<Self, LinalgError> {
+        let n = check_square(a)?;
         let params = fc::CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: threshold,
             ..Default::default()
         };
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
-        let ordering = faer::perm::PermRef::new_checked(perm, &inv, n);
-        let faer = fc::factorize_symbolic_cholesky(
-            pattern,
-            Side::Lower,
-            fc::SymmetricOrdering::Custom(ordering),
-            params,
-        )
-        .map_err(|e| LinalgError::FactorizationFailed {
-            size: n,
-            reason: format!("symbolic analysis failed: {e:?}"),
-        })?;
+        let faer = fc::factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params)
+            .map_err(|e| LinalgError::FactorizationFailed {
+                size: n,
+                reason: format!("symbolic analysis failed: {e:?}"),
+            })?;
         Ok(Self {
             inner: Arc::new(SymbolicInner {
                 faer,

@@ -36,6 +36,8 @@ mod multiple_rank_update;
 mod partial_solve;
 mod sparse_matrix;
 mod supernodal_solve;
+#[cfg(test)]
+mod test_support;
 
 pub use cholesky::{Cholesky, CholeskyOptions, FactorLayout, SymbolicCholesky};
 pub use cholesky_update::UpdateSign;

@@ -47,6 +47,46 @@ impl DynamicFactor {
         out
     }
 
+    /// Forward solve `L y = b` for `b` given by `(permuted row, W values)`: only the
+    /// columns on the reach of the rows (module docs), in increasing order. Returns `y`
+    /// on the reach, indexed by `slot` (filled here; `u32::MAX` off the reach).
+    #[inline(always)]
+    fn forward_sparse<const W: usize>(
+        &self,
+        rhs: &[(usize, [f64; W])],
+        slot: &mut [u32],
+    ) -> Vec<[f64; W]> {
+        let forward = self.reach(rhs.iter().map(|&(i, _)| i), slot);
+        let mut y = vec![[0.0f64; W]; forward.len()];
+        for &(i, v) in rhs {
+            let s = slot[i] as usize;
+            for w in 0..W {
+                y[s][w] += v[w];
+            }
+        }
+        for (s, &j) in forward.iter().enumerate() {
+            let st = self.start[j];
+            let mut yj = y[s];
+            let d = self.vals[st];
+            for v in yj.iter_mut() {
+                *v /= d;
+            }
+            y[s] = yj;
+            let vals = &self.vals[st + 1..];
+            let (r0, rn) = self.run_ptr[j];
+            for &(q, r, m) in &self.runs[r0 as usize..(r0 + rn) as usize] {
+                let (q, m) = (q as usize, m as usize);
+                let base = slot[r as usize] as usize;
+                for (t, &lv) in y[base..base + m].iter_mut().zip(&vals[q..q + m]) {
+                    for w in 0..W {
+                        t[w] -= lv * yj[w];
+                    }
+                }
+            }
+        }
+        y
+    }
+
     /// Module docs; `rhs` as `(permuted row, k values)`, result row-major
     /// `needed.len() × k` for permuted `needed`.
     fn partial_solve(&self, rhs: &[(usize, [f64; 4])], needed: &[usize], k: usize) -> Vec<f64> {
@@ -81,34 +121,7 @@ impl DynamicFactor {
         const W: usize = 4;
         let n = self.n();
         let mut slot_f = vec![u32::MAX; n];
-        let forward = self.reach(rhs.iter().map(|&(i, _)| i), &mut slot_f);
-        let mut y = vec![[0.0f64; W]; forward.len()];
-        for &(i, v) in rhs {
-            let s = slot_f[i] as usize;
-            for w in 0..W {
-                y[s][w] += v[w];
-            }
-        }
-        for (s, &j) in forward.iter().enumerate() {
-            let st = self.start[j];
-            let mut yj = y[s];
-            let d = self.vals[st];
-            for v in yj.iter_mut() {
-                *v /= d;
-            }
-            y[s] = yj;
-            let vals = &self.vals[st + 1..];
-            let (r0, rn) = self.run_ptr[j];
-            for &(q, r, m) in &self.runs[r0 as usize..(r0 + rn) as usize] {
-                let (q, m) = (q as usize, m as usize);
-                let base = slot_f[r as usize] as usize;
-                for (t, &lv) in y[base..base + m].iter_mut().zip(&vals[q..q + m]) {
-                    for w in 0..W {
-                        t[w] -= lv * yj[w];
-                    }
-                }
-            }
-        }
+        let y = self.forward_sparse(rhs, &mut slot_f);
         let mut slot_b = vec![u32::MAX; n];
         let backward = self.reach(needed.iter().copied(), &mut slot_b);
         let mut z = vec![[0.0f64; W]; backward.len()];
@@ -238,25 +251,8 @@ impl DynamicFactor {
     fn solve_sparse_rhs_impl(&self, nz: &[(usize, f64)]) -> Vec<f64> {
         let n = self.n();
         let mut slot_f = vec![u32::MAX; n];
-        let forward = self.reach(nz.iter().map(|&(i, _)| i), &mut slot_f);
-        let mut y = vec![0.0f64; forward.len()];
-        for &(i, v) in nz {
-            y[slot_f[i] as usize] += v;
-        }
-        for (s, &j) in forward.iter().enumerate() {
-            let st = self.start[j];
-            let yj = y[s] / self.vals[st];
-            y[s] = yj;
-            let vals = &self.vals[st + 1..];
-            let (r0, rn) = self.run_ptr[j];
-            for &(q, r, m) in &self.runs[r0 as usize..(r0 + rn) as usize] {
-                let (q, m) = (q as usize, m as usize);
-                let base = slot_f[r as usize] as usize;
-                for (t, &lv) in y[base..base + m].iter_mut().zip(&vals[q..q + m]) {
-                    *t -= lv * yj;
-                }
-            }
-        }
+        let rhs: Vec<(usize, [f64; 1])> = nz.iter().map(|&(i, v)| (i, [v])).collect();
+        let y = self.forward_sparse(&rhs, &mut slot_f);
         let mut z = vec![0.0f64; n];
         for j in (0..n).rev() {
             let st = self.start[j];
@@ -276,7 +272,7 @@ impl DynamicFactor {
                     part[0] += lv * zv;
                 }
             }
-            let yj = if slot_f[j] == u32::MAX { 0.0 } else { y[slot_f[j] as usize] };
+            let yj = if slot_f[j] == u32::MAX { 0.0 } else { y[slot_f[j] as usize][0] };
             z[j] = (yj - ((part[0] + part[1]) + (part[2] + part[3]))) / self.vals[st];
         }
         let mut x = vec![0.0f64; n];
@@ -329,26 +325,11 @@ impl Cholesky {
 
 #[cfg(test)]
 mod tests {
+    use crate::test_support::penalised_grid;
     use crate::{Cholesky, FactorLayout, SparseMatrix, SymbolicCholesky};
 
     fn grid(side: usize) -> SparseMatrix {
-        let n = side * side;
-        let mut t = Vec::new();
-        for y in 0..side {
-            for x in 0..side {
-                let i = y * side + x;
-                for j in [(x + 1 < side).then(|| i + 1), (y + 1 < side).then(|| i + side)]
-                    .into_iter()
-                    .flatten()
-                {
-                    t.extend([(i, i, 1.0), (j, j, 1.0), (i, j, -1.0), (j, i, -1.0)]);
-                }
-                if i.is_multiple_of(53) {
-                    t.push((i, i, 1e8));
-                }
-            }
-        }
-        SparseMatrix::from_triplets(n, n, &t).unwrap()
+        penalised_grid(side, 53)
     }
 
     #[test]

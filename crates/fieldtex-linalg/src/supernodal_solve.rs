@@ -166,28 +166,14 @@ impl DynamicFactor {
 
 #[cfg(test)]
 mod tests {
+    use crate::test_support::penalised_grid;
     use crate::{Cholesky, FactorLayout, SparseMatrix, SymbolicCholesky};
 
     /// Penalised 5-point Laplacian of a `side × side` grid, supernodal factor taken over
     /// for updates (one penalty added).
     fn updated_factor(side: usize) -> (Cholesky, SparseMatrix) {
         let n = side * side;
-        let mut t = Vec::new();
-        for y in 0..side {
-            for x in 0..side {
-                let i = y * side + x;
-                for j in [(x + 1 < side).then(|| i + 1), (y + 1 < side).then(|| i + side)]
-                    .into_iter()
-                    .flatten()
-                {
-                    t.extend([(i, i, 1.0), (j, j, 1.0), (i, j, -1.0), (j, i, -1.0)]);
-                }
-                if i.is_multiple_of(37) {
-                    t.push((i, i, 1e8));
-                }
-            }
-        }
-        let a = SparseMatrix::from_triplets(n, n, &t).unwrap();
+        let a = penalised_grid(side, 37);
         let sym = SymbolicCholesky::analyze_with(&a, FactorLayout::Supernodal).unwrap();
         let mut f = Cholesky::factor_with(&sym, &a).unwrap();
         f.add_diagonal_penalty(5, 1e8).unwrap();
