@@ -89,6 +89,8 @@ pub(crate) struct DynamicFactor {
     /// factor); used by `crate::supernodal_solve` while [`DynamicFactor::faer_layout`]
     /// holds.
     pub(crate) supernodes: Vec<usize>,
+    /// Supernodes updated by the blocked form (`crate::blocked_update`), for tests.
+    pub(crate) blocked_count: usize,
 }
 
 impl DynamicFactor {
@@ -205,6 +207,7 @@ impl DynamicFactor {
             runs,
             run_ptr,
             supernodes,
+            blocked_count: 0,
         }
     }
 

@@ -27,6 +27,7 @@
 //!   parallel), and every reduction
 //!   has a fixed order, so results do not depend on the thread count.
 
+mod blocked_update;
 mod cholesky;
 mod cholesky_update;
 mod dense;
