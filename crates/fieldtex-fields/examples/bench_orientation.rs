@@ -286,11 +286,12 @@ fn main() {
     ratios.sort_by(f64::total_cmp);
     if !ratios.is_empty() {
         println!(
-            "INFO refactor_over_step_update min={:.1} median={:.1} refactor_over_rank1={:.0} steps_below_10x={}",
+            "INFO refactor_over_step_update min={:.1} median={:.1} refactor_over_rank1={:.0} steps_below_10x={} max_step_update_ms={:.1}",
             ratios[0],
             median(ratios.clone()),
             refactor_ms / per_rank1.max(1e-9),
-            ratios.iter().filter(|&&x| x < 10.0).count()
+            ratios.iter().filter(|&&x| x < 10.0).count(),
+            later.iter().map(|s| s.update_ms).fold(0.0, f64::max)
         );
     }
 

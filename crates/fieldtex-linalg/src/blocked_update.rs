@@ -44,6 +44,8 @@ use crate::cholesky_update::DynamicFactor;
 const PANEL: usize = 32;
 /// Rows per parallel chunk of the trailing update (fixed: thread-count independent).
 pub(crate) const CHUNK_ROWS: usize = 256;
+/// Scratch values per chunk: `S` and `S T`.
+const SCRATCH: usize = 2 * CHUNK_ROWS * PANEL;
 /// The blocked form is used for a supernode (suffix) of at least this many columns …
 const MIN_WIDTH: usize = 8;
 /// … with at least this many modifications passing through it …
@@ -95,25 +97,35 @@ impl DynamicFactor {
         }
         let row_slot: Vec<usize> =
             self.rows[s0..s0 + m].iter().map(|&r| self.slot[r as usize] as usize).collect();
-        let mut w = Mat::<f64>::zeros(m, k);
+        // reused buffers (no fresh pages per supernode): `W`, then the chunks' scratch
+        let mut buf = std::mem::take(&mut self.blocked_buf);
+        let n_chunks = (m - b.min(PANEL)).div_ceil(CHUNK_ROWS);
+        buf.clear();
+        buf.resize(m * k + n_chunks * SCRATCH, 0.0);
+        let (wbuf, scratch) = buf.split_at_mut(m * k);
         for (a, &t) in active.iter().enumerate() {
             let inv = 1.0 / beta[t];
-            let src = &work[t];
-            for (r, &sl) in row_slot.iter().enumerate() {
-                w[(r, a)] = src[sl] * inv;
+            let (src, col) = (&work[t], &mut wbuf[a * m..(a + 1) * m]);
+            for (x, &sl) in col.iter_mut().zip(&row_slot) {
+                *x = src[sl] * inv;
             }
         }
         let len = (b - 1) * ld + m;
         let l =
             MatMut::from_column_major_slice_with_stride_mut(&mut self.vals[s0..s0 + len], m, b, ld);
-        householder_update(l, w.as_mut())?;
-        for (a, &t) in active.iter().enumerate() {
-            let dst = &mut work[t];
-            for (r, &sl) in row_slot.iter().enumerate() {
-                dst[sl] = w[(r, a)];
+        let result =
+            householder_update(l, MatMut::from_column_major_slice_mut(wbuf, m, k), scratch);
+        if result.is_ok() {
+            for (a, &t) in active.iter().enumerate() {
+                let (dst, col) = (&mut work[t], &wbuf[a * m..(a + 1) * m]);
+                for (&x, &sl) in col.iter().zip(&row_slot) {
+                    dst[sl] = x;
+                }
+                beta[t] = 1.0;
             }
-            beta[t] = 1.0;
         }
+        self.blocked_buf = buf;
+        result?;
         self.blocked_count += 1;
         Ok(Blocked::Done(pos + b))
     }
@@ -133,6 +145,7 @@ pub(crate) enum Blocked {
 pub(crate) fn householder_update(
     mut l: MatMut<'_, f64>,
     mut w: MatMut<'_, f64>,
+    scratch: &mut [f64],
 ) -> Result<(), usize> {
     let (m, b, k) = (l.nrows(), l.ncols(), w.ncols());
     debug_assert!(w.nrows() == m && b <= m);
@@ -142,10 +155,7 @@ pub(crate) fn householder_update(
     // the panel's rows of `w`, row-major (`wp[i·k + a]`), for the unblocked part
     let mut wp = vec![0.0f64; PANEL * k];
     // per-chunk scratch `(S, S T)`, reused by every panel
-    let n_chunks = (m - b.min(PANEL)).div_ceil(CHUNK_ROWS);
-    let mut scratch: Vec<(Mat<f64>, Mat<f64>)> = (0..n_chunks)
-        .map(|_| (Mat::zeros(CHUNK_ROWS, PANEL), Mat::zeros(CHUNK_ROWS, PANEL)))
-        .collect();
+    debug_assert!(scratch.len() >= (m - b.min(PANEL)).div_ceil(CHUNK_ROWS) * SCRATCH);
     for p0 in (0..b).step_by(PANEL) {
         let pb = PANEL.min(b - p0);
         for i in 0..pb {
@@ -154,39 +164,7 @@ pub(crate) fn householder_update(
             }
         }
         // reflections of the panel's columns, applied at once to the panel's own rows
-        for i in 0..pb {
-            let c = p0 + i;
-            let alpha = l[(c, c)];
-            let (row, below) = wp[i * k..pb * k].split_at_mut(k);
-            let sigma: f64 = row.iter().map(|v| v * v).sum();
-            if sigma == 0.0 {
-                tau[i] = 0.0;
-                u.col_mut(i).fill(0.0);
-                continue;
-            }
-            let beta = (alpha * alpha + sigma).sqrt();
-            let v0 = -sigma / (alpha + beta);
-            if !(beta.is_finite() && v0 != 0.0 && v0.is_finite()) {
-                return Err(c);
-            }
-            let ui = u.col_mut(i).try_as_col_major_mut().expect("contiguous column").as_slice_mut();
-            for (ua, wa) in ui.iter_mut().zip(row.iter_mut()) {
-                *ua = *wa / v0;
-                *wa = 0.0;
-            }
-            let ti = -v0 / beta;
-            tau[i] = ti;
-            l[(c, c)] = beta;
-            for (q, wr) in below.chunks_exact_mut(k).enumerate() {
-                let r = c + 1 + q;
-                let s = l[(r, c)] + wr.iter().zip(ui.iter()).map(|(x, y)| x * y).sum::<f64>();
-                let ts = ti * s;
-                l[(r, c)] -= ts;
-                for (x, y) in wr.iter_mut().zip(ui.iter()) {
-                    *x -= ts * y;
-                }
-            }
-        }
+        reflect_panel_dispatch(l.as_mut(), &mut wp, &mut u, &mut tau, p0, pb, k)?;
         for i in 0..pb {
             for a in 0..k {
                 w[(p0 + i, a)] = 0.0;
@@ -228,26 +206,125 @@ pub(crate) fn householder_update(
         }
         chunks
             .into_par_iter()
-            .zip(scratch.par_iter_mut())
+            .zip(scratch.par_chunks_mut(SCRATCH))
             .for_each(|((lc, wc), sc)| apply_block(lc, wc, ur, tr, sc));
     }
     Ok(())
 }
 
+/// The reflections of the panel `p0 .. p0 + pb` from its own rows (`wp`: those rows of
+/// `W`, row-major `pb × k`), applied to those rows; fills `u`'s first `pb` columns and
+/// `tau`. Runs the AVX2 build when the CPU has it (the same IEEE operations, no FMA:
+/// bit-identical).
+fn reflect_panel_dispatch(
+    l: MatMut<'_, f64>,
+    wp: &mut [f64],
+    u: &mut Mat<f64>,
+    tau: &mut [f64],
+    p0: usize,
+    pb: usize,
+    k: usize,
+) -> Result<(), usize> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 support was just checked.
+        return unsafe { reflect_panel_avx2(l, wp, u, tau, p0, pb, k) };
+    }
+    reflect_panel(l, wp, u, tau, p0, pb, k)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn reflect_panel_avx2(
+    l: MatMut<'_, f64>,
+    wp: &mut [f64],
+    u: &mut Mat<f64>,
+    tau: &mut [f64],
+    p0: usize,
+    pb: usize,
+    k: usize,
+) -> Result<(), usize> {
+    reflect_panel(l, wp, u, tau, p0, pb, k)
+}
+
+#[inline(always)]
+fn reflect_panel(
+    mut l: MatMut<'_, f64>,
+    wp: &mut [f64],
+    u: &mut Mat<f64>,
+    tau: &mut [f64],
+    p0: usize,
+    pb: usize,
+    k: usize,
+) -> Result<(), usize> {
+    for i in 0..pb {
+        let c = p0 + i;
+        let alpha = l[(c, c)];
+        let (row, below) = wp[i * k..pb * k].split_at_mut(k);
+        let sigma = dot(row, row);
+        if sigma == 0.0 {
+            tau[i] = 0.0;
+            u.col_mut(i).fill(0.0);
+            continue;
+        }
+        let beta = (alpha * alpha + sigma).sqrt();
+        let v0 = -sigma / (alpha + beta);
+        if !(beta.is_finite() && v0 != 0.0 && v0.is_finite()) {
+            return Err(c);
+        }
+        let ui = u.col_mut(i).try_as_col_major_mut().expect("contiguous column").as_slice_mut();
+        for (ua, wa) in ui.iter_mut().zip(row.iter_mut()) {
+            *ua = *wa / v0;
+            *wa = 0.0;
+        }
+        let ti = -v0 / beta;
+        tau[i] = ti;
+        l[(c, c)] = beta;
+        for (q, wr) in below.chunks_exact_mut(k).enumerate() {
+            let r = c + 1 + q;
+            let ts = ti * (l[(r, c)] + dot(wr, ui));
+            l[(r, c)] -= ts;
+            for (x, y) in wr.iter_mut().zip(ui.iter()) {
+                *x -= ts * y;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `Σ aᵢ bᵢ` with eight independent partial sums (fixed order: vectorisable and
+/// deterministic).
+#[inline(always)]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for q in 0..8 {
+            acc[q] += x[q] * y[q];
+        }
+    }
+    for (q, (x, y)) in ra.iter().zip(rb).enumerate() {
+        acc[q] += x * y;
+    }
+    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]))
+}
+
 /// `[L_p W] ← [L_p W] (I − V T Vᵀ)` with `V = [I; U]` for one chunk of rows (`scratch`:
-/// two buffers of at least the chunk's size).
+/// [`SCRATCH`] values).
 fn apply_block(
     mut lc: MatMut<'_, f64>,
     mut wc: MatMut<'_, f64>,
     u: MatRef<'_, f64>,
     t: MatRef<'_, f64>,
-    scratch: &mut (Mat<f64>, Mat<f64>),
+    scratch: &mut [f64],
 ) {
     let (h, pb) = (lc.nrows(), lc.ncols());
-    let mut s = scratch.0.as_mut().submatrix_mut(0, 0, h, pb);
+    let (s, st) = scratch.split_at_mut(CHUNK_ROWS * PANEL);
+    let mut s = MatMut::from_column_major_slice_mut(&mut s[..h * pb], h, pb);
     s.copy_from(lc.as_ref());
     matmul(s.as_mut(), Accum::Add, wc.as_ref(), u, 1.0, Par::Seq);
-    let mut st = scratch.1.as_mut().submatrix_mut(0, 0, h, pb);
+    let mut st = MatMut::from_column_major_slice_mut(&mut st[..h * pb], h, pb);
     matmul(st.as_mut(), Accum::Replace, s.as_ref(), t, 1.0, Par::Seq);
     for c in 0..pb {
         for r in 0..h {
@@ -338,7 +415,8 @@ mod tests {
             }
             let before = &l * l.transpose() + &w * w.transpose();
             let (mut l2, mut w2) = (l.clone(), w.clone());
-            householder_update(l2.as_mut(), w2.as_mut()).expect("finite");
+            let mut scratch = vec![0.0; m.div_ceil(CHUNK_ROWS) * SCRATCH];
+            householder_update(l2.as_mut(), w2.as_mut(), &mut scratch).expect("finite");
             let after = &l2 * l2.transpose() + &w2 * w2.transpose();
             let scale = before.norm_max();
             // only the rows/cols ≥ 0 within the trapezoid's reach are comparable: all of

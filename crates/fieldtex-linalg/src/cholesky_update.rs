@@ -91,6 +91,9 @@ pub(crate) struct DynamicFactor {
     pub(crate) supernodes: Vec<usize>,
     /// Supernodes updated by the blocked form (`crate::blocked_update`), for tests.
     pub(crate) blocked_count: usize,
+    /// Reused buffers of the multiple-rank update (work vectors) and of the blocked form.
+    pub(crate) multi_buf: Vec<f64>,
+    pub(crate) blocked_buf: Vec<f64>,
 }
 
 impl DynamicFactor {
@@ -208,6 +211,8 @@ impl DynamicFactor {
             run_ptr,
             supernodes,
             blocked_count: 0,
+            multi_buf: Vec::new(),
+            blocked_buf: Vec::new(),
         }
     }
 

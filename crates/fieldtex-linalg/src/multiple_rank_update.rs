@@ -91,11 +91,13 @@ impl DynamicFactor {
         }
         // work vectors column-major by modification: `work[t · u + slot]`
         let u = union.len();
-        let mut work = vec![0.0f64; u * k];
+        let mut buf = std::mem::take(&mut self.multi_buf);
+        buf.clear();
+        buf.resize(u * k, 0.0);
         for (t, &(f, v)) in cols.iter().enumerate() {
-            work[t * u + self.slot[f] as usize] = v;
+            buf[t * u + self.slot[f] as usize] = v;
         }
-        let mut work: Vec<&mut [f64]> = work.chunks_mut(u).collect();
+        let mut work: Vec<&mut [f64]> = buf.chunks_mut(u).collect();
         let mut beta = vec![1.0f64; k];
         let sigma = if up { 1.0 } else { -1.0 };
         // per column: the modifications that change it, with their `(t, α, δ, γ)`
@@ -207,6 +209,8 @@ impl DynamicFactor {
                 }
             }
         }
+        drop(work);
+        self.multi_buf = buf;
         for &j in &union {
             self.slot[j] = NO_SLOT;
         }
