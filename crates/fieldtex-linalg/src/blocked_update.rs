@@ -98,7 +98,7 @@ impl DynamicFactor {
         let row_slot: Vec<usize> =
             self.rows[s0..s0 + m].iter().map(|&r| self.slot[r as usize] as usize).collect();
         // reused buffers (no fresh pages per supernode): `W`, then the chunks' scratch
-        let mut buf = std::mem::take(&mut self.blocked_buf);
+        let mut buf = std::mem::take(&mut self.blocked_buf.0);
         let n_chunks = (m - b.min(PANEL)).div_ceil(CHUNK_ROWS);
         buf.clear();
         buf.resize(m * k + n_chunks * SCRATCH, 0.0);
@@ -124,7 +124,7 @@ impl DynamicFactor {
                 beta[t] = 1.0;
             }
         }
-        self.blocked_buf = buf;
+        self.blocked_buf.0 = buf;
         result?;
         self.blocked_count += 1;
         Ok(Blocked::Done(pos + b))

@@ -91,9 +91,20 @@ pub(crate) struct DynamicFactor {
     pub(crate) supernodes: Vec<usize>,
     /// Supernodes updated by the blocked form (`crate::blocked_update`), for tests.
     pub(crate) blocked_count: usize,
-    /// Reused buffers of the multiple-rank update (work vectors) and of the blocked form.
-    pub(crate) multi_buf: Vec<f64>,
-    pub(crate) blocked_buf: Vec<f64>,
+    /// Reused buffers of the multiple-rank update (work vectors) and of the blocked form
+    /// (a clone of the factor starts with empty ones).
+    pub(crate) multi_buf: Scratch,
+    pub(crate) blocked_buf: Scratch,
+}
+
+/// A reusable buffer that is not copied when its owner is cloned.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch(pub(crate) Vec<f64>);
+
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Self(Vec::new())
+    }
 }
 
 impl DynamicFactor {
@@ -211,8 +222,8 @@ impl DynamicFactor {
             run_ptr,
             supernodes,
             blocked_count: 0,
-            multi_buf: Vec::new(),
-            blocked_buf: Vec::new(),
+            multi_buf: Scratch::default(),
+            blocked_buf: Scratch::default(),
         }
     }
 

@@ -91,7 +91,7 @@ impl DynamicFactor {
         }
         // work vectors column-major by modification: `work[t · u + slot]`
         let u = union.len();
-        let mut buf = std::mem::take(&mut self.multi_buf);
+        let mut buf = std::mem::take(&mut self.multi_buf.0);
         buf.clear();
         buf.resize(u * k, 0.0);
         for (t, &(f, v)) in cols.iter().enumerate() {
@@ -210,7 +210,7 @@ impl DynamicFactor {
             }
         }
         drop(work);
-        self.multi_buf = buf;
+        self.multi_buf.0 = buf;
         for &j in &union {
             self.slot[j] = NO_SLOT;
         }
