@@ -233,6 +233,9 @@ impl DynamicFactor {
     /// `x = A⁻¹ b` (original order) for `b` given by its nonzeros `(permuted row, value)`:
     /// forward solve on the reach of the nonzeros only, backward solve over every column.
     fn solve_sparse_rhs(&self, nz: &[(usize, f64)]) -> Vec<f64> {
+        if self.has_supernodal_layout() {
+            return self.solve_sparse_rhs_supernodal(nz);
+        }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked above).
