@@ -254,6 +254,12 @@ impl FieldDesign {
     pub fn rank1_update_count(&self) -> usize {
         self.factor.rank1_update_count
     }
+    /// Number of stroke edits that rebuilt the factor from the kept checkpoint factor
+    /// (a copy plus one multiple-rank update, instead of downdates;
+    /// [`crate::design_factor`]).
+    pub fn checkpoint_restore_count(&self) -> usize {
+        self.factor.restore_count
+    }
     /// Magnitude scale of singularity model fields: a quarter of `sqrt(area)`.
     pub fn reference_radius(&self) -> f64 {
         self.reference_radius
