@@ -2,7 +2,7 @@
 //! the supernodes on the reach of the nonzeros, backward pass over all): equal to the
 //! ordinary solve and to a fresh factor's solve after multiple-rank updates and
 //! downdates, for right-hand sides at leaves, at the root and spread out; bit-identical
-//! for 1 and 2 threads.
+//! for 1 and 2 threads. `Cholesky::copy_from` gives the same factor as a clone.
 
 mod common;
 use common::*;
@@ -86,4 +86,44 @@ fn supernodal_sparse_solve_is_identical_for_one_and_two_threads() {
     for (p, q) in one.iter().zip(&two) {
         assert!(p.iter().zip(q).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
+}
+
+/// Bit patterns of the solutions of `f` for the sparse right-hand sides.
+fn solution_bits(f: &mut Cholesky, n: usize) -> Vec<u64> {
+    let mut out = Vec::new();
+    for b in sparse_rhs(n) {
+        out.extend(f.solve_sparse_with_residual(&b).unwrap().0.iter().map(|v| v.to_bits()));
+        out.extend(f.solve(&b).unwrap().iter().map(|v| v.to_bits()));
+    }
+    out
+}
+
+#[test]
+fn copy_from_equals_a_clone_and_stays_updatable() {
+    let side = 32;
+    let n = side * side;
+    let (src, _) = supernodal_factor(side, &[(40, 1.0), (500, 2.0), (1000, 0.5)]);
+    // into an updatable factor of the same analysis with other values (values copied)
+    let (mut dst, _) = supernodal_factor(side, &[(7, 3.0), (300, 4.0)]);
+    dst.copy_from(&src);
+    let mut reference = src.clone();
+    assert_eq!(solution_bits(&mut dst, n), solution_bits(&mut reference, n));
+    // both keep updating alike
+    dst.add_diagonal_penalties(&[(600, 1.5), (601, 1.5)]).unwrap();
+    reference.add_diagonal_penalties(&[(600, 1.5), (601, 1.5)]).unwrap();
+    assert_eq!(solution_bits(&mut dst, n), solution_bits(&mut reference, n));
+    // into factors of another layout or not yet updatable: a clone
+    let a = penalty_system(side, side, &every(n, 11), 2.0);
+    for layout in [FactorLayout::Simplicial, FactorLayout::Supernodal] {
+        let sym = SymbolicCholesky::analyze_with(&a, layout).unwrap();
+        let mut other = Cholesky::factor_with(&sym, &a).unwrap();
+        other.copy_from(&src);
+        let mut reference = src.clone();
+        assert_eq!(solution_bits(&mut other, n), solution_bits(&mut reference, n));
+    }
+    // from a factor never updated
+    let fresh = Cholesky::factor(&a).unwrap();
+    let mut dst2 = src.clone();
+    dst2.copy_from(&fresh);
+    assert_eq!(dst2.solve(&vec![1.0; n]).unwrap(), fresh.solve(&vec![1.0; n]).unwrap());
 }
