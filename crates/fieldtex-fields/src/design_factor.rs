@@ -156,12 +156,17 @@ impl DesignFactor {
                 && c_ups.len() <= limit
                 && c.updates_since_factor + c_ups.len() <= drift_limit
             {
-                let mut factor = c.factor.clone();
-                factor.add_diagonal_penalties(&c_ups)?;
+                let factor = self.factor.as_mut().expect("checked");
+                // into the current factor's buffers (no fresh pages)
+                factor.copy_from(&c.factor);
+                if let Err(e) = factor.add_diagonal_penalties(&c_ups) {
+                    // the factor is the checkpoint's now: refactor on the next sync
+                    self.factor = None;
+                    return Err(e.into());
+                }
                 self.updates_since_factor = c.updates_since_factor + c_ups.len();
                 self.rank1_update_count += c_ups.len();
                 self.restore_count += 1;
-                self.factor = Some(factor);
                 self.factored_diag.copy_from_slice(diag);
                 return Ok(());
             }
@@ -194,11 +199,20 @@ impl DesignFactor {
         let mut factor = Cholesky::factor_with(&self.symbolic, &a)?.with_options(options);
         // take it over for updates now (the first solve would), so the checkpoint is too
         factor.prepare_updates()?;
-        self.checkpoint = Some(Checkpoint {
-            factor: factor.clone(),
-            diag: diag.to_vec(),
-            updates_since_factor: 0,
-        });
+        match &mut self.checkpoint {
+            Some(c) => {
+                c.factor.copy_from(&factor);
+                c.diag.copy_from_slice(diag);
+                c.updates_since_factor = 0;
+            }
+            None => {
+                self.checkpoint = Some(Checkpoint {
+                    factor: factor.clone(),
+                    diag: diag.to_vec(),
+                    updates_since_factor: 0,
+                })
+            }
+        }
         self.factor = Some(factor);
         self.factored_diag.copy_from_slice(diag);
         self.refactor_count += 1;
@@ -220,12 +234,22 @@ impl DesignFactor {
                 behind > RESTORE_COST || c.updates_to(new_diag).is_none()
             }
         };
-        if stale {
-            self.checkpoint = Some(Checkpoint {
-                factor: factor.clone(),
-                diag: self.factored_diag.clone(),
-                updates_since_factor: self.updates_since_factor,
-            });
+        if !stale {
+            return;
+        }
+        match &mut self.checkpoint {
+            Some(c) => {
+                c.factor.copy_from(factor);
+                c.diag.copy_from_slice(&self.factored_diag);
+                c.updates_since_factor = self.updates_since_factor;
+            }
+            None => {
+                self.checkpoint = Some(Checkpoint {
+                    factor: factor.clone(),
+                    diag: self.factored_diag.clone(),
+                    updates_since_factor: self.updates_since_factor,
+                })
+            }
         }
     }
 }
