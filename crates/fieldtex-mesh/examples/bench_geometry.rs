@@ -7,7 +7,9 @@
 //! 388,128 triangles (the size of the refined horse of the benchmark suite). With a
 //! path, the OBJ's `v`/`f` lines are read (polygons fanned) and refined `N` times
 //! (default 0). `--rays-only` runs only the BVH entries, `--threads` sets the pool size
-//! (default 2), `--reps` the number of timed runs of each ray entry (default 3). Prints `BENCH name key=value` lines; ray entries also give `cpu_value`,
+//! (default 2), `--reps` the number of timed runs of each ray entry (default 3),
+//! `--only build|closest|any` runs just that entry (for profiling; implies `--rays-only`),
+//! `--rays N` casts `N` rays instead of 1,000,000. Prints `BENCH name key=value` lines; ray entries also give `cpu_value`,
 //! the rate per CPU-second of this process times the thread count (Linux only), which
 //! is less sensitive to other processes loading the machine than the wall-clock rate, and
 //! `best_value`, the wall-clock rate of the fastest run.
@@ -117,6 +119,8 @@ fn main() {
     let mut threads = 2usize;
     let mut rays_only = false;
     let mut reps = 3usize;
+    let mut only: Option<String> = None;
+    let mut n_rays = 1_000_000u64;
     let mut i = 0;
     while i < args.len() {
         if args[i] == "--refine" {
@@ -127,6 +131,13 @@ fn main() {
             i += 2;
         } else if args[i] == "--reps" {
             reps = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(3).max(1);
+            i += 2;
+        } else if args[i] == "--rays" {
+            n_rays = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(n_rays);
+            i += 2;
+        } else if args[i] == "--only" {
+            only = args.get(i + 1).cloned();
+            rays_only = true;
             i += 2;
         } else if args[i] == "--rays-only" {
             rays_only = true;
@@ -157,22 +168,29 @@ fn main() {
         if !rays_only {
             bench_other(&mesh);
         }
-        let ms = median_ms(5, || {
-            std::hint::black_box(Bvh::build(&mesh).unwrap());
-        });
-        println!("BENCH bvh_build median_ms={ms:.2}");
+        let run = |name: &str| only.as_deref().is_none_or(|o| o == name);
+        if run("build") {
+            let ms = median_ms(5, || {
+                std::hint::black_box(Bvh::build(&mesh).unwrap());
+            });
+            println!("BENCH bvh_build median_ms={ms:.2}");
+        }
         let bvh = Bvh::build(&mesh).unwrap();
-        let rays = random_rays(&mesh, 1_000_000);
-        let mut hits = 0;
-        let m = median_ms_cpu(reps, || {
-            hits = bvh.intersect_many(&rays).iter().filter(|h| h.is_some()).count();
-        });
-        println!("hit fraction {:.3}", hits as f64 / rays.len() as f64);
-        println!("BENCH rays_per_s {}", rate(rays.len(), m));
-        let m = median_ms_cpu(reps, || {
-            std::hint::black_box(bvh.occluded_many(&rays));
-        });
-        println!("BENCH any_hit_rays_per_s {}", rate(rays.len(), m));
+        let rays = random_rays(&mesh, n_rays);
+        if run("closest") {
+            let mut hits = 0;
+            let m = median_ms_cpu(reps, || {
+                hits = bvh.intersect_many(&rays).iter().filter(|h| h.is_some()).count();
+            });
+            println!("hit fraction {:.3}", hits as f64 / rays.len() as f64);
+            println!("BENCH rays_per_s {}", rate(rays.len(), m));
+        }
+        if run("any") {
+            let m = median_ms_cpu(reps, || {
+                std::hint::black_box(bvh.occluded_many(&rays));
+            });
+            println!("BENCH any_hit_rays_per_s {}", rate(rays.len(), m));
+        }
         if !rays_only {
             bench_poisson(&mesh);
         }

@@ -8,6 +8,7 @@
 //! The order only changes speed, never results: every ray is still answered on its own.
 
 use super::Ray;
+use super::bvh_wide::huge_with_capacity;
 use fieldtex_core::vec3::V3;
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -58,7 +59,7 @@ pub(super) fn map_coherent<T: Copy + Default + Send + Sync>(
     }
     let c = Vec3A::new(centre[0] as f32, centre[1] as f32, centre[2] as f32);
     let ih = Vec3A::new(inv_half[0] as f32, inv_half[1] as f32, inv_half[2] as f32);
-    let mut out = Vec::with_capacity(rays.len());
+    let mut out = huge_with_capacity(rays.len());
     for block in rays.chunks(u32::MAX as usize) {
         map_block(block, c, ih, &f, &mut out);
     }
@@ -66,6 +67,12 @@ pub(super) fn map_coherent<T: Copy + Default + Send + Sync>(
 }
 
 /// [`map_coherent`] for at most `u32::MAX` rays, results appended to `out`.
+///
+/// All large buffers live on huge pages ([`huge_with_capacity`]): the gather of the rays
+/// and the scatter of the results touch them at random, and with 4 KiB pages nearly
+/// every such access is also a TLB miss (a costly one in a virtual machine). The rays are
+/// therefore first copied, in input order, into such a buffer (in the same pass as the
+/// keys), and the results are written straight into `out`'s reserved memory.
 fn map_block<T: Copy + Default + Send + Sync>(
     block: &[Ray],
     c: Vec3A,
@@ -73,23 +80,36 @@ fn map_block<T: Copy + Default + Send + Sync>(
     f: &(impl Fn(&[Ray], &mut [T]) + Sync + Send),
     out: &mut Vec<T>,
 ) {
+    const PART: usize = 4096;
     let n = block.len();
-    let keys: Vec<u64> = block
-        .par_iter()
+    let mut keys: Vec<u64> = huge_with_capacity(n);
+    let mut staged: Vec<Ray> = huge_with_capacity(n);
+    block
+        .par_chunks(PART)
+        .zip(keys.spare_capacity_mut()[..n].par_chunks_mut(PART))
+        .zip(staged.spare_capacity_mut()[..n].par_chunks_mut(PART))
         .enumerate()
-        .with_min_len(4096)
-        .map(|(i, r)| (u64::from(ray_key(r, c, ih)) << 32) | i as u64)
-        .collect();
+        .for_each(|(ci, ((rs, ks), ss))| {
+            for (j, ((r, k), s)) in rs.iter().zip(ks).zip(ss).enumerate() {
+                k.write((u64::from(ray_key(r, c, ih)) << 32) | (ci * PART + j) as u64);
+                s.write(*r);
+            }
+        });
+    // SAFETY: the chunks above cover `0..n` of both buffers, so every element is written.
+    unsafe {
+        keys.set_len(n);
+        staged.set_len(n);
+    }
     let keys = radix_sort(keys);
     // Answer in sorted order, each result written straight to its input position.
     let base = out.len();
-    out.par_extend(rayon::iter::repeat_n(T::default(), n));
-    let dst = OutPtr(out[base..].as_mut_ptr());
+    out.reserve(n);
+    let dst = OutPtr(out.spare_capacity_mut()[..n].as_mut_ptr().cast::<T>());
     keys.par_chunks(CHUNK).for_each(|ks| {
-        // Gather first: independent loads overlap, unlike loads inside traversal.
+        // Gather first: independent loads that overlap, unlike loads inside traversal.
         let mut local = [Ray::new([0.0; 3], [0.0; 3]); CHUNK];
         for (l, &k) in local.iter_mut().zip(ks) {
-            *l = block[k as u32 as usize];
+            *l = staged[k as u32 as usize];
         }
         let mut res = [T::default(); CHUNK];
         f(&local[..ks.len()], &mut res[..ks.len()]);
@@ -100,6 +120,9 @@ fn map_block<T: Copy + Default + Send + Sync>(
             unsafe { dst.write(k as u32 as usize, n, r) };
         }
     });
+    // SAFETY: the `n` elements after `base` were all written (the indices of the keys are
+    // a permutation of `0..n`, and a panic in `f` would have ended this function before).
+    unsafe { out.set_len(base + n) };
 }
 
 /// The output of a batch, written by all tasks at disjoint positions.
@@ -135,7 +158,8 @@ fn radix_sort(mut a: Vec<u64>) -> Vec<u64> {
     const PARTS: usize = 16;
     let n = a.len();
     let part = n.div_ceil(PARTS).max(1);
-    let mut b = vec![0u64; n];
+    let mut b: Vec<u64> = huge_with_capacity(n);
+    b.resize(n, 0);
     for pass in 0..(5 * BITS).div_ceil(RADIX) {
         let shift = 32 + pass * RADIX;
         let digit = |x: u64| ((x >> shift) as usize) & (NB - 1);
@@ -191,7 +215,7 @@ fn ray_key(r: &Ray, centre: Vec3A, inv_half: Vec3A) -> u32 {
         return MISS;
     }
     let p = o + d * t0;
-    let q = |x: f32| SPREAD[(((x.clamp(-1.0, 1.0) + 1.0) * 32.0) as usize).min(63)];
+    let q = |x: f32| SPREAD[(((x.clamp(-1.0, 1.0) + 1.0) * 32.0) as i32).clamp(0, 63) as usize];
     // Octahedral map of the direction to [-1, 1]².
     let (x, y) = (dir.x / s, dir.y / s);
     let (u, w) = if dir.z >= 0.0 {

@@ -114,6 +114,72 @@ impl RayBoxes {
         }
         (tns, mask)
     }
+
+    /// [`RayBoxes::test`] with 8-lane AVX registers: the same operations in the same
+    /// order on every lane, so the same results.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2. Meant to be inlined into functions compiled for AVX2
+    /// (the intrinsics are inlined there; elsewhere, as in tests, each is a call).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn test_avx2(&self, n: &Node, tlimit: f32) -> ([f32; W], u32) {
+        use std::arch::x86_64::*;
+        const GROW: f32 = 1.0 + 2.0 * 3.0 * (f32::EPSILON * 0.5) * 1.000_001;
+        const { assert!(W == 8) };
+        let mut tns = [0.0; W];
+        // SAFETY: the caller guarantees AVX2; `near` and `far` hold bound indices below 6
+        // (`RayBoxes::new`), so every row read is one of `n.b`'s 8-float rows, and `tns`
+        // holds 8 floats.
+        let mask = unsafe {
+            let slab = |k: usize, i: usize| {
+                _mm256_mul_ps(
+                    _mm256_sub_ps(
+                        _mm256_loadu_ps(n.b.get_unchecked(i).as_ptr()),
+                        _mm256_set1_ps(self.org[k].x),
+                    ),
+                    _mm256_set1_ps(self.inv[k].x),
+                )
+            };
+            let tn = _mm256_max_ps(
+                _mm256_max_ps(slab(0, self.near[0]), slab(1, self.near[1])),
+                _mm256_max_ps(slab(2, self.near[2]), _mm256_set1_ps(self.tmin)),
+            );
+            let tf = _mm256_mul_ps(
+                _mm256_min_ps(
+                    _mm256_min_ps(slab(0, self.far[0]), slab(1, self.far[1])),
+                    slab(2, self.far[2]),
+                ),
+                _mm256_set1_ps(GROW),
+            );
+            let tf = _mm256_min_ps(tf, _mm256_set1_ps(tlimit));
+            _mm256_storeu_ps(tns.as_mut_ptr(), tn);
+            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as u32
+        };
+        (tns, mask)
+    }
+
+    /// [`RayBoxes::test`] on AVX2 lanes when `AVX` (the caller checked the CPU).
+    #[inline(always)]
+    fn test_on<const AVX: bool>(&self, n: &Node, tlimit: f32) -> ([f32; W], u32) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: `AVX` is only set after the CPU was found to support AVX2.
+            return unsafe { self.test_avx2(n, tlimit) };
+        }
+        self.test(n, tlimit)
+    }
+}
+
+/// Whether the AVX2 box test may be used (checked once, cached by the standard library).
+#[inline(always)]
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    false
 }
 
 /// A copy of `v` in memory that the kernel is asked to back by huge pages (Linux
@@ -121,11 +187,19 @@ impl RayBoxes {
 /// touches these arrays at random, and with 4 KiB pages nearly every access to the lower
 /// tree levels is also a TLB miss.
 pub(super) fn huge_copy<T: Copy>(v: &[T]) -> Vec<T> {
-    let mut out: Vec<T> = Vec::with_capacity(v.len());
+    let mut out = huge_with_capacity(v.len());
+    out.extend_from_slice(v);
+    out
+}
+
+/// An empty vector with room for `n` elements, whose memory the kernel is asked to back
+/// by huge pages (see [`huge_copy`]); fill it without reallocating.
+pub(super) fn huge_with_capacity<T>(n: usize) -> Vec<T> {
+    let out: Vec<T> = Vec::with_capacity(n);
     #[cfg(target_os = "linux")]
     {
         const HUGE: usize = 1 << 21;
-        let bytes = size_of_val(v);
+        let bytes = n * size_of::<T>();
         if bytes >= 2 * HUGE {
             let start = out.as_ptr() as usize;
             let a = start.next_multiple_of(HUGE);
@@ -138,7 +212,6 @@ pub(super) fn huge_copy<T: Copy>(v: &[T]) -> Vec<T> {
             }
         }
     }
-    out.extend_from_slice(v);
     out
 }
 
@@ -292,29 +365,88 @@ impl WideBvh {
         ids: &[u32],
         refine: &[R],
     ) -> Option<(u32, f32)> {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx2() {
+            // SAFETY: the CPU supports AVX2 (checked).
+            return unsafe { self.closest_avx2(rb, shear, tris, ids, refine) };
+        }
+        self.closest_impl::<false, R>(rb, shear, tris, ids, refine)
+    }
+
+    /// [`WideBvh::closest`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn closest_avx2<R>(
+        &self,
+        rb: &RayBoxes,
+        shear: &mut Shear,
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+    ) -> Option<(u32, f32)> {
+        self.closest_impl::<true, R>(rb, shear, tris, ids, refine)
+    }
+
+    #[inline(always)]
+    fn closest_impl<const AVX: bool, R>(
+        &self,
+        rb: &RayBoxes,
+        shear: &mut Shear,
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+    ) -> Option<(u32, f32)> {
         if self.stack_len <= FIXED_STACK {
             let mut stack = [Entry::default(); FIXED_STACK];
-            self.closest_with(rb, shear, tris, ids, refine, &mut stack)
+            self.closest_with::<AVX, R>(rb, shear, tris, ids, refine, &mut stack)
         } else {
             let mut stack = vec![Entry::default(); self.stack_len];
-            self.closest_with(rb, shear, tris, ids, refine, &mut stack)
+            self.closest_with::<AVX, R>(rb, shear, tris, ids, refine, &mut stack)
         }
     }
 
     /// Whether any triangle is hit within `[shear.tmin, shear.tmax]`.
     #[inline]
     pub(super) fn any(&self, rb: &RayBoxes, shear: &Shear, tris: &[RowTriangle]) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx2() {
+            // SAFETY: the CPU supports AVX2 (checked).
+            return unsafe { self.any_avx2(rb, shear, tris) };
+        }
+        self.any_impl::<false>(rb, shear, tris)
+    }
+
+    /// [`WideBvh::any`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn any_avx2(&self, rb: &RayBoxes, shear: &Shear, tris: &[RowTriangle]) -> bool {
+        self.any_impl::<true>(rb, shear, tris)
+    }
+
+    #[inline(always)]
+    fn any_impl<const AVX: bool>(
+        &self,
+        rb: &RayBoxes,
+        shear: &Shear,
+        tris: &[RowTriangle],
+    ) -> bool {
         if self.stack_len <= FIXED_STACK {
             let mut stack = [Entry::default(); FIXED_STACK];
-            self.any_with(rb, shear, tris, &mut stack)
+            self.any_with::<AVX>(rb, shear, tris, &mut stack)
         } else {
             let mut stack = vec![Entry::default(); self.stack_len];
-            self.any_with(rb, shear, tris, &mut stack)
+            self.any_with::<AVX>(rb, shear, tris, &mut stack)
         }
     }
 
     #[inline(always)]
-    fn closest_with<R>(
+    fn closest_with<const AVX: bool, R>(
         &self,
         rb: &RayBoxes,
         shear: &mut Shear,
@@ -327,7 +459,7 @@ impl WideBvh {
             return None;
         }
         let mut st = Closest::new(shear.tmax);
-        while self.closest_step(&mut st, rb, shear, tris, ids, refine, stack) {}
+        while self.closest_step::<AVX, R>(&mut st, rb, shear, tris, ids, refine, stack) {}
         st.best
     }
 
@@ -342,10 +474,42 @@ impl WideBvh {
         ids: &[u32],
         refine: &[R],
     ) {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx2() {
+            // SAFETY: the CPU supports AVX2 (checked).
+            return unsafe { self.closest_many_avx2(rays, tris, ids, refine) };
+        }
+        self.closest_many_impl::<false, R>(rays, tris, ids, refine)
+    }
+
+    /// [`WideBvh::closest_many`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn closest_many_avx2<R>(
+        &self,
+        rays: &mut [ClosestJob],
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+    ) {
+        self.closest_many_impl::<true, R>(rays, tris, ids, refine)
+    }
+
+    #[inline(always)]
+    fn closest_many_impl<const AVX: bool, R>(
+        &self,
+        rays: &mut [ClosestJob],
+        tris: &[RowTriangle],
+        ids: &[u32],
+        refine: &[R],
+    ) {
         const LANES: usize = 4;
         if self.stack_len > FIXED_STACK || self.nodes.is_empty() {
             for (rb, shear, out) in rays.iter_mut() {
-                *out = self.closest(rb, shear, tris, ids, refine);
+                *out = self.closest_impl::<AVX, R>(rb, shear, tris, ids, refine);
             }
             return;
         }
@@ -362,7 +526,7 @@ impl WideBvh {
                 let Some((i, st)) = lane else { continue };
                 busy = true;
                 let (rb, shear, out) = &mut rays[*i];
-                if !self.closest_step(st, rb, shear, tris, ids, refine, stack) {
+                if !self.closest_step::<AVX, R>(st, rb, shear, tris, ids, refine, stack) {
                     *out = st.best;
                     *lane = None;
                 }
@@ -377,7 +541,7 @@ impl WideBvh {
     /// the next entry; `false` once the traversal is over (result in `st.best`).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn closest_step<R>(
+    fn closest_step<const AVX: bool, R>(
         &self,
         st: &mut Closest,
         rb: &RayBoxes,
@@ -390,7 +554,7 @@ impl WideBvh {
         let cur = st.cur;
         if cur.count == 0 {
             let node = &self.nodes[cur.child as usize];
-            let (tn, mask) = rb.test(node, st.tlimit);
+            let (tn, mask) = rb.test_on::<AVX>(node, st.tlimit);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
@@ -418,7 +582,13 @@ impl WideBvh {
                     hits[j] = e;
                     nh += 1;
                 }
-                stack[st.sp..st.sp + nh - 1].copy_from_slice(&hits[..nh - 1]);
+                if st.sp + W <= stack.len() {
+                    // A fixed-size copy (no library call); entries past `nh − 1` are
+                    // overwritten by later pushes before they are read.
+                    stack[st.sp..st.sp + W].copy_from_slice(&hits);
+                } else {
+                    stack[st.sp..st.sp + nh - 1].copy_from_slice(&hits[..nh - 1]);
+                }
                 st.sp += nh - 1;
                 st.cur = hits[nh - 1];
                 return true;
@@ -456,7 +626,7 @@ impl WideBvh {
     }
 
     #[inline(always)]
-    fn any_with(
+    fn any_with<const AVX: bool>(
         &self,
         rb: &RayBoxes,
         shear: &Shear,
@@ -472,7 +642,7 @@ impl WideBvh {
         loop {
             if cur.count == 0 {
                 let node = &self.nodes[cur.child as usize];
-                let (_, mask) = rb.test(node, tlimit);
+                let (_, mask) = rb.test_on::<AVX>(node, tlimit);
                 let mut m = mask;
                 if m != 0 {
                     let first = m.trailing_zeros() as usize;
@@ -528,4 +698,59 @@ fn gather_small(bvh2: &Bvh2, c: u32, out: &mut Vec<u32>) -> bool {
         }
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX2 box test gives bit-identical entry distances and masks to the 4-lane one
+    /// (boxes with empty slots, rays with zero and tiny direction components).
+    #[test]
+    fn avx2_box_test_equals_sse() {
+        if !has_avx2() {
+            return;
+        }
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        for case in 0..20_000 {
+            let mut node = Node { b: [[0.0; W]; 6], child: [0; W], count: [0; W] };
+            for i in 0..W {
+                for k in 0..3 {
+                    let (a, b) = (rnd(), rnd());
+                    node.b[2 * k][i] = a.min(b);
+                    node.b[2 * k + 1][i] = a.max(b);
+                }
+                if (case + i) % 7 == 0 {
+                    for k in 0..3 {
+                        node.b[2 * k][i] = f32::INFINITY;
+                        node.b[2 * k + 1][i] = f32::NEG_INFINITY;
+                    }
+                }
+            }
+            let org = Vec3A::new(2.0 * rnd(), 2.0 * rnd(), 2.0 * rnd());
+            let mut dir = Vec3A::new(rnd(), rnd(), rnd());
+            if case % 5 == 0 {
+                dir[case % 3] = 0.0;
+            }
+            if case % 11 == 0 {
+                dir[(case + 1) % 3] = 1e-35;
+            }
+            let rb = RayBoxes::new(org, dir, 0.0, 1.0);
+            for tlimit in [f32::INFINITY, 1.0, 0.25] {
+                let (ta, ma) = rb.test(&node, tlimit);
+                // SAFETY: AVX2 support was checked above.
+                let (tb, mb) = unsafe { rb.test_avx2(&node, tlimit) };
+                assert_eq!(ma, mb, "case {case}");
+                for i in 0..W {
+                    assert_eq!(ta[i].to_bits(), tb[i].to_bits(), "case {case} lane {i}");
+                }
+            }
+        }
+    }
 }
