@@ -20,8 +20,18 @@
 //!
 //! [`Cholesky::solve_sparse_with_residual`] is the full-vector form: sparse forward pass,
 //! backward pass over every column, the ordinary residual check (the interactive field
-//! design's right-hand side lives on the stroke edges: moving a singularity on the
-//! 128² grid 23 → 14–18 ms on 2 quiet cores, `fieldtex-fields/examples/bench_fields.rs`).
+//! design's right-hand side lives on the stroke edges). While the factor keeps faer's
+//! supernodal layout both passes run per supernode on dense column blocks
+//! (`crate::supernodal_solve`); otherwise per column over the row runs. On the 128²
+//! field-design grid (49K unknowns, 2.3M factor entries) the supernodal form took the
+//! re-solve after a singularity move from 19 to 11 ms (medians, 2 cores under a load
+//! average of 4.4–5.0, `fieldtex-fields/examples/bench_fields.rs`,
+//! `field_move_singularity_solve_only`, which includes the model field and residual);
+//! its backward pass streams the whole factor (18.7 MB), ~2.4 ms at this machine's best
+//! bandwidth. A tree-parallel backward pass (two halves of disjoint subtrees) was tried
+//! and measured slower on the 2 loaded cores (22–25 against 21–22 ms per move), so it
+//! is sequential. No refinement solve runs unless the residual exceeds
+//! `refine_above` (the field design's residuals are ~1e-15).
 
 use crate::LinalgError;
 use crate::cholesky::Cholesky;

@@ -19,6 +19,16 @@
 //! dependency chain. Same arithmetic on every CPU (the AVX2 build uses the
 //! same IEEE operations without FMA contraction), sequential, so results do not depend on
 //! the thread count. They differ from faer's solve by rounding only.
+//!
+//! `DynamicFactor::solve_sparse_rhs_supernodal` is the one-right-hand-side form for
+//! few nonzeros (`Cholesky::solve_sparse_with_residual`): the forward pass visits only
+//! the supernodes on the elimination-tree reach of the nonzeros, each from the column
+//! the reach enters it at; the backward pass every supernode, with plain (unpadded)
+//! column dot products as eight interleaved partial sums.
+//!
+//! [`crate::Cholesky::copy_from`] (a clone into existing buffers; the values only when
+//! both factors keep faer's columns) lives here for want of a better owner: it belongs
+//! in `cholesky.rs` as `Clone::clone_from`.
 
 use crate::cholesky_update::DynamicFactor;
 
