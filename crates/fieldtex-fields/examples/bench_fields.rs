@@ -13,9 +13,11 @@
 //! - `field_move_singularity`: move one wedge, re-solve (right-hand side only), sample;
 //! - `field_add_stroke`: add one ~250 px stroke (~250 changed edges: one multiple-rank
 //!   factor update, see `FieldDesignOptions::rank1_update_limit`), solve, sample;
-//! - `field_move_stroke`: move that stroke by 2–6 px (`set_stroke`: an update for the
-//!   edges gaining weight, a downdate for those losing it), solve, sample;
-//! - `field_remove_stroke`: remove it (a downdate), solve, sample;
+//! - `field_move_stroke`: move that stroke by 2–6 px (`set_stroke`: the factor kept
+//!   from before the stroke was added is copied and gets one multiple-rank update with
+//!   the moved stroke's edges, cheaper than updating the edges gaining weight and
+//!   downdating those losing it; see `design_factor`), solve, sample;
+//! - `field_remove_stroke`: remove it (a copy of that kept factor), solve, sample;
 //! - `field_add_stroke_refactor`: add with `rank1_update_limit = 0` (numeric
 //!   refactorisation with the kept symbolic analysis; the behaviour before the limit
 //!   was raised to 640 edges);
@@ -119,6 +121,7 @@ fn main() {
         (Vec::new(), Vec::new(), Vec::new());
     let updates_before = d.rank1_update_count();
     let refactors_before = d.refactor_count();
+    let restores_before = d.checkpoint_restore_count();
     for k in 0..repeats {
         let t = Instant::now();
         let sid = d.add_stroke(stroke_at(k)).unwrap();
@@ -142,8 +145,9 @@ fn main() {
         assert_eq!(buf.len(), size * size);
     }
     println!(
-        "info: long strokes: {} rank-1 updates and {} refactorisations for {repeats} additions + moves + removals",
+        "info: long strokes: {} rank-1 updates, {} checkpoint restores and {} refactorisations for {repeats} additions + moves + removals",
         d.rank1_update_count() - updates_before,
+        d.checkpoint_restore_count() - restores_before,
         d.refactor_count() - refactors_before
     );
     // A short stroke (~18 px, about 40 edges).

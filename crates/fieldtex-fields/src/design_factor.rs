@@ -1,32 +1,46 @@
 //! The kept factorisation of a field design's matrix `A₀ + diag(s)` (`A₀`: the
 //! stroke-free design matrix, `s`: the summed stroke weights per edge, `#E`), brought up
-//! to date after stroke edits by multiple-rank updates and downdates or by a numeric
-//! refactorisation with the kept symbolic analysis.
+//! to date after stroke edits by multiple-rank updates, by a copy of a kept earlier
+//! factor plus one multiple-rank update, or by a numeric refactorisation with the kept
+//! symbolic analysis.
 //!
-//! A stroke edit changes `A` by `Σ Δs_e e_e e_eᵀ`: the edges whose weight grows get one
-//! multiple-rank update, those whose weight shrinks one multiple-rank downdate
-//! (Davis & Hager 2001, "Multiple-rank modifications of a sparse Cholesky factorization",
-//! via `fieldtex_linalg::Cholesky::add_diagonal_penalties`). The choice between that and a
-//! refactorisation depends only on the number of changed edges (never on timings), so
-//! the result of an edit sequence does not depend on the machine.
+//! A stroke edit changes `A` by `Σ Δs_e e_e e_eᵀ`. Three ways to follow it, the cheapest
+//! by a rule on edge counts only (never timings, so the result of an edit sequence does
+//! not depend on the machine):
+//! - **direct**: the current factor gets one multiple-rank update for the edges whose
+//!   weight grows and one multiple-rank downdate for those whose weight shrinks
+//!   (Davis & Hager 2001, "Multiple-rank modifications of a sparse Cholesky
+//!   factorization", via `fieldtex_linalg::Cholesky::add_diagonal_penalties`); cost
+//!   `ups + 2 · downs` (downdates run rank-1 sweeps, updates blocked reflections);
+//! - **checkpoint**: a kept copy of an earlier factor with stroke diagonal `s_c ≤ s` is
+//!   copied into the current factor's buffers (`Cholesky::copy_from`) and gets one
+//!   multiple-rank update with `s − s_c`; cost `64 + #(s ≠ s_c)` (the copy of the
+//!   2.3M-entry factor measured 4–10 ms, an updated edge 0.1–0.2 ms). No downdate at
+//!   all: dragging a stroke costs a copy plus the update of the stroke's new edges,
+//!   removing the last-added stroke a copy. The checkpoint is taken at every
+//!   refactorisation and, before an edit that only adds weight, from the current factor
+//!   when the old one lies above the new diagonal somewhere or more than 64 edges
+//!   behind (so it is "everything but the stroke being drawn");
+//! - **refactorisation**: when more than [`crate::FieldDesignOptions::rank1_update_limit`]
+//!   (default 640) edges would be modified, after `16 ×` that many modifications since
+//!   the last factorisation (rounding drift), or when a downdate is refused.
 //!
 //! Measured on the 128² grid of the interactive benchmark (49K unknowns, 2.3M factor
-//! entries, 2 cores under a load average of ~2.7, `examples/bench_fields.rs`): a
-//! multiple-rank update or downdate costs ~0.15–0.25 ms per changed edge, a numeric
-//! refactorisation 80–150 ms; a ~250 px stroke changes ~250 edges when added or removed
-//! and ~300–500 when dragged by a few pixels. Hence the default
-//! [`crate::FieldDesignOptions::rank1_update_limit`] of 640 changed edges: additions,
-//! removals and drags of such strokes are updated (add/remove + solve + 512² sampling
-//! 55–90 ms, drag 75–125 ms, against 100–160 ms with a refactorisation), wholesale
-//! changes refactored. Issue 3's 20 ms is out of reach for long strokes either way: the
-//! update of `k` edges costs `k` sweeps over the factor columns on the edges'
-//! elimination-tree paths, which for a 2-D grid always include the top separators
-//! (dense blocks of a few hundred rows), ~0.2 ms per edge here.
+//! entries, 2 cores shared with other jobs, `cargo build --release -p fieldtex-fields
+//! --examples && target/release/examples/bench_fields`, medians of three runs of 15
+//! under a load average of 4.4–5.0, old and new binaries interleaved), one frame =
+//! edit + solve + 512² sampling: adding a ~250 px stroke (~250 edges, direct update)
+//! 75 → 44 ms, dragging it by 2–6 px 128 → 50 ms, removing it 118 → 24 ms, a ~18 px
+//! stroke 42 → 19 ms (the last three through the checkpoint; the solve's share fell with
+//! the supernodal sparse solve, see [`crate::field_design`]). A numeric refactorisation
+//! now includes the take-over for updates (before: in the first solve) and the
+//! checkpoint copy (~90–170 ms). Issue 3's 20 ms stays out of reach for long strokes:
+//! the update of `k` edges touches the factor columns on the edges' elimination-tree
+//! paths, which on a 2-D grid always include the top separators, ~0.1–0.2 ms per edge.
 //!
 //! Not implemented: a Woodbury (capacitance-matrix) correction of the solve instead of a
 //! factor modification: it needs `A⁻¹` at the stroke's ~250–500 edges, i.e. as many
-//! solves (or sparse triangular solves on the factor, which `fieldtex-linalg` does not
-//! expose), far more than the modification itself.
+//! sparse solves reaching the top separators, about the cost of the update itself.
 
 use fieldtex_linalg::{Cholesky, CholeskyOptions, SparseMatrix, SymbolicCholesky};
 
@@ -200,6 +214,8 @@ impl DesignFactor {
         // take it over for updates now (the first solve would), so the checkpoint is too
         factor.prepare_updates()?;
         match &mut self.checkpoint {
+            // no updates allowed: no checkpoint either
+            _ if limit == 0 => self.checkpoint = None,
             Some(c) => {
                 c.factor.copy_from(&factor);
                 c.diag.copy_from_slice(diag);

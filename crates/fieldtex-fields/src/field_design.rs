@@ -49,15 +49,20 @@
 //! Factor once: [`FieldDesign::new`] assembles `A` and analyses its pattern; the first
 //! solve factors it. Strokes change the diagonal of `A` by `Σ Δw_e e_e e_eᵀ`: edits that
 //! change at most [`FieldDesignOptions::rank1_update_limit`] edges (default 640) are
-//! multiple-rank updates/downdates of the factor, larger ones a numeric refactorisation
+//! multiple-rank updates/downdates of the factor or a copy of a kept earlier factor plus
+//! one update (whichever modifies fewer edges), larger ones a numeric refactorisation
 //! with the kept symbolic analysis ([`crate::design_factor`], with the measurements).
 //! Cost of one interactive frame on the 128² grid (49K unknowns) as a front end sees it
 //! (edit, then [`FieldDesign::solve_and_sample_into`] at 512², from a thread outside the
-//! rayon pool; `examples/bench_fields.rs`, 2 cores under a load average of ~2.7):
-//! moving a singularity ~17 ms (one solve with the kept factor, ~13–15 ms of it faer's
-//! supernodal triangular solves, plus ~2.5 ms sampling); a ~250 px stroke changes
-//! ~250–500 edges, whose update costs 40–100 ms — issue 3's 20 ms for stroke edits is
-//! not reached (see [`crate::design_factor`]).
+//! rayon pool; `cargo build --release -p fieldtex-fields --examples &&
+//! target/release/examples/bench_fields`, 2 cores shared with other jobs, load average
+//! 4.4–5.0, medians of three interleaved runs against the previous binary): moving a
+//! singularity 21 → 18 ms (solve alone 19 → 11 ms: the deviation's sparse right-hand
+//! side now runs supernodal dense column loops, `Cholesky::solve_sparse_with_residual`;
+//! plus ~2.5 ms sampling), a full design solve 33 → 16 ms. Stroke edits: add a ~250 px
+//! stroke 44 ms, drag it 50 ms, remove it 24 ms, a short stroke 19 ms — issue 3's 20 ms
+//! is met for short strokes and singularities, not for long strokes (their factor
+//! update, see [`crate::design_factor`]).
 
 use std::sync::Arc;
 

@@ -32,12 +32,14 @@ pub struct FieldDesignOptions {
     pub regularization: f64,
     /// How singularities enter. Default [`SingularityModel::ModelField`].
     pub singularity_model: SingularityModel,
-    /// Stroke edits that change the weight of at most this many edges update the
-    /// factorisation by multiple-rank modifications instead of refactoring (0: always
-    /// refactor). Default 640: on the 128² grid (49K unknowns, 2.3M factor entries) an
-    /// update or downdate measured ~0.15–0.25 ms per edge and a numeric refactorisation
-    /// 90–150 ms on 2 loaded cores (`examples/bench_fields.rs`), so adding, removing and
-    /// dragging a ~250 px stroke (~250–500 changed edges) are updated.
+    /// Stroke edits that modify the weight of at most this many factor edges update the
+    /// factorisation by multiple-rank modifications (of the current factor, or of a
+    /// copy of the kept checkpoint factor, [`crate::design_factor`]) instead of
+    /// refactoring (0: always refactor, no checkpoint kept). Default 640: on the 128²
+    /// grid (49K unknowns, 2.3M factor entries) an update measured ~0.1–0.2 ms per edge,
+    /// a downdate about twice that, and a numeric refactorisation 90–170 ms on 2 loaded
+    /// cores (`examples/bench_fields.rs`), so adding, removing and dragging a ~250 px
+    /// stroke (~250–500 changed edges) are updated.
     pub rank1_update_limit: usize,
 }
 
