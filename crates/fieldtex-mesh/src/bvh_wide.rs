@@ -215,6 +215,24 @@ pub(super) fn huge_with_capacity<T>(n: usize) -> Vec<T> {
     out
 }
 
+/// Hints the cache to load the 64-byte lines holding bytes `p .. p + bytes` (any
+/// address: nothing is read and nothing faults; no effect elsewhere than on x86-64).
+#[inline(always)]
+pub(super) fn prefetch_bytes(p: *const u8, bytes: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // SAFETY: a prefetch never faults and reads nothing into the program, whatever
+        // the address; SSE is part of the x86-64 baseline.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(p.cast());
+            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(bytes.max(1) - 1).cast());
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (p, bytes);
+}
+
 /// Hints the cache to load the `lines` 64-byte lines from `r` on (no effect elsewhere
 /// than on x86-64).
 #[inline(always)]
