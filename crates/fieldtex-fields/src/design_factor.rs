@@ -15,7 +15,8 @@
 //! - **checkpoint**: a kept copy of an earlier factor with stroke diagonal `s_c ≤ s` is
 //!   copied into the current factor's buffers (`Cholesky::copy_from`) and gets one
 //!   multiple-rank update with `s − s_c`; cost `64 + #(s ≠ s_c)` (the copy of the
-//!   2.3M-entry factor measured 4–10 ms, an updated edge 0.1–0.2 ms). No downdate at
+//!   2.3M-entry factor measured 4–13 ms under load averages 3–5, where a clone, with
+//!   fresh pages, took 12–55 ms; an updated edge 0.1–0.2 ms). No downdate at
 //!   all: dragging a stroke costs a copy plus the update of the stroke's new edges,
 //!   removing the last-added stroke a copy. The checkpoint is taken at every
 //!   refactorisation and, before an edit that only adds weight, from the current factor
@@ -51,8 +52,8 @@ use crate::FieldsError;
 /// 30–50 ms for 250 edges on the 128² grid).
 const DOWNDATE_WEIGHT: usize = 2;
 
-/// Cost of copying the checkpoint factor, in updated edges (a clone of the 2.3M-entry
-/// factor measured 8–13 ms, an updated edge 0.12–0.2 ms).
+/// Cost of copying the checkpoint factor into the current one, in updated edges (the
+/// copy of the 2.3M-entry factor measured 4–13 ms, an updated edge 0.1–0.2 ms).
 const RESTORE_COST: usize = 64;
 
 /// An earlier factor kept to rebuild later ones by updates only.
