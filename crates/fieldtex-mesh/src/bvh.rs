@@ -171,7 +171,8 @@ impl Bvh {
             let prim_tris: Vec<RowTriangle> = huge_copy(
                 &order.iter().map(|&i| RowTriangle::new(&tris[i as usize])).collect::<Vec<_>>(),
             );
-            let prim_ids: Vec<u32> = order.iter().map(|&i| keep[i as usize]).collect();
+            let prim_ids: Vec<u32> =
+                huge_copy(&order.iter().map(|&i| keep[i as usize]).collect::<Vec<_>>());
             let mut slot = vec![0u32; tris.len()];
             for (k, &i) in order.iter().enumerate() {
                 slot[i as usize] = k as u32;

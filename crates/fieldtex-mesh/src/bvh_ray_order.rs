@@ -6,6 +6,18 @@
 //! here the box entry point stands in for the not yet known hit point).
 //!
 //! The order only changes speed, never results: every ray is still answered on its own.
+//!
+//! Moving rays and results into and out of that order is a random gather and scatter
+//! over arrays of tens of MB, and in this virtual machine with 4 KiB pages nearly every
+//! such access was also a TLB miss. Measured on one thread (1M rays, 388K triangles):
+//! keys 50 ms, sort 25 ms, gather of the rays from the caller's slice 100–120 ms,
+//! traversal 530–680 ms, scatter of the results 63–80 ms. Now the rays are copied in
+//! input order onto huge pages, one per cache line, in the pass that computes the keys;
+//! the gather prefetches 16 rays ahead; the output lies on huge pages, is written without
+//! a pre-fill, and the lines of a chunk's results are prefetched before the chunk is
+//! answered: gather ~58 ms, scatter 17–32 ms. Gathering straight from the caller's slice
+//! with the same prefetching was slower than staging (1-thread rates 1.15–1.22 vs
+//! 1.33–1.35 M rays/s, machine loaded).
 
 use super::Ray;
 use super::bvh_wide::{huge_with_capacity, prefetch_bytes};

@@ -345,3 +345,45 @@ fn grid_boundary_is_hit_by_axis_parallel_rays() {
         }
     }
 }
+
+#[test]
+fn avx2_and_portable_traversals_agree() {
+    // The 4-lane (portable) traversal must give exactly the AVX2 one's results, as it is
+    // the one taken on CPUs without AVX2; axis-parallel and grazing rays included.
+    if !bvh_wide::has_avx2() {
+        return;
+    }
+    let m = torus(2.0, 0.7, 60, 24);
+    let bvh = Bvh::build(&m).unwrap();
+    let mut rs = rays(&m, 3000);
+    for (i, r) in rs.iter_mut().enumerate().step_by(7) {
+        r.dir[i % 3] = 0.0;
+    }
+    let mut n_hits = 0;
+    for r in &rs {
+        let Some((oray, _)) = bvh.oray(r) else { continue };
+        let rb = RayBoxes::new(oray.origin, oray.direction, oray.tmin, bvh.scene_half);
+        let shear = Shear::new(&oray);
+        let (mut s0, mut s1) = (shear, shear);
+        let a = bvh.wide.closest_impl::<false, _>(
+            &rb,
+            &mut s0,
+            &bvh.prim_tris,
+            &bvh.prim_ids,
+            &bvh.corners,
+        );
+        let b = bvh.wide.closest_impl::<true, _>(
+            &rb,
+            &mut s1,
+            &bvh.prim_tris,
+            &bvh.prim_ids,
+            &bvh.corners,
+        );
+        assert_eq!(a.map(|(p, t)| (p, t.to_bits())), b.map(|(p, t)| (p, t.to_bits())));
+        let any0 = bvh.wide.any_impl::<false>(&rb, &shear, &bvh.prim_tris);
+        assert_eq!(any0, bvh.wide.any_impl::<true>(&rb, &shear, &bvh.prim_tris));
+        assert_eq!(any0, a.is_some());
+        n_hits += usize::from(any0);
+    }
+    assert!(n_hits > 1000 && n_hits < 2900, "{n_hits}");
+}
