@@ -13,7 +13,7 @@
 //!   factorization", via `fieldtex_linalg::Cholesky::add_diagonal_penalties`); cost
 //!   `ups + 2 · downs` (downdates run rank-1 sweeps, updates blocked reflections);
 //! - **checkpoint**: a kept copy of an earlier factor with stroke diagonal `s_c ≤ s` is
-//!   copied into the current factor's buffers (`Cholesky::copy_from`) and gets one
+//!   copied into the current factor's buffers (`Cholesky::clone_from`) and gets one
 //!   multiple-rank update with `s − s_c`; cost `64 + #(s ≠ s_c)` (the copy of the
 //!   2.3M-entry factor measured 4–13 ms under load averages 3–5, where a clone, with
 //!   fresh pages, took 12–55 ms; an updated edge 0.1–0.2 ms). No downdate at
@@ -173,7 +173,7 @@ impl DesignFactor {
             {
                 let factor = self.factor.as_mut().expect("checked");
                 // into the current factor's buffers (no fresh pages)
-                factor.copy_from(&c.factor);
+                factor.clone_from(&c.factor);
                 if let Err(e) = factor.add_diagonal_penalties(&c_ups) {
                     // the factor is the checkpoint's now: refactor on the next sync
                     self.factor = None;
@@ -218,7 +218,7 @@ impl DesignFactor {
             // no updates allowed: no checkpoint either
             _ if limit == 0 => self.checkpoint = None,
             Some(c) => {
-                c.factor.copy_from(&factor);
+                c.factor.clone_from(&factor);
                 c.diag.copy_from_slice(diag);
                 c.updates_since_factor = 0;
             }
@@ -256,7 +256,7 @@ impl DesignFactor {
         }
         match &mut self.checkpoint {
             Some(c) => {
-                c.factor.copy_from(factor);
+                c.factor.clone_from(factor);
                 c.diag.copy_from_slice(&self.factored_diag);
                 c.updates_since_factor = self.updates_since_factor;
             }

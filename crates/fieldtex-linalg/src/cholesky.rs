@@ -255,6 +255,34 @@ impl Clone for Cholesky {
             last_residual: AtomicU64::new(self.last_residual.load(Ordering::Relaxed)),
         }
     }
+
+    /// `*self = src.clone()`, reusing `self`'s buffers when both are updatable factors of
+    /// the same matrix pattern, ordering and options: a memory copy instead of fresh
+    /// allocations, whose page faults made a clone of the 2.3M-entry field-design factor
+    /// cost 12–55 ms on a loaded machine (4–13 ms this way). Otherwise a clone.
+    fn clone_from(&mut self, src: &Self) {
+        let compatible = match (&self.dynamic, &src.dynamic) {
+            (Some(d), Some(s)) => {
+                d.perm == s.perm
+                    && self.options == src.options
+                    && self.symbolic.factor_nnz() == src.symbolic.factor_nnz()
+                    && self.matrix.col_ptr() == src.matrix.col_ptr()
+                    && self.matrix.row_idx() == src.matrix.row_idx()
+            }
+            _ => false,
+        };
+        if !compatible {
+            *self = src.clone();
+            return;
+        }
+        let (d, s) = (self.dynamic.as_mut(), src.dynamic.as_ref());
+        d.expect("checked").copy_same_pattern_from(s.expect("checked"));
+        // same pattern (checked above): the values only
+        self.matrix.values_mut().copy_from_slice(src.matrix.values());
+        self.extra_terms.clone_from(&src.extra_terms);
+        self.downdated = src.downdated;
+        self.last_residual.store(src.last_residual.load(Ordering::Relaxed), Ordering::Relaxed);
+    }
 }
 
 impl std::fmt::Debug for Cholesky {

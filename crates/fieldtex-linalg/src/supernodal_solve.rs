@@ -25,10 +25,6 @@
 //! the supernodes on the elimination-tree reach of the nonzeros, each from the column
 //! the reach enters it at; the backward pass every supernode, with plain (unpadded)
 //! column dot products as eight interleaved partial sums.
-//!
-//! [`crate::Cholesky::copy_from`] (a clone into existing buffers; the values only when
-//! both factors keep faer's columns) lives here for want of a better owner: it belongs
-//! in `cholesky.rs` as `Clone::clone_from`.
 
 use crate::cholesky_update::DynamicFactor;
 
@@ -302,95 +298,6 @@ impl DynamicFactor {
             x[p] = y[i];
         }
         x
-    }
-}
-
-impl crate::Cholesky {
-    /// Makes `self` a copy of `src` (`*self = src.clone()`), reusing `self`'s buffers
-    /// where both are updatable factors of the same matrix pattern, ordering and
-    /// options: a memory copy instead of fresh allocations, whose page faults made a
-    /// clone of the 2.3M-entry field-design factor cost 12–55 ms on a loaded machine.
-    /// When both still have faer's layout with the same columns (the structure is then
-    /// that of the same symbolic analysis: no fill has moved a column), only the factor
-    /// values are copied. Otherwise (or if `src` has not been taken over for updates)
-    /// it clones. The result is the same either way. (Belongs in `Clone::clone_from`.)
-    pub fn copy_from(&mut self, src: &crate::Cholesky) {
-        let compatible = match (&self.dynamic, &src.dynamic) {
-            (Some(d), Some(s)) => {
-                d.perm == s.perm
-                    && self.options() == src.options()
-                    && self.symbolic().factor_nnz() == src.symbolic().factor_nnz()
-                    && self.matrix.col_ptr() == src.matrix.col_ptr()
-                    && self.matrix.row_idx() == src.matrix.row_idx()
-            }
-            _ => false,
-        };
-        if !compatible {
-            *self = src.clone();
-            return;
-        }
-        let d = self.dynamic.as_mut().expect("checked");
-        let s = src.dynamic.as_ref().expect("checked");
-        let same_columns = d.faer_layout
-            && s.faer_layout
-            && d.supernodes == s.supernodes
-            && d.start == s.start
-            && d.len == s.len
-            && d.vals.len() == s.vals.len();
-        if same_columns {
-            // rows, runs and the tree are those of faer's analysis in both
-            d.vals.copy_from_slice(&s.vals);
-            d.blocked_count = s.blocked_count;
-        } else {
-            // every field listed, so a new one cannot be forgotten here
-            let DynamicFactor {
-                faer_layout,
-                perm,
-                inv,
-                start,
-                len,
-                cap,
-                rows,
-                vals,
-                parent,
-                work,
-                mark,
-                stamp,
-                path,
-                backup,
-                slot,
-                runs,
-                run_ptr,
-                supernodes,
-                blocked_count,
-                multi_buf: _,
-                blocked_buf: _,
-            } = s;
-            d.faer_layout = *faer_layout;
-            d.perm.clone_from(perm);
-            d.inv.clone_from(inv);
-            d.start.clone_from(start);
-            d.len.clone_from(len);
-            d.cap.clone_from(cap);
-            d.rows.clone_from(rows);
-            d.vals.clone_from(vals);
-            d.parent.clone_from(parent);
-            d.work.clone_from(work);
-            d.mark.clone_from(mark);
-            d.stamp = *stamp;
-            d.path.clone_from(path);
-            d.backup.clone_from(backup);
-            d.slot.clone_from(slot);
-            d.runs.clone_from(runs);
-            d.run_ptr.clone_from(run_ptr);
-            d.supernodes.clone_from(supernodes);
-            d.blocked_count = *blocked_count;
-        }
-        // same pattern (checked above): the values only
-        self.matrix.values_mut().copy_from_slice(src.matrix.values());
-        self.extra_terms.clone_from(&src.extra_terms);
-        self.downdated = src.downdated;
-        self.store_last_residual(src.last_residual());
     }
 }
 

@@ -2,7 +2,7 @@
 //! the supernodes on the reach of the nonzeros, backward pass over all): equal to the
 //! ordinary solve and to a fresh factor's solve after multiple-rank updates and
 //! downdates, for right-hand sides at leaves, at the root and spread out; bit-identical
-//! for 1 and 2 threads. `Cholesky::copy_from` gives the same factor as a clone.
+//! for 1 and 2 threads. `Cholesky::clone_from` gives the same factor as a clone.
 
 mod common;
 use common::*;
@@ -105,7 +105,7 @@ fn copy_from_equals_a_clone_and_stays_updatable() {
     let (src, _) = supernodal_factor(side, &[(40, 1.0), (500, 2.0), (1000, 0.5)]);
     // into an updatable factor of the same analysis with other values (values copied)
     let (mut dst, _) = supernodal_factor(side, &[(7, 3.0), (300, 4.0)]);
-    dst.copy_from(&src);
+    dst.clone_from(&src);
     let mut reference = src.clone();
     assert_eq!(solution_bits(&mut dst, n), solution_bits(&mut reference, n));
     // both keep updating alike
@@ -117,13 +117,13 @@ fn copy_from_equals_a_clone_and_stays_updatable() {
     for layout in [FactorLayout::Simplicial, FactorLayout::Supernodal] {
         let sym = SymbolicCholesky::analyze_with(&a, layout).unwrap();
         let mut other = Cholesky::factor_with(&sym, &a).unwrap();
-        other.copy_from(&src);
+        other.clone_from(&src);
         let mut reference = src.clone();
         assert_eq!(solution_bits(&mut other, n), solution_bits(&mut reference, n));
     }
     // from a factor never updated
     let fresh = Cholesky::factor(&a).unwrap();
     let mut dst2 = src.clone();
-    dst2.copy_from(&fresh);
+    dst2.clone_from(&fresh);
     assert_eq!(dst2.solve(&vec![1.0; n]).unwrap(), fresh.solve(&vec![1.0; n]).unwrap());
 }
