@@ -43,7 +43,7 @@ use crate::cholesky_update::DynamicFactor;
 /// Columns per panel (reflections combined into one compact WY block).
 const PANEL: usize = 32;
 /// Rows per parallel chunk of the trailing update (fixed: thread-count independent).
-pub(crate) const CHUNK_ROWS: usize = 256;
+pub(crate) const CHUNK_ROWS: usize = 128;
 /// Scratch values per chunk: `S` and `S T`.
 const SCRATCH: usize = 2 * CHUNK_ROWS * PANEL;
 /// The blocked form is used for a supernode (suffix) of at least this many columns …
@@ -151,6 +151,7 @@ pub(crate) fn householder_update(
     debug_assert!(w.nrows() == m && b <= m);
     let mut u = Mat::<f64>::zeros(k, PANEL);
     let mut t = Mat::<f64>::zeros(PANEL, PANEL);
+    let mut gram = Mat::<f64>::zeros(PANEL, PANEL);
     let mut tau = [0.0f64; PANEL];
     // the panel's rows of `w`, row-major (`wp[i·k + a]`), for the unblocked part
     let mut wp = vec![0.0f64; PANEL * k];
@@ -158,23 +159,32 @@ pub(crate) fn householder_update(
     debug_assert!(scratch.len() >= (m - b.min(PANEL)).div_ceil(CHUNK_ROWS) * SCRATCH);
     for p0 in (0..b).step_by(PANEL) {
         let pb = PANEL.min(b - p0);
-        for i in 0..pb {
-            for a in 0..k {
+        // column by column: each reads a few contiguous entries of `w`
+        for a in 0..k {
+            for i in 0..pb {
                 wp[i * k + a] = w[(p0 + i, a)];
             }
         }
         // reflections of the panel's columns, applied at once to the panel's own rows
         reflect_panel_dispatch(l.as_mut(), &mut wp, &mut u, &mut tau, p0, pb, k)?;
-        for i in 0..pb {
-            for a in 0..k {
-                w[(p0 + i, a)] = 0.0;
-            }
+        for a in 0..k {
+            w.as_mut().col_mut(a).subrows_mut(p0, pb).fill(0.0);
         }
         let rest = m - p0 - pb;
         if rest == 0 {
             continue;
         }
-        // compact WY: H₀ ⋯ H_{pb−1} = I − V T Vᵀ, V = [I; U] (forward accumulation)
+        // compact WY: H₀ ⋯ H_{pb−1} = I − V T Vᵀ, V = [I; U] (forward accumulation):
+        // T[r][i] = −τᵢ Σ_{r≤q<i} T[r][q] (UᵀU)[q][i], from the Gram matrix of U
+        let ur = u.as_ref().subcols(0, pb);
+        matmul(
+            gram.as_mut().submatrix_mut(0, 0, pb, pb),
+            Accum::Replace,
+            ur.transpose(),
+            ur,
+            1.0,
+            Par::Seq,
+        );
         for i in 0..pb {
             for r in 0..pb {
                 t[(r, i)] = 0.0;
@@ -183,10 +193,8 @@ pub(crate) fn householder_update(
             if tau[i] == 0.0 {
                 continue;
             }
-            let ui = u.col(i);
-            let z: Vec<f64> = (0..i).map(|q| u.col(q).transpose() * ui).collect();
             for r in 0..i {
-                let s: f64 = (r..i).map(|q| t[(r, q)] * z[q]).sum();
+                let s: f64 = (r..i).map(|q| t[(r, q)] * gram[(q, i)]).sum();
                 t[(r, i)] = -tau[i] * s;
             }
         }
