@@ -25,6 +25,17 @@
 //! `bvh_ray_order`) over fixed chunks in parallel; every ray is still answered alone, so
 //! results equal the single-ray queries for any thread count.
 //!
+//! **Measured** (`cargo build --release -p fieldtex-mesh --examples &&
+//! target/release/examples/bench_geometry --rays-only --reps 5`: 388K-triangle torus, 1M
+//! incoherent rays, 53 % hit; 2 cores, medians per run, load average at the start of the
+//! run). Before the AVX2 box test and the huge-page ray staging: closest hit 1.85 M rays/s
+//! (load 0.6), 1.63–1.84 (load 1.3–1.5), 2.17–2.37 (load 1.6–2.0); any hit 2.10–2.99;
+//! 1 thread 0.88–1.31 M rays/s. After: closest hit 2.38–2.87 M rays/s (load 1.4–2.2,
+//! quiet windows: BVH build ~300–370 ms), 1.94–2.18 (load 0.8–1.5 with a build of
+//! 400–520 ms, i.e. another process still running); any hit 2.33–2.78; 1 thread
+//! 1.30–1.54 M rays/s. The rate depends much on the other processes of this shared
+//! 2-core machine; compare only runs taken side by side.
+//!
 //! **Conventions.** `t` is the ray parameter: hit point `origin + t · dir` (a distance
 //! when `dir` is unit). Barycentric coordinates `[b0, b1, b2]` weight the triangle's
 //! corners in order. Triangles with a non-finite corner are left out (counted in
