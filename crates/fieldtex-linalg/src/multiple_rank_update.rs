@@ -41,11 +41,12 @@
 //! handles the whole supernode at once with structured Householder reflections in
 //! panels (`crate::blocked_update`), whose trailing work is two dense matrix products.
 //! There the result equals the sweeps' to rounding, no longer bit for bit (it is still
-//! independent of the thread count). Measured after this change (same benchmark, loaded
-//! 2-core VM, load average ~2.9): the 178 greedy steps' updates 3.3–3.5 s → 2.3–2.4 s,
-//! the slowest step's ratio refactorisation / update 6.5–8.5× → 12.6× and up; a
-//! 61-penalty curve on a 448² grid (`examples/bench_linalg.rs`) 15–16 ms against 28–36 ms
-//! for the same downdate by sweeps.
+//! independent of the thread count). Measured (same benchmark, 178 greedy steps): the
+//! steps' updates 3.3–3.5 s → 2.2–2.7 s, the slowest step 85 ms → 38–46 ms, the
+//! smallest ratio refactorisation / step update 6.5–8.5× → 15.5–18.4× (load ~1.4; 12.6×
+//! and up under load ~2.9); a 61-penalty curve on a 448² grid
+//! (`examples/bench_linalg.rs`) 15–16 ms against 28–36 ms for the same downdate by
+//! sweeps.
 //!
 //! Not implemented: multiple-rank modifications by general (non-diagonal) vectors, which
 //! can create fill (use [`Cholesky::update`] per vector); a blocked form of downdates
