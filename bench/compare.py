@@ -6,7 +6,8 @@ import sys
 vals = {}
 for line in sys.stdin:
     parts = line.split()
-    if len(parts) == 3 and parts[0] == "BENCH" and "=" in parts[2]:
+    # the first `key=value` after the name counts (some lines add e.g. `cpu_value=`)
+    if len(parts) >= 3 and parts[0] == "BENCH" and "=" in parts[2]:
         k, v = parts[2].split("=", 1)
         try:
             vals[parts[1]] = float(v)
