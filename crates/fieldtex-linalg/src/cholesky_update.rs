@@ -227,67 +227,26 @@ impl DynamicFactor {
         }
     }
 
-    /// Makes `self` a copy of `s`, a factor of the same pattern and ordering, reusing
-    /// `self`'s buffers: when both keep faer's layout with the same columns only the
-    /// values are copied (rows, runs and tree are those of the same analysis), otherwise
-    /// every field is cloned into the existing allocations. The update buffers are not
-    /// copied.
+    /// Makes `self` a copy of `s`, a factor of the same pattern and ordering. When both
+    /// keep faer's layout with the same columns (rows, runs and tree are then those of
+    /// the same analysis) only the values are copied, into the existing allocation;
+    /// otherwise (fill has moved columns: rare) it is a clone. `self`'s update buffers
+    /// are kept.
     pub(crate) fn copy_same_pattern_from(&mut self, s: &DynamicFactor) {
-        let d = self;
-        let same_columns = d.faer_layout
+        let same_columns = self.faer_layout
             && s.faer_layout
-            && d.supernodes == s.supernodes
-            && d.start == s.start
-            && d.len == s.len
-            && d.vals.len() == s.vals.len();
+            && self.supernodes == s.supernodes
+            && self.start == s.start
+            && self.len == s.len
+            && self.vals.len() == s.vals.len();
         if same_columns {
-            // rows, runs and the tree are those of faer's analysis in both
-            d.vals.copy_from_slice(&s.vals);
-            d.blocked_count = s.blocked_count;
+            self.vals.copy_from_slice(&s.vals);
+            self.blocked_count = s.blocked_count;
         } else {
-            // every field listed, so a new one cannot be forgotten here
-            let DynamicFactor {
-                faer_layout,
-                perm,
-                inv,
-                start,
-                len,
-                cap,
-                rows,
-                vals,
-                parent,
-                work,
-                mark,
-                stamp,
-                path,
-                backup,
-                slot,
-                runs,
-                run_ptr,
-                supernodes,
-                blocked_count,
-                multi_buf: _,
-                blocked_buf: _,
-            } = s;
-            d.faer_layout = *faer_layout;
-            d.perm.clone_from(perm);
-            d.inv.clone_from(inv);
-            d.start.clone_from(start);
-            d.len.clone_from(len);
-            d.cap.clone_from(cap);
-            d.rows.clone_from(rows);
-            d.vals.clone_from(vals);
-            d.parent.clone_from(parent);
-            d.work.clone_from(work);
-            d.mark.clone_from(mark);
-            d.stamp = *stamp;
-            d.path.clone_from(path);
-            d.backup.clone_from(backup);
-            d.slot.clone_from(slot);
-            d.runs.clone_from(runs);
-            d.run_ptr.clone_from(run_ptr);
-            d.supernodes.clone_from(supernodes);
-            d.blocked_count = *blocked_count;
+            let buffers =
+                (std::mem::take(&mut self.multi_buf), std::mem::take(&mut self.blocked_buf));
+            *self = s.clone();
+            (self.multi_buf, self.blocked_buf) = buffers;
         }
     }
 
