@@ -43,7 +43,7 @@ use crate::cholesky_update::DynamicFactor;
 /// Columns per panel (reflections combined into one compact WY block).
 const PANEL: usize = 32;
 /// Rows per parallel chunk of the trailing update (fixed: thread-count independent).
-pub(crate) const CHUNK_ROWS: usize = 128;
+const CHUNK_ROWS: usize = 128;
 /// Scratch values per chunk: `S` and `S T`.
 const SCRATCH: usize = 2 * CHUNK_ROWS * PANEL;
 /// The blocked form is used for a supernode (suffix) of at least this many columns …
