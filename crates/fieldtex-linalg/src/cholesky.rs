@@ -285,6 +285,60 @@ impl Clone for Cholesky {
     }
 }
 
+impl Cholesky {
+    /// Makes `self` equal to `src` (as [`Clone::clone_from`] would) by copying only what
+    /// can differ, **given** that the two were equal (a clone or `clone_from` of each
+    /// other, or of the same factor) and that since then each received only diagonal
+    /// modifications ([`Cholesky::add_diagonal_penalties`],
+    /// [`Cholesky::remove_diagonal_penalties`], [`Cholesky::add_diagonal_penalty`]) at
+    /// the indices in `changed` (repeats allowed). A diagonal modification of index `i`
+    /// changes only the factor columns on the elimination-tree path from `i` to the root
+    /// (it creates no fill), so only those columns and the matrix diagonal at `changed`
+    /// are copied: for a stroke of ~250 edges on the 128² field-design grid that is a
+    /// fraction of the 2.3M-entry factor. Falls back to [`Clone::clone_from`] when the
+    /// factors are not both updatable factors with the same layout. Returns the number
+    /// of factor values copied.
+    ///
+    /// The caller is responsible for the precondition: columns off those paths are not
+    /// compared (that would cost as much as the copy).
+    pub fn copy_changed_from(&mut self, src: &Self, changed: &[usize]) -> usize {
+        let n = self.size();
+        let compatible = match (&self.dynamic, &src.dynamic) {
+            (Some(d), Some(s)) => {
+                d.perm == s.perm
+                    && self.options == src.options
+                    && self.matrix.col_ptr() == src.matrix.col_ptr()
+                    && self.matrix.row_idx() == src.matrix.row_idx()
+                    && changed.iter().all(|&i| i < n)
+            }
+            _ => false,
+        };
+        let copied = if compatible {
+            let (d, s) =
+                (self.dynamic.as_mut().expect("checked"), src.dynamic.as_ref().expect("checked"));
+            let from: Vec<usize> = changed.iter().map(|&i| s.inv[i]).collect();
+            d.copy_paths_from(s, &from)
+        } else {
+            None
+        };
+        let Some(copied) = copied else {
+            self.clone_from(src);
+            return self.dynamic.as_ref().map_or(self.values.len(), |d| d.values().len());
+        };
+        let (dst, from) = (self.matrix.values_mut(), src.matrix.values());
+        for &i in changed {
+            // a diagonal modification changed `A[i][i]` (stored) or an extra term
+            if let Some(p) = src.matrix.find(i, i) {
+                dst[p] = from[p];
+            }
+        }
+        self.extra_terms.clone_from(&src.extra_terms);
+        self.downdated = src.downdated;
+        self.last_residual.store(src.last_residual.load(Ordering::Relaxed), Ordering::Relaxed);
+        copied
+    }
+}
+
 impl std::fmt::Debug for Cholesky {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Cholesky")

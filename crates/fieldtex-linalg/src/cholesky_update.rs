@@ -250,6 +250,38 @@ impl DynamicFactor {
         }
     }
 
+    /// Copies from `s` the columns on the elimination-tree paths of the permuted columns
+    /// `from` (each path from the column to its root), where the two factors may differ
+    /// when they were equal before and only diagonal modifications at `from` happened
+    /// since (a diagonal modification changes exactly the columns on its path). Returns
+    /// the number of values copied, or `None` (nothing copied) when the column layouts
+    /// differ.
+    pub(crate) fn copy_paths_from(&mut self, s: &DynamicFactor, from: &[usize]) -> Option<usize> {
+        let same_columns = self.faer_layout == s.faer_layout
+            && self.start == s.start
+            && self.len == s.len
+            && self.parent == s.parent
+            && self.vals.len() == s.vals.len();
+        if !same_columns {
+            return None;
+        }
+        let n = self.n();
+        let mut seen = vec![false; n];
+        let mut copied = 0;
+        for &f in from {
+            let mut j = f;
+            while j != NONE && !seen[j] {
+                seen[j] = true;
+                let (st, l) = (self.start[j], self.len[j]);
+                self.vals[st..st + l].copy_from_slice(&s.vals[st..st + l]);
+                copied += l;
+                j = self.parent[j];
+            }
+        }
+        self.blocked_count = s.blocked_count;
+        Some(copied)
+    }
+
     pub(crate) fn n(&self) -> usize {
         self.perm.len()
     }

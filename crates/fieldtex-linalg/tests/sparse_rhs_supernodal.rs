@@ -127,3 +127,42 @@ fn copy_from_equals_a_clone_and_stays_updatable() {
     dst2.clone_from(&fresh);
     assert_eq!(dst2.solve(&vec![1.0; n]).unwrap(), fresh.solve(&vec![1.0; n]).unwrap());
 }
+
+#[test]
+fn copy_changed_from_equals_a_full_copy() {
+    let side = 40;
+    let n = side * side;
+    let (base, _) = supernodal_factor(side, &[(40, 1.0)]);
+    let nnz = base.symbolic().factor_nnz();
+    let mut cur = base.clone();
+    // a cluster of penalties (like a stroke), part of it removed again, one more added
+    let ups: Vec<(usize, f64)> = (0..40).map(|t| (620 + t, 0.5 + t as f64 * 0.01)).collect();
+    cur.add_diagonal_penalties(&ups).unwrap();
+    cur.remove_diagonal_penalties(&ups[..10]).unwrap();
+    cur.add_diagonal_penalty(777, 2.0).unwrap();
+    let changed: Vec<usize> = ups.iter().map(|p| p.0).chain([777, 620]).collect();
+    // back to the base: only the paths of `changed` are copied
+    let mut restored = cur.clone();
+    let copied = restored.copy_changed_from(&base, &changed);
+    assert!(copied > 0 && copied < nnz / 2, "{copied} of {nnz} values copied");
+    assert_eq!(solution_bits(&mut restored, n), solution_bits(&mut base.clone(), n));
+    // and the other way: a copy of the base brought to the current state
+    let mut forward = base.clone();
+    forward.copy_changed_from(&cur, &changed);
+    assert_eq!(solution_bits(&mut forward, n), solution_bits(&mut cur.clone(), n));
+    // the test can fail: leaving indices out leaves their paths stale (the solve then
+    // fails its residual check or differs)
+    let mut partial = cur.clone();
+    partial.copy_changed_from(&base, &changed[..5]);
+    let b = vec![1.0; n];
+    let (x, _) = base.solve_with_residual(&b).unwrap();
+    match partial.solve_with_residual(&b) {
+        Ok((y, _)) => assert_ne!(x, y),
+        Err(e) => assert!(e.to_string().contains("residual"), "{e}"),
+    }
+    // into a factor that is not updatable: a full copy
+    let a = penalty_system(side, side, &every(n, 11), 2.0);
+    let mut other = Cholesky::factor(&a).unwrap();
+    other.copy_changed_from(&cur, &changed);
+    assert_eq!(solution_bits(&mut other, n), solution_bits(&mut cur.clone(), n));
+}
