@@ -18,6 +18,10 @@
 //!   the moved stroke's edges, cheaper than updating the edges gaining weight and
 //!   downdating those losing it; see `design_factor`), solve, sample;
 //! - `field_remove_stroke`: remove it (a copy of that kept factor), solve, sample;
+//! - `field_drag_stroke_1px` (and its 90th percentile `_p90`): a mouse drag, the same
+//!   stroke moved by 1 px per event, 12 events: each event's edit (direct updates and
+//!   downdates of the edges that changed, or a checkpoint restore plus an update,
+//!   whichever changes fewer edges), solve, sample;
 //! - `field_add_stroke_refactor`: add with `rank1_update_limit = 0` (numeric
 //!   refactorisation with the kept symbolic analysis; the behaviour before the limit
 //!   was raised to 640 edges);
@@ -150,6 +154,28 @@ fn main() {
         d.checkpoint_restore_count() - restores_before,
         d.refactor_count() - refactors_before
     );
+    // A mouse drag: the same stroke moved 1 px per event (a front end re-solves on each),
+    // 12 events per repeat; the edit path is chosen by edge counts (design_factor).
+    let mut t_drag_1px = Vec::new();
+    for k in 0..repeats {
+        let y = 150.0 + 10.0 * k as f64;
+        let sid = d.add_stroke(stroke_at(k)).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
+        for step in 1..=12 {
+            let dy = step as f64;
+            let moved = Stroke::from_pixels(&[
+                [60.0, y + dy],
+                [200.0, y - 20.0 + dy],
+                [300.0, y + 10.0 + dy],
+            ]);
+            let t = Instant::now();
+            d.set_stroke(sid, moved).unwrap();
+            d.solve_and_sample_into(size, size, &mut buf).unwrap();
+            t_drag_1px.push(ms(t));
+        }
+        d.remove_stroke(sid).unwrap();
+        d.solve_and_sample_into(size, size, &mut buf).unwrap();
+    }
     // A short stroke (~18 px, about 40 edges).
     let mut t_short = Vec::new();
     let updates_short = d.rank1_update_count();
@@ -204,6 +230,12 @@ fn main() {
     println!("BENCH field_add_stroke median_ms={:.2}", median(t_stroke));
     println!("BENCH field_move_stroke median_ms={:.2}", median(t_move_stroke));
     println!("BENCH field_remove_stroke median_ms={:.2}", median(t_remove_stroke));
+    println!("BENCH field_drag_stroke_1px median_ms={:.2}", median(t_drag_1px.clone()));
+    t_drag_1px.sort_by(|a, b| a.total_cmp(b));
+    println!(
+        "BENCH field_drag_stroke_1px_p90 median_ms={:.2}",
+        t_drag_1px[t_drag_1px.len() * 9 / 10]
+    );
     println!("BENCH field_add_stroke_refactor median_ms={:.2}", median(t_stroke_refactor));
     println!("BENCH field_add_short_stroke median_ms={:.2}", median(t_short));
     println!("BENCH field_numeric_refactor median_ms={:.2}", median(t_refactor));

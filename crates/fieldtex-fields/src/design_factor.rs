@@ -13,31 +13,46 @@
 //!   factorization", via `fieldtex_linalg::Cholesky::add_diagonal_penalties`); cost
 //!   `ups + 2 · downs` (downdates run rank-1 sweeps, updates blocked reflections);
 //! - **checkpoint**: a kept copy of an earlier factor with stroke diagonal `s_c ≤ s` is
-//!   copied into the current factor's buffers (`Cholesky::clone_from`) and gets one
-//!   multiple-rank update with `s − s_c`; cost `64 + #(s ≠ s_c)` (the copy of the
-//!   2.3M-entry factor measured 4–13 ms under load averages 3–5, where a clone, with
-//!   fresh pages, took 12–55 ms; an updated edge 0.1–0.2 ms). No downdate at
-//!   all: dragging a stroke costs a copy plus the update of the stroke's new edges,
-//!   removing the last-added stroke a copy. The checkpoint is taken at every
-//!   refactorisation and, before an edit that only adds weight, from the current factor
-//!   when the old one lies above the new diagonal somewhere or more than 64 edges
-//!   behind (so it is "everything but the stroke being drawn");
+//!   copied into the current factor's buffers and gets one multiple-rank update with
+//!   `s − s_c`; cost `16 + #(s ≠ s_c)`. The copy moves only what can differ
+//!   (`Cholesky::copy_changed_from`): the two factors were equal after the last copy
+//!   between them, and each diagonal modification since changed only the columns on its
+//!   edge's elimination-tree path, so the edges modified since (`dirty`) name every
+//!   column to copy — for a ~250-edge stroke 1.4–1.7 ms instead of 4–13 ms for the whole
+//!   2.3M-entry factor (measured under load averages 3–5; a clone with fresh pages took
+//!   12–55 ms). No downdate at all: dragging a stroke costs that copy plus the update of
+//!   the stroke's new edges, removing the last-added stroke the copy. The checkpoint is
+//!   taken at every refactorisation and, before an edit that only adds weight, from the
+//!   current factor (again only the dirty paths) when the old one lies above the new
+//!   diagonal somewhere or more than 16 edges behind (so it is "everything but the
+//!   stroke being drawn");
 //! - **refactorisation**: when more than [`crate::FieldDesignOptions::rank1_update_limit`]
 //!   (default 640) edges would be modified, after `16 ×` that many modifications since
 //!   the last factorisation (rounding drift), or when a downdate is refused.
 //!
 //! Measured on the 128² grid of the interactive benchmark (49K unknowns, 2.3M factor
 //! entries, 2 cores shared with other jobs, `cargo build --release -p fieldtex-fields
-//! --examples && target/release/examples/bench_fields`, medians of three runs of 15
-//! under a load average of 4.4–5.0, old and new binaries interleaved), one frame =
-//! edit + solve + 512² sampling: adding a ~250 px stroke (~250 edges, direct update)
-//! 75 → 44 ms, dragging it by 2–6 px 128 → 50 ms, removing it 118 → 24 ms, a ~18 px
-//! stroke 42 → 19 ms (the last three through the checkpoint; the solve's share fell with
-//! the supernodal sparse solve, see [`crate::field_design`]). A numeric refactorisation
-//! now includes the take-over for updates (before: in the first solve) and the
-//! checkpoint copy (~90–170 ms). Issue 3's 20 ms stays out of reach for long strokes:
-//! the update of `k` edges touches the factor columns on the edges' elimination-tree
-//! paths, which on a 2-D grid always include the top separators, ~0.1–0.2 ms per edge.
+//! --examples && target/release/examples/bench_fields`, medians of 15), one frame =
+//! edit + solve + 512² sampling. Session 4 (load 4.4–5.0, against the sweeps-only
+//! factor): adding a ~250 px stroke (~250 edges, direct update) 75 → 44 ms, dragging it
+//! by 2–6 px 128 → 50 ms, removing it 118 → 24 ms, a ~18 px stroke 42 → 19 ms. With the
+//! path copies (load 2.2–2.8, old and new binaries interleaved): drag 52 → 30–35 ms,
+//! remove 24 → 13–14 ms, add 30–33 ms (no copy involved), short stroke 16–18 ms; a mouse
+//! drag of 1 px per event (`field_drag_stroke_1px`) 31–32 ms, 90th percentile 34–43 ms.
+//! A numeric refactorisation includes the take-over for updates and the checkpoint copy
+//! (~90–170 ms).
+//!
+//! Issue 3's 20 ms stays out of reach for long strokes: the update of `k` edges touches
+//! the factor columns on the edges' elimination-tree paths, which on a 2-D grid always
+//! include the top separators. Counted for the benchmark's ~250-edge strokes (rows ×
+//! modifications over the union of the paths): 38–52M operations, of which 38–57 % in
+//! the chain of supernodes above the first branching of the union, which every
+//! modification crosses; below it the union splits into unbalanced subtrees (e.g. 31M
+//! against 0.2M), so running the subtrees of the update in parallel would save at most
+//! ~20 %, and the update stays ~16–19 ms on this machine. A tree-parallel backward
+//! substitution was tried again and was slower here (9.8 → 11.6 ms per singularity
+//! move: building the supernode tree and the shared-slice accesses cost more than the
+//! second core gave).
 //!
 //! Not implemented: a Woodbury (capacitance-matrix) correction of the solve instead of a
 //! factor modification: it needs `A⁻¹` at the stroke's ~250–500 edges, i.e. as many
@@ -52,9 +67,12 @@ use crate::FieldsError;
 /// 30–50 ms for 250 edges on the 128² grid).
 const DOWNDATE_WEIGHT: usize = 2;
 
-/// Cost of copying the checkpoint factor into the current one, in updated edges (the
-/// copy of the 2.3M-entry factor measured 4–13 ms, an updated edge 0.1–0.2 ms).
-const RESTORE_COST: usize = 64;
+/// Cost of bringing the current factor back to the checkpoint, in updated edges: the
+/// copy of the changed paths measured ~1 ms for a ~250-edge stroke, an updated edge
+/// 0.05–0.1 ms (64 while the whole 2.3M-entry factor was copied, 4–13 ms; 16 and 64
+/// measured the same within noise on the stroke benchmarks, 16 with a lower 90th
+/// percentile for 1 px drags).
+const RESTORE_COST: usize = 16;
 
 /// An earlier factor kept to rebuild later ones by updates only.
 struct Checkpoint {
