@@ -68,7 +68,7 @@ use crate::FieldsError;
 const DOWNDATE_WEIGHT: usize = 2;
 
 /// Cost of bringing the current factor back to the checkpoint, in updated edges: the
-/// copy of the changed paths measured ~1 ms for a ~250-edge stroke, an updated edge
+/// copy of the changed paths measured 1.4–1.7 ms for a ~250-edge stroke, an updated edge
 /// 0.05–0.1 ms (64 while the whole 2.3M-entry factor was copied, 4–13 ms; 16 and 64
 /// measured the same within noise on the stroke benchmarks, 16 with a lower 90th
 /// percentile for 1 px drags).
