@@ -28,14 +28,17 @@
 //!   rayon thread count.
 
 pub mod appearance_space;
+pub mod color_lookup;
 pub mod domain;
 mod error;
 pub mod exemplar_analysis;
+pub mod flip_combing;
 pub mod gaussian_stack;
 pub mod k_coherence;
 pub mod parallel_synthesis;
 pub mod synthesis_options;
 
+pub use color_lookup::{ColorFilter, color_lookup};
 pub use domain::{ImageDomain, SynthesisDomain};
 pub use error::SynthError;
 pub use exemplar_analysis::{APPEARANCE_DIMS, AnalysisLevel, AnalysisOptions, ExemplarAnalysis};

@@ -26,6 +26,33 @@
 //!    [`SynthesisOptions::own_candidates`]) its own jumps `S[p] + C′ᵢ(S[p])`; the one
 //!    whose exemplar neighbourhood `Ẽ_β[u + (−1)^β h Δ]` (4 × 8 = 32-D) is closest wins
 //!    (ties: the earlier candidate, the current value first) and sets `S[p]`, `I[p]`.
+//!    With [`SynthesisOptions::keep_flips`] (default) only candidates with `α = I[p]`
+//!    take part, so `I` changes only through the upsampling bits `c`.
+//! 4. **Colours**: after the finest level, `E[S[p]]` read with
+//!    [`SynthesisOptions::color_filter`] (cubic convolution by default,
+//!    [`crate::color_lookup`]).
+//!
+//! Flip indicators start combed on the initialisation level
+//! ([`SynthesisOptions::comb_flips`], [`crate::flip_combing`]), so the effective frame
+//! has seams only where the field's singularities force them.
+//!
+//! # Why the 2-RoSy fix did not reduce defects near singularities (issue 3)
+//! Measured with `examples/orient_probe` on the `out/orient-bench` whorl field, stripes
+//! exemplar, seed 1, load ≈ 2.5: with free flips (paper D lets the winner's `α` become
+//! `I[p]`) the flipped regions grew ragged boundaries — 13 853 horizontal/vertical
+//! neighbour pairs whose effective frames point in opposite directions, against the 463
+//! representative jumps of the field itself (the `--no-rosy-fix` run). Each such seam
+//! is a break in the texture (only ≈ 25 % of the pairs across one are coherent): the
+//! fix moved the discontinuities around instead of removing them. With kept flips
+//! (and combing) 417 seam pairs remain, the phase defects fell from 63 to 49 (within 3
+//! periods of the singularities 9 → 7; nofix 11) and the guided coherence (stride 16)
+//! from .00183 to .00154. The remaining defects near singularities are mostly
+//! not the engine's: on woodgrain, bands and weave the phase-defect detector finds
+//! 600–900 defects all over the image, and the count inside the discs of radius 3
+//! periods is what that density predicts (e.g. woodgrain whorl: 12 found, 16.6
+//! expected from the image-wide density), with or without the fix; on stripes the
+//! remaining ones are where the field spreads or squeezes the stripes (deltas, the
+//! core), which a texture of one fixed period cannot follow without ending stripes.
 //!
 //! Speed: the 32-D neighbourhood vector of every exemplar pixel (both copies) is
 //! tabulated per level, so a candidate costs one 32-byte load and an exact integer
@@ -39,7 +66,7 @@
 //!
 //! Not implemented: the second PCA of the neighbourhood vectors (a GPU memory
 //! optimisation), feature-distance channels, per-level jitter amplitudes (only
-//! [`SynthesisOptions::unjittered_levels`]), scale-dependent
+//! [`SynthesisOptions::unjittered_levels`], default 1), scale-dependent
 //! stack levels (with `scale ≠ 1` level `c` still uses stack level `c`).
 
 use std::time::Instant;
@@ -48,8 +75,10 @@ use fieldtex_core::rng::hash_unit;
 use fieldtex_core::{Image, Progress};
 use rayon::prelude::*;
 
+use crate::color_lookup::color_lookup;
 use crate::domain::check_jacobian;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
+use crate::flip_combing::comb_flips;
 
 /// Corner offsets `Δ` of the four-corner neighbourhood; bit 0 of the index is the x
 /// sign (0 = −1), bit 1 the y sign.
@@ -62,7 +91,7 @@ use crate::{SynthError, SynthesisDomain};
 /// [`SynthesisDomain::output_size`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SynthesisResult {
-    /// Exemplar colour at each sample's coordinate.
+    /// Exemplar colour at each sample's coordinate ([`SynthesisOptions::color_filter`]).
     pub colors: Image,
     /// Exemplar coordinate of each sample, in `[0, W) × [0, H)`.
     pub coords: Vec<[f32; 2]>,
@@ -325,6 +354,8 @@ struct Pass<'a> {
     k: usize,
     rosy: bool,
     own: bool,
+    /// [`SynthesisOptions::keep_flips`] (with the 2-RoSy fix).
+    keep_flips: bool,
     /// Whether the CPU supports AVX2 (the correction then runs the AVX2 build).
     avx2: bool,
 }
@@ -441,6 +472,9 @@ impl Pass<'_> {
                 continue;
             }
             let (u, a, off) = pred[k];
+            if self.keep_flips && a != current.1 {
+                continue;
+            }
             push(u, a);
             if self.k == 0 {
                 continue;
@@ -534,7 +568,11 @@ fn synthesize_with(
             [(ux as f32).min(wf.next_down()), (uy as f32).min(hf.next_down())]
         })
         .collect();
-    let mut fl = vec![false; n_init];
+    let mut fl = if options.rosy_fix && options.comb_flips {
+        comb_flips(&parent_tables.nbr, &parent_tables.jac)
+    } else {
+        vec![false; n_init]
+    };
     let mut level_timings_ms = Vec::with_capacity(levels);
 
     for level in (0..levels).rev() {
@@ -567,8 +605,16 @@ fn synthesize_with(
             })
             .unzip();
         // 3. Correction passes with subpasses.
-        let pass =
-            Pass { ex, t: &tables, spacing, k: options.k, rosy, own: options.own_candidates, avx2 };
+        let pass = Pass {
+            ex,
+            t: &tables,
+            spacing,
+            k: options.k,
+            rosy,
+            own: options.own_candidates,
+            avx2,
+            keep_flips: rosy && options.keep_flips,
+        };
         let passes = if level == 0 {
             options.finest_passes.unwrap_or(options.correction_passes)
         } else {
@@ -591,7 +637,8 @@ fn synthesize_with(
         progress.advance(1);
     }
     progress.finish_stage();
-    let pixels = s.iter().map(|&u| analysis.color_at(u)).collect();
+    let filter = options.color_filter;
+    let pixels = s.par_iter().map(|&u| color_lookup(analysis, u, filter)).collect();
     Ok(SynthesisResult {
         colors: Image { width: out_w, height: out_h, pixels },
         coords: s,

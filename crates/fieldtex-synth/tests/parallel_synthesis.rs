@@ -4,8 +4,8 @@ use std::f32::consts::PI;
 
 use fieldtex_core::{Image, NoProgress};
 use fieldtex_synth::{
-    AnalysisOptions, ExemplarAnalysis, ImageDomain, SynthError, SynthesisDomain, SynthesisOptions,
-    synthesize,
+    AnalysisOptions, ColorFilter, ExemplarAnalysis, ImageDomain, SynthError, SynthesisDomain,
+    SynthesisOptions, synthesize,
 };
 
 /// Horizontal sinusoidal stripes (they run along x, vary along y), period 8 px, tileable.
@@ -83,7 +83,8 @@ fn coords_are_valid_and_colours_match_the_exemplar() {
     let an = analyse(&ex);
     assert_eq!(an.level_count(), 5);
     let dom = ImageDomain::constant(37, 29, 0.7, 1.0).unwrap();
-    let r = synthesize(&an, &dom, &SynthesisOptions::default(), &NoProgress).unwrap();
+    let opts = SynthesisOptions { color_filter: ColorFilter::Nearest, ..Default::default() };
+    let r = synthesize(&an, &dom, &opts, &NoProgress).unwrap();
     assert_eq!((r.colors.width, r.colors.height), (37, 29));
     assert_eq!(r.coords.len(), 37 * 29);
     assert_eq!(r.flips.len(), 37 * 29);
@@ -307,4 +308,49 @@ fn real_non_power_of_two_exemplar_follows_the_field() {
     let inside =
         r.coords.iter().filter(|u| u.iter().all(|&v| v >= margin && v < 116.0 - margin)).count();
     assert!(inside as f32 > 0.99 * r.coords.len() as f32, "{inside} of {}", r.coords.len());
+}
+
+/// Horizontal and vertical neighbour pairs whose effective frames `(−1)^I J` point in
+/// opposite directions.
+fn effective_seams(r: &fieldtex_synth::SynthesisResult, dom: &ImageDomain) -> usize {
+    let (w, h) = (dom.width, dom.height);
+    let eff = |p: usize| dom.jacobian(0, p).map(|v| if r.flips[p] { -v } else { v });
+    let mut seams = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let a = eff(y * w + x);
+            for (qx, qy) in [(x + 1, y), (x, y + 1)] {
+                if qx < w && qy < h {
+                    let b = eff(qy * w + qx);
+                    seams += (a[0] * b[0] + a[1] * b[1] < 0.0) as usize;
+                }
+            }
+        }
+    }
+    seams
+}
+
+#[test]
+fn kept_flips_leave_fewer_effective_frame_seams_than_free_flips() {
+    // Two +1/2 wedges: the representative field jumps along cuts from each, and a
+    // 180°-symmetric exemplar (stripes) lets free flips wander.
+    let an = analyse(&stripes(32));
+    let n = 96usize;
+    let field: Vec<f32> = (0..n * n)
+        .flat_map(|i| {
+            let (x, y) = ((i % n) as f32 + 0.5, (i / n) as f32 + 0.5);
+            let a = 0.5 * (y - 48.0).atan2(x - 30.0) + 0.5 * (y - 48.0).atan2(x - 66.0);
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    let dom = ImageDomain::from_direction_field(n, n, &field, 1.0).unwrap();
+    let (mut kept, mut free) = (0, 0);
+    for seed in 0..3 {
+        let opts = SynthesisOptions { seed, ..Default::default() };
+        kept += effective_seams(&synthesize(&an, &dom, &opts, &NoProgress).unwrap(), &dom);
+        let opts = SynthesisOptions { seed, keep_flips: false, ..Default::default() };
+        free += effective_seams(&synthesize(&an, &dom, &opts, &NoProgress).unwrap(), &dom);
+    }
+    eprintln!("effective-frame seam pairs: kept {kept}, free {free}");
+    assert!(kept * 2 < free, "kept flips {kept} vs free flips {free}");
 }
