@@ -59,15 +59,18 @@ impl DynamicFactor {
     /// within a supernode each column's parent is the next) and stored in faer's
     /// column-major block. `work[t]` is modification `t`'s work vector over the union's
     /// slots and `beta[t]` its C1 scale (the pending vector is `work[t] / beta[t]`).
+    /// `through(q)` lists, ascending, the modifications whose path holds the union column
+    /// in slot `q` (the only ones that can have nonzero work entries there).
     /// Returns [`Blocked::Done`] with the union position after the supernode,
     /// [`Blocked::No`] with the first column past it if it does not qualify (the caller
     /// sweeps its columns), `Err(column)` if a pivot became non-finite (overflow).
-    pub(crate) fn blocked_supernode_update(
+    pub(crate) fn blocked_supernode_update<'a>(
         &mut self,
         union: &[usize],
         pos: usize,
         work: &mut [&mut [f64]],
         beta: &mut [f64],
+        through: impl Fn(usize) -> &'a [u32],
     ) -> Result<Blocked, usize> {
         let j = union[pos];
         if !self.faer_layout || self.supernodes.len() < 2 {
@@ -88,26 +91,47 @@ impl DynamicFactor {
             return Ok(Blocked::No(end));
         }
         let slot0 = self.slot[j] as usize;
-        let active: Vec<usize> = (0..work.len())
+        // every path that meets the supernode leaves it through its last column
+        // (the supernode's columns are consecutive on the union: so are their slots)
+        let active: Vec<usize> = through(slot0 + b - 1)
+            .iter()
+            .map(|&t| t as usize)
             .filter(|&t| work[t][slot0..slot0 + b].iter().any(|&w| w != 0.0))
             .collect();
         let k = active.len();
         if k < MIN_MODS || m * b * k < MIN_WORK {
             return Ok(Blocked::No(end));
         }
-        let row_slot: Vec<usize> =
-            self.rows[s0..s0 + m].iter().map(|&r| self.slot[r as usize] as usize).collect();
+        // the block's rows as segments `(first block row, first slot, length)` of
+        // consecutive slots: the diagonal row, then the column's runs of consecutive rows
+        // (consecutive slots on any union of paths, `DynamicFactor::runs`)
+        let mut segments: Vec<(usize, usize, usize)> = vec![(0, slot0, 1)];
+        let (r0, rn) = self.run_ptr[j];
+        for &(q, r, len) in &self.runs[r0 as usize..(r0 + rn) as usize] {
+            let (row, sl, len) = (1 + q as usize, self.slot[r as usize] as usize, len as usize);
+            match segments.last_mut() {
+                Some(last) if last.0 + last.2 == row && last.1 + last.2 == sl => last.2 += len,
+                _ => segments.push((row, sl, len)),
+            }
+        }
+        debug_assert_eq!(segments.iter().map(|g| g.2).sum::<usize>(), m);
         // reused buffers (no fresh pages per supernode): `W`, then the chunks' scratch
         let mut buf = std::mem::take(&mut self.blocked_buf.0);
         let n_chunks = (m - b.min(PANEL)).div_ceil(CHUNK_ROWS);
-        buf.clear();
-        buf.resize(m * k + n_chunks * SCRATCH, 0.0);
-        let (wbuf, scratch) = buf.split_at_mut(m * k);
+        // grown only (no zero fill): `W` is written whole by the gather below and the
+        // scratch by `apply_block` before it is read
+        let need = m * k + n_chunks * SCRATCH;
+        if buf.len() < need {
+            buf.resize(need, 0.0);
+        }
+        let (wbuf, scratch) = buf[..need].split_at_mut(m * k);
         for (a, &t) in active.iter().enumerate() {
             let inv = 1.0 / beta[t];
             let (src, col) = (&work[t], &mut wbuf[a * m..(a + 1) * m]);
-            for (x, &sl) in col.iter_mut().zip(&row_slot) {
-                *x = src[sl] * inv;
+            for &(row, sl, len) in &segments {
+                for (x, &w) in col[row..row + len].iter_mut().zip(&src[sl..sl + len]) {
+                    *x = w * inv;
+                }
             }
         }
         let len = (b - 1) * ld + m;
@@ -118,8 +142,8 @@ impl DynamicFactor {
         if result.is_ok() {
             for (a, &t) in active.iter().enumerate() {
                 let (dst, col) = (&mut work[t], &wbuf[a * m..(a + 1) * m]);
-                for (&x, &sl) in col.iter().zip(&row_slot) {
-                    dst[sl] = x;
+                for &(row, sl, len) in &segments {
+                    dst[sl..sl + len].copy_from_slice(&col[row..row + len]);
                 }
                 beta[t] = 1.0;
             }
