@@ -4,7 +4,7 @@
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
 //!  [DIR…] [--const DEG…] [--both] [--no-rosy-fix] [--free-flips] [--no-comb] [--nearest]
 //!  [--passes N] [--finest-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
-//!  [--seed S] [--stride N] [--runs R] [--png DIR]`
+//!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--analysis-k K]`
 //!
 //! Each `DIR` holds `field.npy` (H × W × 2) and `report.json` (its
 //! `metrics.designed_singularities`), e.g. `out/orient-bench/<exemplar>-<preset>`.
@@ -53,6 +53,40 @@ fn load_case(dir: &Path) -> Case {
     Case { name, n: shape[0], field, sings }
 }
 
+/// Stripe ends a texture of period `t` must have near the singularities when its
+/// stripes follow the field: stripes along the unit line field `d` with a constant
+/// period need a phase `φ` with `∇φ = (2π/t) d⊥`, which exists only where
+/// `curl d⊥ = div d = 0`; the net number of stripe ends in a region is
+/// `∫ div d dA / t`. Summed here as `∫ |div d| dA / t` over the annuli `1.5 t ≤ r ≤ 3 t`
+/// around the designed singularities (the phase-defect metric skips the inner 1.5 t),
+/// with `d` of each neighbour sign-aligned to the centre's (a line field).
+fn required_dislocations(case: &Case, t: f64) -> f64 {
+    let n = case.n;
+    let v = |x: usize, y: usize| {
+        let i = 2 * (y * n + x);
+        [case.field[i] as f64, case.field[i + 1] as f64]
+    };
+    let mut sum = 0.0;
+    for y in 1..n - 1 {
+        for x in 1..n - 1 {
+            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+            let inside = case.sings.iter().any(|s| {
+                let r2 = (px - s[0]).powi(2) + (py - s[1]).powi(2);
+                r2 <= 9.0 * t * t && r2 >= 2.25 * t * t
+            });
+            if !inside {
+                continue;
+            }
+            let c = v(x, y);
+            let al = |w: [f64; 2]| if w[0] * c[0] + w[1] * c[1] < 0.0 { [-w[0], -w[1]] } else { w };
+            let (e, wv, s, nn) =
+                (al(v(x + 1, y)), al(v(x - 1, y)), al(v(x, y + 1)), al(v(x, y - 1)));
+            sum += (0.5 * (e[0] - wv[0]) + 0.5 * (s[1] - nn[1])).abs();
+        }
+    }
+    sum / t
+}
+
 fn main() {
     let mut args = std::env::args().skip(1);
     let exemplar = PathBuf::from(args.next().expect("EXEMPLAR.png"));
@@ -60,11 +94,14 @@ fn main() {
     let mut opts = SynthesisOptions { seed: 1, ..Default::default() };
     let (mut both, mut stride, mut runs) = (false, 8usize, 1usize);
     let mut png: Option<PathBuf> = None;
+    let mut aopts = AnalysisOptions::default();
     let mut consts: Vec<f32> = Vec::new();
     while let Some(a) = args.next() {
         match a.as_str() {
             "--both" => both = true,
             "--no-comb" => opts.comb_flips = false,
+            "--scan" => aopts.coherence_scan = num(args.next(), &a),
+            "--analysis-k" => aopts.k = num(args.next(), &a),
             "--nearest" => opts.color_filter = fieldtex_synth::ColorFilter::Nearest,
             "--free-flips" => opts.keep_flips = false,
             "--const" => consts.push(num::<f32>(args.next(), &a)),
@@ -84,7 +121,7 @@ fn main() {
     }
     let ex: Image = fieldtex_io::read_image(&exemplar).expect("exemplar");
     let t0 = Instant::now();
-    let analysis = ExemplarAnalysis::new(&ex, &AnalysisOptions::default(), &NoProgress).unwrap();
+    let analysis = ExemplarAnalysis::new(&ex, &aopts, &NoProgress).unwrap();
     println!(
         "analysis_ms={:.0} explained={:?}",
         t0.elapsed().as_secs_f64() * 1e3,
@@ -179,8 +216,9 @@ fn main() {
             let near = ev::count_defects_near(&pd.defects, &case.sings, r);
             let disc = std::f64::consts::PI * r * r * case.sings.len() as f64;
             let bg = pd.count as f64 * disc / pd.evaluated_pixels.max(1) as f64;
+            let need = required_dislocations(case, pd.period_px);
             println!(
-                "{:44} fix={} syn_ms={:6.0} gc={:.6} oe={:5.2} defects={:4} near={:3} bg={:5.1} T={:.1}",
+                "{:44} fix={} syn_ms={:6.0} gc={:.6} oe={:5.2} defects={:4} near={:3} bg={:5.1} need={:4.1} T={:.1}",
                 case.name,
                 fix as u8,
                 times[times.len() / 2],
@@ -189,6 +227,7 @@ fn main() {
                 pd.count,
                 near,
                 bg,
+                need,
                 pd.period_px
             );
             if let Some(dir) = &png {

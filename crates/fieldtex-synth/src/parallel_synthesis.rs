@@ -59,7 +59,7 @@
 //! distance; candidates are gathered first and scored in one branch-free sweep; on CPUs
 //! with AVX2 the correction runs an AVX2 build (bit-identical results). The finest
 //! level holds ¾ of the samples, so [`SynthesisOptions::finest_passes`] (default 2)
-//! is separate from the coarse levels' [`SynthesisOptions::correction_passes`] (4).
+//! is separate from the coarse levels' [`SynthesisOptions::correction_passes`] (6).
 //!
 //! With [`SynthesisOptions::rosy_fix`] off, the engine is plain anisometric synthesis:
 //! predictions use `J(p)`, no flips, only `Ẽ₀` (the ablation of paper D Fig. 5).
