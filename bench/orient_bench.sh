@@ -2,6 +2,9 @@
 # Quality and speed of `fieldtex orient` (issue: orientation-field guided synthesis)
 # against Embark's texture-synthesis (installed into bench/.tools by this script),
 # on the same exemplar and output size, measured in the same run.
+# err_deg: coherence-weighted orientation error of the texture against the field turned by
+# the exemplar's own dominant stripe direction; the exemplar's own error against that
+# direction (its waviness, a floor for any synthesis) is printed at the end of each line.
 # Usage: bench/orient_bench.sh [--size N] [--presets "whorl left-loop"] [--exemplars "stripes_Fabric071 ..."]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -58,7 +61,8 @@ err = m["texture"]["orientation_error"]["mean_error_deg"]
 coh = m["texture"]["coherence"]["mean"]
 gcoh = m["texture"]["guided_coherence"]["mean"]
 print(f"{sys.argv[3]:32} {sys.argv[4]:12} {err:8.2f} {coh:8.5f} {gcoh:8.5f} {m.get('phase_defects_near_singularities', -1):8} "
-      f"{n['metrics'].get('phase_defects_near_singularities', -1):9} {t['synthesis']:9.0f} {t['analysis']:9.0f} {sys.argv[5]:>8}  (embark coherence {sys.argv[6]})")
+      f"{n['metrics'].get('phase_defects_near_singularities', -1):9} {t['synthesis']:9.0f} {t['analysis']:9.0f} {sys.argv[5]:>8}  (embark coherence {sys.argv[6]}; "
+      f"exemplar's own error {m.get('exemplar_orientation', {}).get('self_error_deg', float('nan')):.1f} deg)")
 PY
   done
 done

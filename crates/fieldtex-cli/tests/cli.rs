@@ -344,6 +344,11 @@ fn orient_preset_outputs_and_determinism() {
     let r = report_without_timings(&a);
     let designed = r["metrics"]["designed_singularities"].as_array().unwrap();
     assert_eq!(designed.len(), 2, "a loop has one core and one delta");
+    // the stripes exemplar runs along its x axis (mod 180°) and is straight
+    let own = &r["metrics"]["exemplar_orientation"];
+    let angle = own["dominant_angle_deg"].as_f64().unwrap();
+    assert!(angle.min(180.0 - angle) < 3.0, "dominant angle {angle}");
+    assert!(own["self_error_deg"].as_f64().unwrap() < 2.0, "{own}");
     assert_eq!(r, report_without_timings(&b));
     let o = run(
         &[

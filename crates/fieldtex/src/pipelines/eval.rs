@@ -49,11 +49,14 @@ pub(crate) fn bad(e: ev::EvalError, what: &Path) -> Error {
 }
 
 /// Computes every metric; `field` is `H×W×2` of the output's size when present.
+/// `exemplar_angle_deg` is the exemplar's own stripe direction for the orientation error
+/// (the texture is expected at field angle + this; 0 = stripes along the exemplar's x).
 pub(crate) fn image_metrics(
     output: &Image,
     exemplar: &Image,
     field: Option<&[f32]>,
     angle_deg: Option<f64>,
+    exemplar_angle_deg: f64,
     seed: u64,
 ) -> std::result::Result<ImageMetrics, ev::EvalError> {
     let ob = ev::rgb_buffer(output);
@@ -82,7 +85,10 @@ pub(crate) fn image_metrics(
         _ => None,
     };
     let orientation_error = match reference {
-        Some(r) => Some(ev::orientation_error(&o, &r, &ev::OrientationErrorOptions::default())?),
+        Some(r) => {
+            let opts = ev::OrientationErrorOptions { exemplar_angle_deg, ..Default::default() };
+            Some(ev::orientation_error(&o, &r, &opts)?)
+        }
         None => {
             skipped.push("orientation_error: no guidance field or angle given".to_string());
             None
@@ -153,5 +159,5 @@ pub fn eval_files(
         }
         None => (None, None),
     };
-    image_metrics(&out, &ex, field.as_deref(), angle, seed).map_err(|e| bad(e, image))
+    image_metrics(&out, &ex, field.as_deref(), angle, 0.0, seed).map_err(|e| bad(e, image))
 }

@@ -188,8 +188,14 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     fieldtex_io::write_png(&out_dir.join("texture.png"), &synth)?;
     fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
+    // The exemplar's own stripe direction: the texture is expected at field angle + it
+    // (as `align` measures on surfaces); 0 when it has no measurable orientation.
+    let own = exemplar_orientation(&exemplar);
+    let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
     let metrics = report
-        .time("metrics", || image_metrics(&synth, &exemplar, Some(&flat), None, options.seed))
+        .time("metrics", || {
+            image_metrics(&synth, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
+        })
         .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
     // Phase defects near designed singularities (within 3 exemplar periods).
     if let Some(pd) = &metrics.phase_defects {
@@ -199,10 +205,46 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     }
     report.metric("designed_singularities", &designed);
     report.metric("texture", &metrics);
+    if let Some(own) = &own {
+        report.metric("exemplar_orientation", own);
+    }
     let preview = preview_with_singularities(&synth, &designed);
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     write_report(out_dir, &report)?;
     Ok(report)
+}
+
+/// The exemplar's dominant stripe direction and its own orientation error against it.
+#[derive(Debug, Clone, serde::Serialize)]
+pub(crate) struct ExemplarOrientation {
+    /// Coherence-weighted mean stripe direction (structure tensor), degrees in [0, 180).
+    pub dominant_angle_deg: f64,
+    /// Coherence of that mean direction, in [0, 1].
+    pub dominant_coherence: f64,
+    /// The exemplar's orientation error against its dominant direction (same structure
+    /// tensor and weighting as `texture.orientation_error`): the floor that a synthesis
+    /// reproducing the exemplar's local structure cannot go below. A wavy exemplar (e.g.
+    /// curved bands) scores tens of degrees here, and its guided outputs about as much.
+    pub self_error_deg: f64,
+}
+
+/// [`ExemplarOrientation`] of an exemplar; `None` when it has no measurable orientation.
+pub(crate) fn exemplar_orientation(exemplar: &Image) -> Option<ExemplarOrientation> {
+    let buf = fieldtex_eval::rgb_buffer(exemplar);
+    let view = fieldtex_eval::ImageView::new(&buf, exemplar.width, exemplar.height, 3).ok()?;
+    let (angle, coherence) = fieldtex_eval::dominant_orientation(&view).ok()?;
+    let reference = fieldtex_eval::OrientationReference::ConstantDeg(angle);
+    let own = fieldtex_eval::orientation_error(
+        &view,
+        &reference,
+        &fieldtex_eval::OrientationErrorOptions::default(),
+    )
+    .ok()?;
+    Some(ExemplarOrientation {
+        dominant_angle_deg: angle,
+        dominant_coherence: coherence,
+        self_error_deg: own.mean_error_deg,
+    })
 }
 
 /// The texture with designed singularities marked: wedges (+1/2) as red discs,

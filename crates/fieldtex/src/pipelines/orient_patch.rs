@@ -160,15 +160,23 @@ pub(crate) fn orient_patch(
     fieldtex_io::write_png(&out_dir.join("texture.png"), &texture)?;
     fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
     report.time("model", || super::write_model(out_dir, &patch.mesh, Some(&texture)))?;
+    // the exemplar's own stripe direction (see `orient`): expected at field angle + it
+    let own = super::orient::exemplar_orientation(&exemplar);
+    let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
+    if let Some(own) = &own {
+        report.metric("exemplar_orientation", own);
+    }
     let metrics = report
-        .time("metrics", || image_metrics(&texture, &exemplar, Some(&flat), None, options.seed))
+        .time("metrics", || {
+            image_metrics(&texture, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
+        })
         .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
     let pts: Vec<[f64; 2]> = designed.iter().map(|s| s.texel).collect();
     if let Some(pd) = &metrics.phase_defects {
         let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
         report.metric("phase_defects_near_singularities", near);
     }
-    if let Some(e) = chart_orientation_error(&texture, &field, &inside) {
+    if let Some(e) = chart_orientation_error(&texture, &field, &inside, exemplar_angle) {
         report.metric("chart_orientation_error", e);
     }
     let marks: Vec<DesignedSingularity> = designed
@@ -285,6 +293,7 @@ fn chart_orientation_error(
     texture: &Image,
     field: &[[f32; 2]],
     inside: &[bool],
+    exemplar_angle_deg: f64,
 ) -> Option<ChartOrientationError> {
     let buf = fieldtex_eval::rgb_buffer(texture);
     let view = fieldtex_eval::ImageView::new(&buf, texture.width, texture.height, 3).ok()?;
@@ -299,7 +308,8 @@ fn chart_orientation_error(
             if !inside[i] {
                 continue;
             }
-            let expected = (field[i][1] as f64).atan2(field[i][0] as f64);
+            let expected =
+                (field[i][1] as f64).atan2(field[i][0] as f64) + exemplar_angle_deg.to_radians();
             let d = (om.angle[i] as f64 - expected).rem_euclid(std::f64::consts::PI);
             let e = d.min(std::f64::consts::PI - d);
             let c = om.coherence[i] as f64;
