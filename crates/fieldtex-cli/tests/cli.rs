@@ -350,6 +350,36 @@ fn orient_preset_outputs_and_determinism() {
     assert!(angle.min(180.0 - angle) < 3.0, "dominant angle {angle}");
     assert!(own["self_error_deg"].as_f64().unwrap() < 2.0, "{own}");
     assert_eq!(r, report_without_timings(&b));
+    // --no-metrics: the same texture, a report without image metrics
+    let c = tmp("orient-t3");
+    let o = run(
+        &[
+            "orient",
+            "--preset",
+            "left-loop",
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--size",
+            "128",
+            "--grid",
+            "32",
+            "--out",
+            c.to_str().unwrap(),
+            "--no-metrics",
+            "--quiet",
+        ],
+        limit,
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        std::fs::read(a.join("texture.png")).unwrap()
+            == std::fs::read(c.join("texture.png")).unwrap()
+    );
+    let rc = report_without_timings(&c);
+    assert!(
+        rc["metrics"].get("texture").is_none()
+            && rc["metrics"]["designed_singularities"].is_array()
+    );
     let o = run(
         &[
             "orient",

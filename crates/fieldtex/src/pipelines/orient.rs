@@ -48,6 +48,9 @@ pub struct OrientOptions {
     /// With `mesh`: texture only the connected region of triangles whose centroids lie
     /// within radius `[3]` of the point `[0..3]` (`--patch X,Y,Z,R`). Default None.
     pub patch: Option<[f64; 4]>,
+    /// Compute the image metrics of the report (`--no-metrics` turns them off: they take
+    /// ~15 s for a 512² output, mostly the exact patch searches). Default true.
+    pub metrics: bool,
 }
 
 impl OrientOptions {
@@ -62,6 +65,7 @@ impl OrientOptions {
             seed: 1,
             mesh: None,
             patch: None,
+            metrics: true,
         }
     }
 }
@@ -188,25 +192,29 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     fieldtex_io::write_png(&out_dir.join("texture.png"), &synth)?;
     fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
-    // The exemplar's own stripe direction: the texture is expected at field angle + it
-    // (as `align` measures on surfaces); 0 when it has no measurable orientation.
-    let own = exemplar_orientation(&exemplar);
-    let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
-    let metrics = report
-        .time("metrics", || {
-            image_metrics(&synth, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
-        })
-        .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
-    // Phase defects near designed singularities (within 3 exemplar periods).
-    if let Some(pd) = &metrics.phase_defects {
-        let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-        let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
-        report.metric("phase_defects_near_singularities", near);
-    }
     report.metric("designed_singularities", &designed);
-    report.metric("texture", &metrics);
-    if let Some(own) = &own {
-        report.metric("exemplar_orientation", own);
+    if options.metrics {
+        // The exemplar's own stripe direction: the texture is expected at field angle + it
+        // (as `align` measures on surfaces); 0 when it has no measurable orientation.
+        let own = exemplar_orientation(&exemplar);
+        let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
+        let metrics = report
+            .time("metrics", || {
+                image_metrics(&synth, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
+            })
+            .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
+        // Phase defects near designed singularities (within 3 exemplar periods).
+        if let Some(pd) = &metrics.phase_defects {
+            let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
+            let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
+            report.metric("phase_defects_near_singularities", near);
+        }
+        report.metric("texture", &metrics);
+        if let Some(own) = &own {
+            report.metric("exemplar_orientation", own);
+        }
+    } else {
+        report.notes.push("image metrics skipped (--no-metrics)".into());
     }
     let preview = preview_with_singularities(&synth, &designed);
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;

@@ -160,38 +160,42 @@ pub(crate) fn orient_patch(
     fieldtex_io::write_png(&out_dir.join("texture.png"), &texture)?;
     fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
     report.time("model", || super::write_model(out_dir, &patch.mesh, Some(&texture)))?;
-    // the exemplar's own stripe direction (see `orient`): expected at field angle + it
-    let own = super::orient::exemplar_orientation(&exemplar);
-    let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
-    if let Some(own) = &own {
-        report.metric("exemplar_orientation", own);
-    }
-    let metrics = report
-        .time("metrics", || {
-            image_metrics(&texture, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
-        })
-        .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
-    let pts: Vec<[f64; 2]> = designed.iter().map(|s| s.texel).collect();
-    if let Some(pd) = &metrics.phase_defects {
-        let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
-        report.metric("phase_defects_near_singularities", near);
-    }
-    if let Some(e) = chart_orientation_error(&texture, &field, &inside, exemplar_angle) {
-        report.metric("chart_orientation_error", e);
-    }
     let marks: Vec<DesignedSingularity> = designed
         .iter()
         .map(|s| DesignedSingularity { x: s.texel[0], y: s.texel[1], index: kind_index(s.kind) })
         .collect();
     report.metric("designed_singularities", &marks);
     report.metric("designed_singularities_on_patch", &designed);
-    report.metric("texture", &metrics);
-    report.notes.push(
-        "curved patch: orientation error, singularities and phase defects are measured in \
-         parameter (texture) space against the field pulled back to it (field.npy); \
-         chart_orientation_error counts chart texels only; nothing is measured on the surface"
-            .into(),
-    );
+    if options.metrics {
+        // the exemplar's own stripe direction (see `orient`): expected at field angle + it
+        let own = super::orient::exemplar_orientation(&exemplar);
+        let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
+        if let Some(own) = &own {
+            report.metric("exemplar_orientation", own);
+        }
+        let metrics = report
+            .time("metrics", || {
+                image_metrics(&texture, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
+            })
+            .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
+        let pts: Vec<[f64; 2]> = designed.iter().map(|s| s.texel).collect();
+        if let Some(pd) = &metrics.phase_defects {
+            let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
+            report.metric("phase_defects_near_singularities", near);
+        }
+        if let Some(e) = chart_orientation_error(&texture, &field, &inside, exemplar_angle) {
+            report.metric("chart_orientation_error", e);
+        }
+        report.metric("texture", &metrics);
+        report.notes.push(
+            "curved patch: orientation error, singularities and phase defects are measured in \
+             parameter (texture) space against the field pulled back to it (field.npy); \
+             chart_orientation_error counts chart texels only; nothing is measured on the surface"
+                .into(),
+        );
+    } else {
+        report.notes.push("image metrics skipped (--no-metrics)".into());
+    }
     let preview = report.time("preview", || preview(&patch.mesh, &texture, &designed));
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     write_report(out_dir, &report)?;
