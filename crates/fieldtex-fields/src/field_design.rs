@@ -59,10 +59,12 @@
 //! 4.4–5.0, medians of three interleaved runs against the previous binary): moving a
 //! singularity 21 → 18 ms (solve alone 19 → 11 ms: the deviation's sparse right-hand
 //! side now runs supernodal dense column loops, `Cholesky::solve_sparse_with_residual`;
-//! plus ~2.5 ms sampling), a full design solve 33 → 16 ms. Stroke edits: add a ~250 px
-//! stroke 44 ms, drag it 50 ms, remove it 24 ms, a short stroke 19 ms — issue 3's 20 ms
-//! is met for short strokes and singularities, not for long strokes (their factor
-//! update, see [`crate::design_factor`]).
+//! plus ~2.5 ms sampling), a full design solve 33 → 16 ms. Stroke edits (session 5, load
+//! 2.4–3.0, after the path copies between the factor and its checkpoint and the faster
+//! multiple-rank update): add a ~250 px stroke 27 ms, drag it 28 ms, a 1 px-per-event
+//! mouse drag 31 ms, remove it 13 ms, a short stroke 16 ms, move a singularity 12 ms —
+//! issue 3's 20 ms is met for singularities, short strokes and removals, not for adding
+//! or moving long strokes (their factor update, see [`crate::design_factor`]).
 
 use std::sync::Arc;
 
