@@ -2,9 +2,11 @@
 //! `fieldtex orient` (paper D §4 targets of issue 3).
 //!
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
-//!  [DIR…] [--const DEG…] [--both] [--no-rosy-fix] [--free-flips] [--no-comb] [--nearest]
+//!  [DIR…] [--const DEG…] [--ideal DEG…] [--both] [--no-rosy-fix] [--free-flips]
+//!  [--no-comb] [--nearest] [--no-snap]
 //!  [--passes N] [--finest-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
-//!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--analysis-k K]`
+//!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--analysis-k K]
+//!  [--no-metrics]`
 //!
 //! Each `DIR` holds `field.npy` (H × W × 2) and `report.json` (its
 //! `metrics.designed_singularities`), e.g. `out/orient-bench/<exemplar>-<preset>`.
@@ -15,7 +17,8 @@
 //! the image's defects would put there (`bg`), and the coordinate coherence of
 //! neighbour pairs, the effective-frame seams (`(−1)^I J` turning by more than 90°
 //! between neighbours) and the flipped share. `--const DEG` adds a constant-field
-//! case (no singularities). `--both` runs with and without the 2-RoSy fix. `--png DIR`
+//! case (no singularities); `--ideal DEG` scores the exemplar itself rotated to a
+//! constant field (the resampling floor of the metric). `--both` runs with and without the 2-RoSy fix. `--png DIR`
 //! writes the texture, the texture with the defects marked (red: within 3 periods of a
 //! designed singularity), 3× crops around the singularities and the flip map.
 
@@ -95,11 +98,16 @@ fn main() {
     let (mut both, mut stride, mut runs) = (false, 8usize, 1usize);
     let mut png: Option<PathBuf> = None;
     let mut aopts = AnalysisOptions::default();
+    let mut no_metrics = false;
+    let mut ideal: Vec<f32> = Vec::new();
     let mut consts: Vec<f32> = Vec::new();
     while let Some(a) = args.next() {
         match a.as_str() {
             "--both" => both = true,
+            "--no-metrics" => no_metrics = true,
             "--no-comb" => opts.comb_flips = false,
+            "--no-snap" => opts.snap_coordinates = false,
+            "--ideal" => ideal.push(num::<f32>(args.next(), &a)),
             "--scan" => aopts.coherence_scan = num(args.next(), &a),
             "--analysis-k" => aopts.k = num(args.next(), &a),
             "--nearest" => opts.color_filter = fieldtex_synth::ColorFilter::Nearest,
@@ -131,6 +139,33 @@ fn main() {
     );
     let eb = ev::rgb_buffer(&ex);
     let ev_ex = ev::ImageView::new(&eb, ex.width, ex.height, 3).unwrap();
+    // Resampling floor: the exemplar itself rotated to a constant field at each angle
+    // of `--ideal` (coordinates an exact rotation of the output grid, cubic colours),
+    // scored like a synthesis result.
+    for &deg in &ideal {
+        let n = 512usize;
+        let (sn, cs) = deg.to_radians().sin_cos();
+        let mut img = Image { width: n, height: n, pixels: Vec::with_capacity(n * n) };
+        for y in 0..n {
+            for x in 0..n {
+                let (px, py) = (x as f32 + 0.5 - 256.0, y as f32 + 0.5 - 256.0);
+                // J = [d; d⊥]: exemplar x along d = (cos, sin).
+                let u = [
+                    cs * px + sn * py + 1000.0 * ex.width as f32,
+                    -sn * px + cs * py + 1000.0 * ex.height as f32,
+                ];
+                let u = [u[0].rem_euclid(ex.width as f32), u[1].rem_euclid(ex.height as f32)];
+                img.pixels.push(fieldtex_synth::color_lookup(&analysis, u, opts.color_filter));
+            }
+        }
+        let field: Vec<f32> = (0..n * n).flat_map(|_| [cs, sn]).collect();
+        let ob = ev::rgb_buffer(&img);
+        let out = ev::ImageView::new(&ob, n, n, 3).unwrap();
+        let fv = ev::FieldView::new(&field, n, n).unwrap();
+        let gopts = ev::GuidedCoherenceOptions { stride, ..Default::default() };
+        let gc = ev::guided_coherence(&out, &ev_ex, &fv, &gopts).unwrap();
+        println!("ideal rotated copy {deg:5.1}°: gc={:.6} (median {:.6})", gc.mean, gc.median);
+    }
     let fixes: Vec<bool> = if both { vec![true, false] } else { vec![opts.rosy_fix] };
     let mut cases: Vec<Case> = consts
         .iter()
@@ -159,6 +194,16 @@ fn main() {
             }
             times.sort_by(f64::total_cmp);
             let res = res.unwrap();
+            if no_metrics {
+                println!(
+                    "{:44} fix={} syn_ms={:6.0} levels_ms={:?}",
+                    case.name,
+                    fix as u8,
+                    times[times.len() / 2],
+                    res.level_timings_ms.iter().map(|t| t.round()).collect::<Vec<_>>()
+                );
+                continue;
+            }
             // Coordinate coherence of horizontal/vertical neighbour pairs: S[q] − S[p] within
             // 0.5 px of the effective frame's offset F(p) δ, F = (−1)^I J; split by whether
             // the representative vectors jump (J(p)·J(q) < 0) between p and q.
@@ -218,11 +263,13 @@ fn main() {
             let bg = pd.count as f64 * disc / pd.evaluated_pixels.max(1) as f64;
             let need = required_dislocations(case, pd.period_px);
             println!(
-                "{:44} fix={} syn_ms={:6.0} gc={:.6} oe={:5.2} defects={:4} near={:3} bg={:5.1} need={:4.1} T={:.1}",
+                "{:44} fix={} syn_ms={:6.0} gc={:.6} (median {:.6}, p95 {:.6}) oe={:5.2} defects={:4} near={:3} bg={:5.1} need={:4.1} T={:.1}",
                 case.name,
                 fix as u8,
                 times[times.len() / 2],
                 gc.mean,
+                gc.median,
+                gc.p95,
                 oe.mean_error_deg,
                 pd.count,
                 near,

@@ -17,6 +17,15 @@
 //! nearest .00183 / .00503 / .000080 / .00058 → cubic .00171 / .00451 / .000075 /
 //! .00050; bilinear lowered the weave score more (.0039) but blurred its fine diagonal
 //! threads so much that the orientation error rose from 8.9° to 10.7° (cubic 9.0°).
+//!
+//! The resampling floor (`orient_probe --ideal DEG`: the exemplar itself, exactly
+//! rotated to a constant field, scored by `fieldtex_eval::guided_coherence`, stride
+//! 16): at 10°/30°/45° nearest gives weave .0043/.0029/.0029, bands .00057/.00047/
+//! .00047, woodgrain .000074/.000056/.000057, stripes .00110/.00068/.00046; cubic
+//! .0013/.0010/.0011, .00026/.00024/.00023, .000038/.000037/.000037, .00026/.00020/
+//! .00018 (0°: exactly 0 with both). A perfect rotated copy of bands or woodgrain
+//! therefore already scores about what Embark's *unguided* output scores (.00024,
+//! .000039): any rotated synthesis of those two lies above it.
 
 use crate::exemplar_analysis::ExemplarAnalysis;
 
@@ -57,20 +66,35 @@ fn cubic(analysis: &ExemplarAnalysis, u: [f32; 2]) -> [f32; 4] {
     let (x, y) = (u[0] as f64 - 0.5, u[1] as f64 - 0.5);
     let (x0, y0) = (x.floor(), y.floor());
     let (wx, wy) = (keys_weights((x - x0) as f32), keys_weights((y - y0) as f32));
+    // Synthesised coordinates are wrapped, so the taps need at most one wrap each; the
+    // Euclidean remainder covers any other input.
+    let wrap = |v: i64, n: i64| {
+        if v < 0 {
+            if v >= -n { v + n } else { v.rem_euclid(n) }
+        } else if v >= n {
+            if v < 2 * n { v - n } else { v.rem_euclid(n) }
+        } else {
+            v
+        }
+    };
     let (x0, y0) = (x0 as i64, y0 as i64);
+    let xs: [usize; 4] = std::array::from_fn(|i| wrap(x0 - 1 + i as i64, w) as usize);
     let mut acc = [0.0f32; 4];
     let mut lo = [f32::INFINITY; 4];
     let mut hi = [f32::NEG_INFINITY; 4];
     for (j, wyj) in wy.iter().enumerate() {
-        let row = (y0 - 1 + j as i64).rem_euclid(h) * w;
-        for (i, wxi) in wx.iter().enumerate() {
-            let p = colors[(row + (x0 - 1 + i as i64).rem_euclid(w)) as usize];
-            let wgt = wxi * wyj;
+        let row = &colors[wrap(y0 - 1 + j as i64, h) as usize * w as usize..];
+        let mut racc = [0.0f32; 4];
+        for (&xi, wxi) in xs.iter().zip(&wx) {
+            let p = row[xi];
             for c in 0..4 {
-                acc[c] += wgt * p[c];
+                racc[c] += wxi * p[c];
                 lo[c] = lo[c].min(p[c]);
                 hi[c] = hi[c].max(p[c]);
             }
+        }
+        for c in 0..4 {
+            acc[c] += wyj * racc[c];
         }
     }
     std::array::from_fn(|c| acc[c].clamp(lo[c], hi[c]))

@@ -565,6 +565,8 @@ fn synthesize_with(
             let ux = m + hash_unit(options.seed, "synthesis-init", 2 * i) * (w as f64 - 2.0 * m);
             let uy =
                 m + hash_unit(options.seed, "synthesis-init", 2 * i + 1) * (h as f64 - 2.0 * m);
+            let (ux, uy) =
+                if options.snap_coordinates { (ux.floor(), uy.floor()) } else { (ux, uy) };
             [(ux as f32).min(wf.next_down()), (uy as f32).min(hf.next_down())]
         })
         .collect();
@@ -587,6 +589,7 @@ fn synthesize_with(
         let seed = options.seed;
         let (ps, pf, pj) = (&s, &fl, &parent_tables.jac);
         let rosy = options.rosy_fix;
+        let snap = options.snap_coordinates;
         let (mut ns, mut nf): (Vec<[f32; 2]>, Vec<bool>) = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -597,8 +600,12 @@ fn synthesize_with(
                 let f = if flip_par { jpar.map(|v| -v) } else { jpar };
                 let o = mat_vec(&f, [off[0] * spacing, off[1] * spacing]);
                 let idx = ((level * n0 + i) as u64) * 2;
-                let jx = (2.0 * hash_unit(seed, "synthesis-jitter", idx) - 1.0) as f32 * amp;
-                let jy = (2.0 * hash_unit(seed, "synthesis-jitter", idx + 1) - 1.0) as f32 * amp;
+                let mut jx = (2.0 * hash_unit(seed, "synthesis-jitter", idx) - 1.0) as f32 * amp;
+                let mut jy =
+                    (2.0 * hash_unit(seed, "synthesis-jitter", idx + 1) - 1.0) as f32 * amp;
+                if snap {
+                    (jx, jy) = (jx.round(), jy.round());
+                }
                 let u = ex.wrap([ps[par][0] + o[0] + jx, ps[par][1] + o[1] + jy]);
                 let flip = rosy && (flip_par ^ (frobenius(&jpar, &tables.jac[i]) < 0.0));
                 (u, flip)

@@ -354,3 +354,21 @@ fn kept_flips_leave_fewer_effective_frame_seams_than_free_flips() {
     eprintln!("effective-frame seam pairs: kept {kept}, free {free}");
     assert!(kept * 2 < free, "kept flips {kept} vs free flips {free}");
 }
+
+#[test]
+fn snapped_coordinates_copy_exemplar_pixels_for_an_axis_aligned_field() {
+    // With snapping (default) and no finest-level jitter, a 0° field puts every finest
+    // coordinate on a pixel centre, so the cubic colours are exemplar pixels.
+    let ex = blotches(24, 20);
+    let an = analyse(&ex);
+    let dom = ImageDomain::constant(40, 36, 0.0, 1.0).unwrap();
+    let r = synthesize(&an, &dom, &SynthesisOptions::default(), &NoProgress).unwrap();
+    for (i, u) in r.coords.iter().enumerate() {
+        assert_eq!(u.map(|v| v.fract()), [0.5, 0.5], "sample {i}: {u:?}");
+        assert_eq!(r.colors.pixels[i], ex.get(u[0] as usize, u[1] as usize), "sample {i}");
+    }
+    // Without snapping the phases are arbitrary and the colours interpolate.
+    let opts = SynthesisOptions { snap_coordinates: false, ..Default::default() };
+    let r = synthesize(&an, &dom, &opts, &NoProgress).unwrap();
+    assert!(r.coords.iter().any(|u| u[0].fract() != 0.5));
+}
