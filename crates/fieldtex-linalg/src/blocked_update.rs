@@ -312,12 +312,33 @@ fn reflect_panel(
         let ti = -v0 / beta;
         tau[i] = ti;
         l[(c, c)] = beta;
-        for (q, wr) in below.chunks_exact_mut(k).enumerate() {
-            let r = c + 1 + q;
-            let ts = ti * (l[(r, c)] + dot(wr, ui));
-            l[(r, c)] -= ts;
-            for (x, y) in wr.iter_mut().zip(ui.iter()) {
-                *x -= ts * y;
+        // two rows at a time: `ui` is loaded once per pair (each row's dot and update are
+        // the same operations in the same order as row by row: same bits)
+        let mut rows = below.chunks_exact_mut(k);
+        let mut r = c + 1;
+        loop {
+            match (rows.next(), rows.next()) {
+                (Some(w0), Some(w1)) => {
+                    let (d0, d1) = dot2(w0, w1, ui);
+                    let t0 = ti * (l[(r, c)] + d0);
+                    let t1 = ti * (l[(r + 1, c)] + d1);
+                    l[(r, c)] -= t0;
+                    l[(r + 1, c)] -= t1;
+                    for ((x0, x1), y) in w0.iter_mut().zip(w1.iter_mut()).zip(ui.iter()) {
+                        *x0 -= t0 * y;
+                        *x1 -= t1 * y;
+                    }
+                    r += 2;
+                }
+                (Some(w0), None) => {
+                    let t0 = ti * (l[(r, c)] + dot(w0, ui));
+                    l[(r, c)] -= t0;
+                    for (x, y) in w0.iter_mut().zip(ui.iter()) {
+                        *x -= t0 * y;
+                    }
+                    break;
+                }
+                _ => break,
             }
         }
     }
@@ -340,6 +361,26 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
         acc[q] += x * y;
     }
     ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]))
+}
+
+/// [`dot`] of `a` and of `b` with `u`, in one pass over `u` (each sum in `dot`'s order).
+#[inline(always)]
+fn dot2(a: &[f64], b: &[f64], u: &[f64]) -> (f64, f64) {
+    let (mut p, mut q) = ([0.0f64; 8], [0.0f64; 8]);
+    let (ca, cb, cu) = (a.chunks_exact(8), b.chunks_exact(8), u.chunks_exact(8));
+    let (ra, rb, ru) = (ca.remainder(), cb.remainder(), cu.remainder());
+    for ((x, y), z) in ca.zip(cb).zip(cu) {
+        for t in 0..8 {
+            p[t] += x[t] * z[t];
+            q[t] += y[t] * z[t];
+        }
+    }
+    for (t, ((x, y), z)) in ra.iter().zip(rb).zip(ru).enumerate() {
+        p[t] += x * z;
+        q[t] += y * z;
+    }
+    let sum = |a: [f64; 8]| ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]));
+    (sum(p), sum(q))
 }
 
 /// `[L_p W] ← [L_p W] (I − V T Vᵀ)` with `V = [I; U]` for one chunk of rows (`scratch`:
