@@ -12,7 +12,8 @@
 //! `metrics.designed_singularities`), e.g. `out/orient-bench/<exemplar>-<preset>`.
 //! Per case it prints the synthesis time (median of `--runs`), the guided coherence
 //! (`fieldtex_eval::guided_coherence`, stride `--stride`, default 8 like the report),
-//! the orientation error, the phase-defect count, the count within 3 periods of the
+//! the orientation error (against the field turned by the exemplar's dominant stripe
+//! direction, as `fieldtex orient` reports it, and raw), the phase-defect count, the count within 3 periods of the
 //! designed singularities (as `fieldtex orient`) and the count a uniform density of
 //! the image's defects would put there (`bg`), and the coordinate coherence of
 //! neighbour pairs, the effective-frame seams (`(−1)^I J` turning by more than 90°
@@ -139,6 +140,7 @@ fn main() {
     );
     let eb = ev::rgb_buffer(&ex);
     let ev_ex = ev::ImageView::new(&eb, ex.width, ex.height, 3).unwrap();
+    let ex_angle = ev::dominant_orientation(&ev_ex).map_or(0.0, |a| a.0);
     // Resampling floor: the exemplar itself rotated to a constant field at each angle
     // of `--ideal` (coordinates an exact rotation of the output grid, cubic colours),
     // scored like a synthesis result.
@@ -250,12 +252,18 @@ fn main() {
             let fv = ev::FieldView::new(&case.field, case.n, case.n).unwrap();
             let gopts = ev::GuidedCoherenceOptions { stride, ..Default::default() };
             let gc = ev::guided_coherence(&out, &ev_ex, &fv, &gopts).unwrap();
-            let oe = ev::orientation_error(
+            let oe_raw = ev::orientation_error(
                 &out,
                 &ev::OrientationReference::Field(fv),
                 &ev::OrientationErrorOptions::default(),
             )
             .unwrap();
+            // As `fieldtex orient` reports it: against the field turned by the
+            // exemplar's own dominant stripe direction.
+            let oe_opts =
+                ev::OrientationErrorOptions { exemplar_angle_deg: ex_angle, ..Default::default() };
+            let oe = ev::orientation_error(&out, &ev::OrientationReference::Field(fv), &oe_opts)
+                .unwrap();
             let pd = ev::phase_defects(&out, &ev::PhaseDefectOptions::default()).unwrap();
             let r = 3.0 * pd.period_px;
             let near = ev::count_defects_near(&pd.defects, &case.sings, r);
@@ -263,7 +271,7 @@ fn main() {
             let bg = pd.count as f64 * disc / pd.evaluated_pixels.max(1) as f64;
             let need = required_dislocations(case, pd.period_px);
             println!(
-                "{:44} fix={} syn_ms={:6.0} gc={:.6} (median {:.6}, p95 {:.6}) oe={:5.2} defects={:4} near={:3} bg={:5.1} need={:4.1} T={:.1}",
+                "{:44} fix={} syn_ms={:6.0} gc={:.6} (median {:.6}, p95 {:.6}) oe={:5.2} (raw {:5.2}) defects={:4} near={:3} bg={:5.1} need={:4.1} T={:.1}",
                 case.name,
                 fix as u8,
                 times[times.len() / 2],
@@ -271,6 +279,7 @@ fn main() {
                 gc.median,
                 gc.p95,
                 oe.mean_error_deg,
+                oe_raw.mean_error_deg,
                 pd.count,
                 near,
                 bg,

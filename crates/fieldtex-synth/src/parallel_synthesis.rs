@@ -12,7 +12,10 @@
 //!    directions (Frobenius product `⟨J(a), J(b)⟩ < 0`, i.e. `u(a)·u(b) < 0` for
 //!    rotations).
 //! 2. **Jitter**: `S += a h ξ`, `ξ ∈ [−1, 1]²` from
-//!    `hash_unit(seed, "synthesis-jitter", …)`, `a` = [`SynthesisOptions::jitter`].
+//!    `hash_unit(seed, "synthesis-jitter", …)`, `a` = [`SynthesisOptions::jitter`],
+//!    none on the [`SynthesisOptions::unjittered_levels`] finest levels; with
+//!    [`SynthesisOptions::snap_coordinates`] the offset is rounded to whole pixels and
+//!    the initial coordinates are integers (Lefebvre & Hoppe 2005 §3.2).
 //! 3. **Correction** (`passes × subpasses`, 2×2 interleaved): each neighbour `q = p + δ`
 //!    predicts `P = S[q] − h F(q) δ` with flip `α = I[q] ⊕ c(q, p)` — the corrected
 //!    prediction `P̃` of paper D, which uses the neighbour's Jacobian and flip. The
@@ -30,7 +33,7 @@
 //!    take part, so `I` changes only through the upsampling bits `c`.
 //! 4. **Colours**: after the finest level, `E[S[p]]` read with
 //!    [`SynthesisOptions::color_filter`] (cubic convolution by default,
-//!    [`crate::color_lookup`]).
+//!    [`mod@crate::color_lookup`]).
 //!
 //! Flip indicators start combed on the initialisation level
 //! ([`SynthesisOptions::comb_flips`], [`crate::flip_combing`]), so the effective frame
@@ -43,16 +46,24 @@
 //! neighbour pairs whose effective frames point in opposite directions, against the 463
 //! representative jumps of the field itself (the `--no-rosy-fix` run). Each such seam
 //! is a break in the texture (only ≈ 25 % of the pairs across one are coherent): the
-//! fix moved the discontinuities around instead of removing them. With kept flips
-//! (and combing) 417 seam pairs remain, the phase defects fell from 63 to 49 (within 3
-//! periods of the singularities 9 → 7; nofix 11) and the guided coherence (stride 16)
-//! from .00183 to .00154. The remaining defects near singularities are mostly
-//! not the engine's: on woodgrain, bands and weave the phase-defect detector finds
-//! 600–900 defects all over the image, and the count inside the discs of radius 3
-//! periods is what that density predicts (e.g. woodgrain whorl: 12 found, 16.6
-//! expected from the image-wide density), with or without the fix; on stripes the
-//! remaining ones are where the field spreads or squeezes the stripes (deltas, the
-//! core), which a texture of one fixed period cannot follow without ending stripes.
+//! fix moved the discontinuities around instead of removing them. With kept flips and
+//! combing 417 seam pairs remain (left-loop: 565 against 235 representative jumps: the
+//! combing seams of the coarse initialisation level are straight and longer than the
+//! field's own cut, but they do not wander). Final defaults, whorl: phase defects near
+//! the singularities 4 with the fix against 7 without (before: 9 / 11).
+//!
+//! The remaining defects near singularities are mostly not the engine's: on woodgrain,
+//! bands and weave the phase-defect detector finds 500–850 defects all over the image,
+//! and the count inside the discs of radius 3 periods is what that density predicts
+//! (e.g. woodgrain whorl: 18 found, 15.8 expected), with or without the fix. On stripes
+//! they sit where the field spreads or squeezes the stripes (the deltas, the core): a
+//! texture of one period following a line field `d` needs `div d = 0` to have no stripe
+//! ends, and `∫ |div d| dA / period` over the counted annuli (1.5–3 periods around each
+//! singularity) is 5.8–9.7 stripe ends on the four presets with singularities — more
+//! than the 3–9 found, so these are forced by the field, not by seams. The nofix seams
+//! that the fix removes (straight cuts from the singularities to the border, paper D
+//! Fig. 5) shift the stripe phase along a line and mostly do not produce a ±2π
+//! winding, so the criterion hardly sees them.
 //!
 //! Speed: the 32-D neighbourhood vector of every exemplar pixel (both copies) is
 //! tabulated per level, so a candidate costs one 32-byte load and an exact integer
@@ -76,13 +87,13 @@ use fieldtex_core::{Image, Progress};
 use rayon::prelude::*;
 
 use crate::color_lookup::color_lookup;
-use crate::domain::check_jacobian;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
 use crate::flip_combing::comb_flips;
+use crate::level_tables::{LevelTables, NONE, OFFS8, frobenius, mat_vec, tabulate};
 
 /// Corner offsets `Δ` of the four-corner neighbourhood; bit 0 of the index is the x
 /// sign (0 = −1), bit 1 the y sign.
-const CORNERS: [[i32; 2]; 4] = [[-1, -1], [1, -1], [-1, 1], [1, 1]];
+pub(crate) const CORNERS: [[i32; 2]; 4] = [[-1, -1], [1, -1], [-1, 1], [1, 1]];
 pub use crate::synthesis_options::SynthesisOptions;
 use crate::synthesis_options::{MAX_K, validate};
 use crate::{SynthError, SynthesisDomain};
@@ -101,124 +112,9 @@ pub struct SynthesisResult {
     pub level_timings_ms: Vec<f64>,
 }
 
-const NONE: u32 = u32::MAX;
 /// Candidates of one correction at most: per neighbour its prediction and k jumps, and
 /// p's own k jumps.
 const MAX_CANDIDATES: usize = 8 * (1 + MAX_K) + MAX_K;
-/// Neighbour offsets in angular order (angle `k · 45°` from +x, y down).
-const OFFS8: [[i32; 2]; 8] = [[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1]];
-
-/// One domain level, tabulated.
-struct LevelTables {
-    nbr: Vec<[u32; 8]>,
-    jac: Vec<[f32; 4]>,
-    classes: Vec<Vec<u32>>,
-    parent: Vec<(u32, [f32; 2])>,
-    /// Per sample and corner `Δ`, the neighbour (index into [`OFFS8`]) whose direction is
-    /// closest to the warped corner offset `J⁻¹ Δ`; the corner averages that neighbour's
-    /// prediction and those of its two angular neighbours.
-    corner_dir: Vec<[u8; 4]>,
-}
-
-/// Unit vectors of [`OFFS8`] (angle `k · 45°`).
-const DIRS8: [[f32; 2]; 8] = {
-    const R: f32 = std::f32::consts::FRAC_1_SQRT_2;
-    [[1.0, 0.0], [R, R], [0.0, 1.0], [-R, R], [-1.0, 0.0], [-R, -R], [0.0, -1.0], [R, -R]]
-};
-
-/// The [`LevelTables::corner_dir`] entry of Jacobian `j`: per corner, the direction of
-/// [`OFFS8`] with the largest dot product with `J⁻¹ Δ` (the angularly nearest; the
-/// lowest index on exact ties).
-fn corner_directions(j: &[f32; 4]) -> [u8; 4] {
-    let jinv = inverse(j);
-    CORNERS.map(|cd| {
-        let phi = mat_vec(&jinv, [cd[0] as f32, cd[1] as f32]);
-        let mut best = (f32::NEG_INFINITY, 0u8);
-        for (k, d) in DIRS8.iter().enumerate() {
-            let dot = d[0] * phi[0] + d[1] * phi[1];
-            if dot > best.0 {
-                best = (dot, k as u8);
-            }
-        }
-        best.1
-    })
-}
-
-fn tabulate(
-    domain: &dyn SynthesisDomain,
-    level: usize,
-    scale: f32,
-    subpasses: usize,
-    with_parent: bool,
-) -> Result<LevelTables, SynthError> {
-    let n = domain.sample_count(level);
-    let coarse_n = if with_parent { domain.sample_count(level + 1) } else { 0 };
-    type Row = ([u32; 8], [f32; 4], u8, (u32, [f32; 2]));
-    let rows: Vec<Result<Row, SynthError>> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let mut nb = [NONE; 8];
-            for (k, o) in OFFS8.iter().enumerate() {
-                if let Some(q) = domain.neighbor(level, i, *o) {
-                    if q >= n {
-                        return Err(SynthError::InvalidDomain {
-                            reason: format!(
-                                "level {level} sample {i}: neighbour {q} ≥ sample count {n}"
-                            ),
-                        });
-                    }
-                    nb[k] = q as u32;
-                }
-            }
-            let j = domain.jacobian(level, i);
-            check_jacobian(level, i, &j)?;
-            let j = j.map(|v| v * scale);
-            let class = if subpasses == 1 { 0 } else { domain.subpass_class(level, i) };
-            if class >= 4 {
-                return Err(SynthError::InvalidDomain {
-                    reason: format!("level {level} sample {i}: subpass class {class} ≥ 4"),
-                });
-            }
-            let parent = if with_parent {
-                let (pi, off) = domain.parent(level, i);
-                if pi >= coarse_n || !off.iter().all(|v| v.is_finite()) {
-                    return Err(SynthError::InvalidDomain {
-                        reason: format!(
-                            "level {level} sample {i}: parent {pi} / offset {off:?} invalid"
-                        ),
-                    });
-                }
-                (pi as u32, off)
-            } else {
-                (0, [0.0; 2])
-            };
-            Ok((nb, j, class as u8, parent))
-        })
-        .collect();
-    let mut t = LevelTables {
-        nbr: Vec::with_capacity(n),
-        jac: Vec::with_capacity(n),
-        classes: vec![Vec::new(); subpasses],
-        parent: Vec::with_capacity(n),
-        corner_dir: Vec::with_capacity(n),
-    };
-    for (i, r) in rows.into_iter().enumerate() {
-        let (nb, j, class, parent) = r?;
-        t.nbr.push(nb);
-        t.corner_dir.push(corner_directions(&j));
-        t.jac.push(j);
-        t.classes[class as usize].push(i as u32);
-        t.parent.push(parent);
-    }
-    t.classes.retain(|c| !c.is_empty());
-    Ok(t)
-}
-
-#[inline]
-fn mat_vec(j: &[f32; 4], v: [f32; 2]) -> [f32; 2] {
-    [j[0] * v[0] + j[1] * v[1], j[2] * v[0] + j[3] * v[1]]
-}
-
 /// Lanes of a four-corner neighbourhood vector: 4 corners × [`APPEARANCE_DIMS`].
 const NV: usize = 4 * APPEARANCE_DIMS;
 
@@ -234,17 +130,6 @@ fn dist_nv(a: &[i8; NV], t: &[i16; NV], mask: &[i16; NV]) -> i32 {
         acc += d as i32 * d as i32;
     }
     acc
-}
-
-#[inline]
-fn frobenius(a: &[f32; 4], b: &[f32; 4]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
-}
-
-#[inline]
-fn inverse(j: &[f32; 4]) -> [f32; 4] {
-    let det = j[0] * j[3] - j[1] * j[2];
-    [j[3] / det, -j[1] / det, -j[2] / det, j[0] / det]
 }
 
 /// The exemplar side of one level.

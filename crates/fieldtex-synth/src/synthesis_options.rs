@@ -70,7 +70,7 @@ pub struct SynthesisOptions {
     /// texture; kept flips leave 483. Default true.
     #[serde(default = "default_true")]
     pub keep_flips: bool,
-    /// How coordinates become colours ([`crate::color_lookup`]). Default
+    /// How coordinates become colours ([`mod@crate::color_lookup`]). Default
     /// [`ColorFilter::Cubic`].
     #[serde(default)]
     pub color_filter: ColorFilter,
