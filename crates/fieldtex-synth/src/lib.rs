@@ -40,8 +40,12 @@
 //! defect density (500–850 defects per image) puts into the discs, with or without
 //! the fix, so that criterion cannot separate the two there (see
 //! [`parallel_synthesis`] for the analysis). Synthesis of 512² after analysis: 545–704
-//! ms wall through `fieldtex orient` (load 1.0–1.7), the same as before within the noise
-//! of this shared VM.
+//! ms wall through `fieldtex orient` (load 1.0–1.7). Same-session A/B (`orient_probe
+//! --no-metrics --runs 7`, whorl, median, load ≈ 2.2, alternating): the previous
+//! defaults (`--free-flips --no-comb --nearest --unjittered 0 --passes 4 --no-snap`)
+//! 483–520 ms, the new ones 547–591 ms (+14 %: the two extra coarse passes; kept flips
+//! and the unjittered finest level make each pass cheaper); 8 coarse passes would cost
+//! 591–698 ms for a gain on weave only.
 //!
 //! # Conventions
 //! - Colours are sRGB-encoded `f32` as stored in [`fieldtex_core::Image`]; the engine
