@@ -18,15 +18,18 @@ if [ "$only" = all ] || [ "$only" = align ]; then
     cp "out/gallery/align-$n/preview.png" "docs/gallery/align-$n.png"
     cp "out/gallery/align-$n-nofa/preview.png" "docs/gallery/align-$n-nofa.png"
   done
-  "$bin" orient --preset whorl --exemplar "$ex/stripes_Fabric071.png" --mesh ../shared/data/meshes/demosthenes-bust-open.obj \
-    --patch 0.18,1.6,0.9,0.8 --size 512 --out out/gallery/orient-patch --quiet
-  cp out/gallery/orient-patch/preview.png docs/gallery/orient-patch.png
-  [ "$only" = align ] && { echo "gallery (align, patch) written to docs/gallery/"; exit 0; }
+  [ "$only" = align ] && { echo "gallery (align) written to docs/gallery/"; exit 0; }
 fi
+# orient (paper D): the five fingerprint presets and a curved patch (`gallery.sh orient`
+# for these only).
+"$bin" orient --preset whorl --exemplar "$ex/stripes_Fabric071.png" --mesh ../shared/data/meshes/demosthenes-bust-open.obj \
+  --patch 0.18,1.6,0.9,0.8 --size 512 --out out/gallery/orient-patch --quiet --no-metrics
+cp out/gallery/orient-patch/preview.png docs/gallery/orient-patch.png
 for p in arch tented-arch left-loop right-loop whorl; do
-  "$bin" orient --preset "$p" --exemplar "$ex/stripes_Fabric071.png" --size 384 --out "out/gallery/orient-$p" --quiet
+  "$bin" orient --preset "$p" --exemplar "$ex/stripes_Fabric071.png" --size 384 --out "out/gallery/orient-$p" --quiet --no-metrics
   cp "out/gallery/orient-$p/preview.png" "docs/gallery/orient-$p.png"
 done
+[ "$only" = orient ] && { echo "gallery (orient) written to docs/gallery/"; exit 0; }
 "$bin" demo --out out/gallery/demo --quiet
 cp out/gallery/demo/preview.png docs/gallery/demo.png
 "$bin" atlas ../shared/data/meshes/stanford-bunny.obj --out out/gallery/atlas-bunny --quiet
