@@ -11,7 +11,7 @@
 //!   weight grows and one multiple-rank downdate for those whose weight shrinks
 //!   (Davis & Hager 2001, "Multiple-rank modifications of a sparse Cholesky
 //!   factorization", via `fieldtex_linalg::Cholesky::add_diagonal_penalties`); cost
-//!   `ups + 2 · downs` (downdates run rank-1 sweeps, updates blocked reflections);
+//!   `ups + 4 · downs` (downdates run rank-1 sweeps, updates blocked reflections);
 //! - **checkpoint**: a kept copy of an earlier factor with stroke diagonal `s_c ≤ s` is
 //!   copied into the current factor's buffers and gets one multiple-rank update with
 //!   `s − s_c`; cost `16 + #(s ≠ s_c)`. The copy moves only what can differ
@@ -64,8 +64,13 @@ use crate::FieldsError;
 
 /// A downdated edge costs about this many updated edges (multiple-rank downdates run
 /// the rank-1 sweeps, updates the blocked reflections; measured 60–95 ms against
-/// 30–50 ms for 250 edges on the 128² grid).
-const DOWNDATE_WEIGHT: usize = 2;
+/// 30–50 ms for 250 edges on the 128² grid in session 4, hence 2 then). Raised to 4
+/// once restores copied only the changed paths: a 1 px-per-event mouse drag of a
+/// ~250 px stroke then goes through the checkpoint (restore + update of the new edges)
+/// instead of updating and downdating the changed edges, 27.8–31.0 → 23.6–24.5 ms per
+/// event, 90th percentile 31–41 → 25–32 ms, other edits unchanged (`bench_fields`,
+/// load 0.2–0.9, binaries interleaved).
+const DOWNDATE_WEIGHT: usize = 4;
 
 /// Cost of bringing the current factor back to the checkpoint, in updated edges: the
 /// copy of the changed paths measured 1.4–1.7 ms for a ~250-edge stroke, an updated edge
