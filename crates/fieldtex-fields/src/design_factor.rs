@@ -35,12 +35,12 @@
 //! --examples && target/release/examples/bench_fields`, medians of 15), one frame =
 //! edit + solve + 512² sampling. Session 4 (load 4.4–5.0, against the sweeps-only
 //! factor): adding a ~250 px stroke (~250 edges, direct update) 75 → 44 ms, dragging it
-//! by 2–6 px 128 → 50 ms, removing it 118 → 24 ms, a ~18 px stroke 42 → 19 ms. With the
-//! path copies (load 2.2–2.8, old and new binaries interleaved): drag 52 → 30–35 ms,
-//! remove 24 → 13–14 ms, add 30–33 ms (no copy involved), short stroke 16–18 ms; a mouse
-//! drag of 1 px per event (`field_drag_stroke_1px`) 31–32 ms, 90th percentile 34–43 ms.
-//! A numeric refactorisation includes the take-over for updates and the checkpoint copy
-//! (~90–170 ms).
+//! by 2–6 px 128 → 50 ms, removing it 118 → 24 ms, a ~18 px stroke 42 → 19 ms. Session 5,
+//! with the path copies, the faster multiple-rank update and the downdate weight 4 (three
+//! runs at load 1.2–1.3): add 22.5–23.5 ms, drag by 2–6 px 23.5–24.7 ms, drag by 1 px per
+//! event (`field_drag_stroke_1px`) 23.5–24.2 ms (90th percentile 24.8–25.4), remove
+//! 10.2–11.0 ms, ~18 px stroke 13.2–13.7 ms. A numeric refactorisation includes the
+//! take-over for updates and the checkpoint copy (~90–170 ms).
 //!
 //! Issue 3's 20 ms stays out of reach for long strokes: the update of `k` edges touches
 //! the factor columns on the edges' elimination-tree paths, which on a 2-D grid always
@@ -49,10 +49,9 @@
 //! the chain of supernodes above the first branching of the union, which every
 //! modification crosses; below it the union splits into unbalanced subtrees (e.g. 31M
 //! against 0.2M), so running the subtrees of the update in parallel would save at most
-//! ~20 %, and the update stays ~16–19 ms on this machine. A tree-parallel backward
-//! substitution was tried again and was slower here (9.8 → 11.6 ms per singularity
-//! move: building the supernode tree and the shared-slice accesses cost more than the
-//! second core gave).
+//! ~20 %; the update stays ~13 ms and the solve ~8 ms on this machine. A tree-parallel
+//! backward substitution was tried again and measured no faster here (under load 9.8 →
+//! 11.6 ms per singularity move; quiet, within noise).
 //!
 //! Not implemented: a Woodbury (capacitance-matrix) correction of the solve instead of a
 //! factor modification: it needs `A⁻¹` at the stroke's ~250–500 edges, i.e. as many
@@ -202,14 +201,8 @@ impl DesignFactor {
                 && c.updates_since_factor + c_ups.len() <= drift_limit
             {
                 let factor = self.factor.as_mut().expect("checked");
-                // into the current factor's buffers (no fresh pages), only the columns
-                // that can differ when those are known
-                match self.dirty.take() {
-                    Some(dirty) => {
-                        factor.copy_changed_from(&c.factor, &dirty);
-                    }
-                    None => factor.clone_from(&c.factor),
-                }
+                // into the current factor's buffers (no fresh pages)
+                copy_factor(factor, &c.factor, self.dirty.take());
                 if let Err(e) = factor.add_diagonal_penalties(&c_ups) {
                     // the factor is the checkpoint's now: refactor on the next sync
                     self.factor = None;
@@ -299,12 +292,7 @@ impl DesignFactor {
         }
         match &mut self.checkpoint {
             Some(c) => {
-                match self.dirty.take() {
-                    Some(dirty) => {
-                        c.factor.copy_changed_from(factor, &dirty);
-                    }
-                    None => c.factor.clone_from(factor),
-                }
+                copy_factor(&mut c.factor, factor, self.dirty.take());
                 c.diag.copy_from_slice(&self.factored_diag);
                 c.updates_since_factor = self.updates_since_factor;
             }
@@ -317,6 +305,17 @@ impl DesignFactor {
             }
         }
         self.dirty = Some(Vec::new());
+    }
+}
+
+/// `*dst = src.clone()` into `dst`'s buffers: only the paths of the `dirty` edges when
+/// they are known (the two factors differ nowhere else), else the whole factor.
+fn copy_factor(dst: &mut Cholesky, src: &Cholesky, dirty: Option<Vec<usize>>) {
+    match dirty {
+        Some(edges) => {
+            dst.copy_changed_from(src, &edges);
+        }
+        None => dst.clone_from(src),
     }
 }
 

@@ -59,10 +59,11 @@
 //! 4.4–5.0, medians of three interleaved runs against the previous binary): moving a
 //! singularity 21 → 18 ms (solve alone 19 → 11 ms: the deviation's sparse right-hand
 //! side now runs supernodal dense column loops, `Cholesky::solve_sparse_with_residual`;
-//! plus ~2.5 ms sampling), a full design solve 33 → 16 ms. Stroke edits (session 5, load
-//! 2.4–3.0, after the path copies between the factor and its checkpoint and the faster
-//! multiple-rank update): add a ~250 px stroke 27 ms, drag it 28 ms, a 1 px-per-event
-//! mouse drag 31 ms, remove it 13 ms, a short stroke 16 ms, move a singularity 12 ms —
+//! plus ~2.5 ms sampling), a full design solve 33 → 16 ms. Session 5 (load 1.2–1.3, after
+//! the path copies between the factor and its checkpoint and the faster multiple-rank
+//! update): add a ~250 px stroke 22.5–23.5 ms, drag it 23.5–24.7 ms (1 px per event
+//! 23.5–24.2 ms), remove it 10.2–11.0 ms, a short stroke 13.2–13.7 ms, move a singularity
+//! 9.2–9.6 ms, a full design solve 10.9–11.1 ms —
 //! issue 3's 20 ms is met for singularities, short strokes and removals, not for adding
 //! or moving long strokes (their factor update, see [`crate::design_factor`]).
 
