@@ -313,27 +313,28 @@ fn orient_preset_outputs_and_determinism() {
     let a = tmp("orient-t1");
     let b = tmp("orient-t2");
     let limit = Duration::from_secs(300);
-    for (dir, t) in [(&a, "1"), (&b, "2")] {
-        let o = run(
-            &[
-                "orient",
-                "--preset",
-                "left-loop",
-                "--exemplar",
-                ex.to_str().unwrap(),
-                "--size",
-                "128",
-                "--grid",
-                "32",
-                "--out",
-                dir.to_str().unwrap(),
-                "--threads",
-                t,
-                "--quiet",
-            ],
-            limit,
-        );
+    // a small left-loop run into `dir` with extra flags
+    let orient = |dir: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "orient",
+            "--preset",
+            "left-loop",
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--size",
+            "128",
+            "--grid",
+            "32",
+            "--out",
+            dir.to_str().unwrap(),
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args, limit);
         assert_eq!(code(&o), 0, "{}", stderr(&o));
+    };
+    for (dir, t) in [(&a, "1"), (&b, "2")] {
+        orient(dir, &["--threads", t]);
     }
     for f in ["texture.png", "field.npy", "preview.png"] {
         let x = std::fs::read(a.join(f)).unwrap();
@@ -352,25 +353,7 @@ fn orient_preset_outputs_and_determinism() {
     assert_eq!(r, report_without_timings(&b));
     // --no-metrics: the same texture, a report without image metrics
     let c = tmp("orient-t3");
-    let o = run(
-        &[
-            "orient",
-            "--preset",
-            "left-loop",
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--size",
-            "128",
-            "--grid",
-            "32",
-            "--out",
-            c.to_str().unwrap(),
-            "--no-metrics",
-            "--quiet",
-        ],
-        limit,
-    );
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    orient(&c, &["--no-metrics"]);
     assert!(
         std::fs::read(a.join("texture.png")).unwrap()
             == std::fs::read(c.join("texture.png")).unwrap()
