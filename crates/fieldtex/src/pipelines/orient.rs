@@ -194,25 +194,10 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
     report.metric("designed_singularities", &designed);
     if options.metrics {
-        // The exemplar's own stripe direction: the texture is expected at field angle + it
-        // (as `align` measures on surfaces); 0 when it has no measurable orientation.
-        let own = exemplar_orientation(&exemplar);
-        let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
-        let metrics = report
-            .time("metrics", || {
-                image_metrics(&synth, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
-            })
-            .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
-        // Phase defects near designed singularities (within 3 exemplar periods).
-        if let Some(pd) = &metrics.phase_defects {
-            let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-            let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
-            report.metric("phase_defects_near_singularities", near);
-        }
+        let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
+        let (metrics, _) =
+            texture_metrics(&mut report, &synth, &exemplar, &flat, &pts, options.seed)?;
         report.metric("texture", &metrics);
-        if let Some(own) = &own {
-            report.metric("exemplar_orientation", own);
-        }
     } else {
         report.notes.push("image metrics skipped (--no-metrics)".into());
     }
@@ -220,6 +205,34 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     write_report(out_dir, &report)?;
     Ok(report)
+}
+
+/// The image metrics of an orient texture (`flat`: its `H×W×2` field) against the field
+/// turned by the exemplar's own stripe direction, which is reported as
+/// `exemplar_orientation` (as `align` measures on surfaces; 0 when the exemplar has no
+/// measurable orientation), plus the phase defects within 3 exemplar periods of the
+/// designed singularities `points`. Returns the metrics and that direction in degrees.
+pub(crate) fn texture_metrics(
+    report: &mut Report,
+    texture: &Image,
+    exemplar: &Image,
+    flat: &[f32],
+    points: &[[f64; 2]],
+    seed: u64,
+) -> Result<(super::eval::ImageMetrics, f64)> {
+    let own = exemplar_orientation(exemplar);
+    let angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
+    if let Some(own) = &own {
+        report.metric("exemplar_orientation", own);
+    }
+    let metrics = report
+        .time("metrics", || image_metrics(texture, exemplar, Some(flat), None, angle, seed))
+        .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
+    if let Some(pd) = &metrics.phase_defects {
+        let near = fieldtex_eval::count_defects_near(&pd.defects, points, 3.0 * pd.period_px);
+        report.metric("phase_defects_near_singularities", near);
+    }
+    Ok((metrics, angle))
 }
 
 /// The exemplar's dominant stripe direction and its own orientation error against it.

@@ -53,7 +53,6 @@ mod texel_jacobians;
 
 use super::orient::{DesignedSingularity, FieldSource, OrientOptions, kind_index};
 use crate::outputs::{prepare_out_dir, write_report};
-use crate::pipelines::eval::image_metrics;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_core::vec3::{add, cross, normalize, sub};
@@ -167,22 +166,15 @@ pub(crate) fn orient_patch(
     report.metric("designed_singularities", &marks);
     report.metric("designed_singularities_on_patch", &designed);
     if options.metrics {
-        // the exemplar's own stripe direction (see `orient`): expected at field angle + it
-        let own = super::orient::exemplar_orientation(&exemplar);
-        let exemplar_angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
-        if let Some(own) = &own {
-            report.metric("exemplar_orientation", own);
-        }
-        let metrics = report
-            .time("metrics", || {
-                image_metrics(&texture, &exemplar, Some(&flat), None, exemplar_angle, options.seed)
-            })
-            .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
         let pts: Vec<[f64; 2]> = designed.iter().map(|s| s.texel).collect();
-        if let Some(pd) = &metrics.phase_defects {
-            let near = fieldtex_eval::count_defects_near(&pd.defects, &pts, 3.0 * pd.period_px);
-            report.metric("phase_defects_near_singularities", near);
-        }
+        let (metrics, exemplar_angle) = super::orient::texture_metrics(
+            &mut report,
+            &texture,
+            &exemplar,
+            &flat,
+            &pts,
+            options.seed,
+        )?;
         if let Some(e) = chart_orientation_error(&texture, &field, &inside, exemplar_angle) {
             report.metric("chart_orientation_error", e);
         }
