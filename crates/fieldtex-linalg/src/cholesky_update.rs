@@ -89,6 +89,9 @@ pub(crate) struct DynamicFactor {
     /// factor); used by `crate::supernodal_solve` while [`DynamicFactor::faer_layout`]
     /// holds.
     pub(crate) supernodes: Vec<usize>,
+    /// Two-worker schedule of the supernodal backward pass (`crate::subtree_schedule`;
+    /// `None`: sequential), built from the structure, which updates keep.
+    pub(crate) backward_schedule: Option<std::sync::Arc<crate::subtree_schedule::SubtreeSchedule>>,
     /// Supernodes updated by the blocked form (`crate::blocked_update`), for tests.
     pub(crate) blocked_count: usize,
     /// Reused buffers of the multiple-rank update (work vectors) and of the blocked form
@@ -202,7 +205,24 @@ impl DynamicFactor {
             parent[j] = col.iter().map(|&r| r as usize).min().unwrap_or(NONE);
             run_ptr.push(push_runs(col, &mut runs));
         }
+        let backward_schedule = if faer_layout && supernodes.len() > 1 {
+            let nsn = supernodes.len() - 1;
+            let cost: Vec<usize> = (0..nsn)
+                .map(|s| (supernodes[s + 1] - supernodes[s]) * len[supernodes[s]])
+                .collect();
+            let parent_sn: Vec<u32> = (0..nsn)
+                .map(|s| match parent[supernodes[s + 1] - 1] {
+                    NONE => u32::MAX,
+                    p => (supernodes.partition_point(|&b| b <= p) - 1) as u32,
+                })
+                .collect();
+            crate::subtree_schedule::SubtreeSchedule::build(&cost, &parent_sn)
+                .map(std::sync::Arc::new)
+        } else {
+            None
+        };
         Self {
+            backward_schedule,
             faer_layout,
             perm,
             inv,

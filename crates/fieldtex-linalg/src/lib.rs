@@ -36,6 +36,7 @@ mod multi_rhs_solve;
 mod multiple_rank_update;
 mod partial_solve;
 mod sparse_matrix;
+mod subtree_schedule;
 mod supernodal_solve;
 #[cfg(test)]
 mod test_support;

@@ -190,30 +190,45 @@ impl Cholesky {
         let (cp, ri, va) = (self.matrix.col_ptr(), self.matrix.row_idx(), self.matrix.values());
         // row-major A X (n × k)
         let mut ax = vec![0.0f64; n * k];
-        ax.par_chunks_mut(ROW_CHUNK * k).enumerate().for_each(|(chunk, out)| {
-            let mut s = [0.0f64; MAX_BLOCK];
-            for (o, row) in out.chunks_mut(k).enumerate() {
-                let j = chunk * ROW_CHUNK + o;
-                if k <= MAX_BLOCK {
-                    s[..k].fill(0.0);
-                    for p in cp[j]..cp[j + 1] {
-                        let (i, v) = (ri[p], va[p]);
-                        for (c, sc) in s[..k].iter_mut().enumerate() {
-                            *sc += v * x[c * n + i];
-                        }
+        if k == 1 {
+            // one right-hand side: the same sums in the same order, without the block loop
+            ax.par_chunks_mut(ROW_CHUNK).enumerate().for_each(|(chunk, out)| {
+                let j0 = chunk * ROW_CHUNK;
+                for (o, v) in out.iter_mut().enumerate() {
+                    let (p0, p1) = (cp[j0 + o], cp[j0 + o + 1]);
+                    let mut t = 0.0;
+                    for (&i, &a) in ri[p0..p1].iter().zip(&va[p0..p1]) {
+                        t += a * x[i];
                     }
-                    row.copy_from_slice(&s[..k]);
-                } else {
-                    for (c, rc) in row.iter_mut().enumerate() {
-                        let mut t = 0.0;
+                    *v = t;
+                }
+            });
+        } else {
+            ax.par_chunks_mut(ROW_CHUNK * k).enumerate().for_each(|(chunk, out)| {
+                let mut s = [0.0f64; MAX_BLOCK];
+                for (o, row) in out.chunks_mut(k).enumerate() {
+                    let j = chunk * ROW_CHUNK + o;
+                    if k <= MAX_BLOCK {
+                        s[..k].fill(0.0);
                         for p in cp[j]..cp[j + 1] {
-                            t += va[p] * x[c * n + ri[p]];
+                            let (i, v) = (ri[p], va[p]);
+                            for (c, sc) in s[..k].iter_mut().enumerate() {
+                                *sc += v * x[c * n + i];
+                            }
                         }
-                        *rc = t;
+                        row.copy_from_slice(&s[..k]);
+                    } else {
+                        for (c, rc) in row.iter_mut().enumerate() {
+                            let mut t = 0.0;
+                            for p in cp[j]..cp[j + 1] {
+                                t += va[p] * x[c * n + ri[p]];
+                            }
+                            *rc = t;
+                        }
                     }
                 }
-            }
-        });
+            });
+        }
         for (w, sign) in &self.extra_terms {
             for c in 0..k {
                 let d: f64 = w.iter().map(|&(i, v)| v * x[c * n + i]).sum();

@@ -27,10 +27,15 @@
 //! re-solve after a singularity move from 19 to 11 ms (medians, 2 cores under a load
 //! average of 4.4–5.0, `fieldtex-fields/examples/bench_fields.rs`,
 //! `field_move_singularity_solve_only`, which includes the model field and residual);
-//! its backward pass streams the whole factor (18.7 MB), ~2.4 ms at this machine's best
-//! bandwidth. A tree-parallel backward pass (two halves of disjoint subtrees) was tried
-//! and measured slower on the 2 loaded cores (22–25 against 21–22 ms per move), so it
-//! is sequential. No refinement solve runs unless the residual exceeds
+//! its backward pass streams the whole factor (18.7 MB) and is memory-latency bound on
+//! one core (4.5–4.8 ms of a ~6 ms solve; a version without the per-column dependency
+//! chain and one with software prefetching were no faster). With two threads it runs on
+//! two workers over disjoint subtrees (`crate::subtree_schedule`, same bits): the
+//! re-solve after a singularity move 8.8–13.0 → 6.1–6.3 ms, a long-stroke frame
+//! 24.5–32.2 → 21.2–22.4 ms (same binary, the schedule switched off and on, other
+//! processes paused, load ≈ 1). An earlier tree-parallel attempt that built its split
+//! per solve was slower under load. The residual of one right-hand side has its own
+//! loop (same sums): 1.45 → 0.9 ms. No refinement solve runs unless the residual exceeds
 //! `refine_above` (the field design's residuals are ~1e-15).
 
 use crate::LinalgError;

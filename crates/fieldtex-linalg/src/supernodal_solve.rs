@@ -187,6 +187,124 @@ fn dot8(a: &[f64], b: &[f64]) -> f64 {
     ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]))
 }
 
+/// `y` shared by the workers of the backward pass: each writes only the columns of its
+/// own supernodes and reads only columns already final (module docs of
+/// `crate::subtree_schedule`).
+#[derive(Clone, Copy)]
+struct SharedColumns(*mut f64, usize);
+
+// SAFETY: the schedule gives the workers disjoint columns to write and only finished
+// columns to read (see `SharedColumns`).
+unsafe impl Send for SharedColumns {}
+// SAFETY: as above.
+unsafe impl Sync for SharedColumns {}
+
+impl DynamicFactor {
+    /// `Lᵀ z = y` in place (permuted order) over every supernode: sequentially, or the
+    /// schedule's top then its two bins on two workers (`crate::subtree_schedule`: the
+    /// same bits either way).
+    fn backward_all(&self, y: &mut [f64], buf: &mut Vec<f64>) {
+        let nsn = self.supernodes.len() - 1;
+        let shared = SharedColumns(y.as_mut_ptr(), y.len());
+        match &self.backward_schedule {
+            Some(plan) if rayon::current_num_threads() > 1 => {
+                // SAFETY: `y` is borrowed mutably for the whole call; the top runs alone,
+                // then the bins write disjoint columns and read only columns of their own
+                // subtrees or of the (finished) top.
+                unsafe {
+                    self.backward_list(plan.top.iter().map(|&s| s as usize), shared, buf);
+                    rayon::join(
+                        || {
+                            self.backward_list(
+                                plan.bins[0].iter().map(|&s| s as usize),
+                                shared,
+                                &mut Vec::new(),
+                            )
+                        },
+                        || {
+                            self.backward_list(
+                                plan.bins[1].iter().map(|&s| s as usize),
+                                shared,
+                                &mut Vec::new(),
+                            )
+                        },
+                    );
+                }
+            }
+            // SAFETY: one worker, `y` borrowed mutably.
+            _ => unsafe { self.backward_list((0..nsn).rev(), shared, buf) },
+        }
+    }
+
+    /// The backward step of each supernode of `list` in turn (module docs), AVX2 build
+    /// when the CPU has it (the same IEEE operations: bit-identical).
+    ///
+    /// # Safety
+    /// `y` points to `n` live values; no other thread writes the columns read here or
+    /// touches the columns written here (the list's own supernodes) meanwhile.
+    unsafe fn backward_list(
+        &self,
+        list: impl Iterator<Item = usize>,
+        y: SharedColumns,
+        buf: &mut Vec<f64>,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: AVX2 checked; the caller's contract.
+            return unsafe { self.backward_list_avx2(list, y, buf) };
+        }
+        // SAFETY: the caller's contract.
+        unsafe { self.backward_list_impl(list, y, buf) }
+    }
+
+    /// # Safety
+    /// As [`DynamicFactor::backward_list`], on a CPU with AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn backward_list_avx2(
+        &self,
+        list: impl Iterator<Item = usize>,
+        y: SharedColumns,
+        buf: &mut Vec<f64>,
+    ) {
+        // SAFETY: the caller's contract.
+        unsafe { self.backward_list_impl(list, y, buf) }
+    }
+
+    /// # Safety
+    /// As [`DynamicFactor::backward_list`].
+    #[inline(always)]
+    unsafe fn backward_list_impl(
+        &self,
+        list: impl Iterator<Item = usize>,
+        y: SharedColumns,
+        buf: &mut Vec<f64>,
+    ) {
+        let sn = &self.supernodes;
+        debug_assert_eq!(y.1, self.n());
+        for s in list {
+            let (b, e) = (sn[s], sn[s + 1]);
+            let (base, nrows) = (self.start[b], self.len[b]);
+            let rows = &self.rows[base..base + nrows];
+            let ns = e - b;
+            buf.clear();
+            // SAFETY: columns `b..e` are this worker's; the pattern rows are ancestors,
+            // final before this supernode runs (caller's contract), all `< n`.
+            unsafe {
+                buf.extend_from_slice(std::slice::from_raw_parts(y.0.add(b), ns));
+                buf.extend(rows[ns..].iter().map(|&r| *y.0.add(r as usize)));
+            }
+            for c in (0..ns).rev() {
+                let col = &self.vals[base + c * nrows..base + (c + 1) * nrows];
+                let acc = buf[c] - dot8(&col[c + 1..], &buf[c + 1..]);
+                buf[c] = acc / col[c];
+            }
+            // SAFETY: this worker's own columns.
+            unsafe { std::slice::from_raw_parts_mut(y.0.add(b), ns).copy_from_slice(&buf[..ns]) };
+        }
+    }
+}
+
 impl DynamicFactor {
     /// Supernode holding permuted column `j`.
     #[inline]
@@ -278,21 +396,7 @@ impl DynamicFactor {
             }
         }
         // backward: Lᵀ z = y over every supernode
-        for s in (0..nsn).rev() {
-            let (b, e) = (sn[s], sn[s + 1]);
-            let (base, nrows) = (self.start[b], self.len[b]);
-            let rows = &self.rows[base..base + nrows];
-            let ns = e - b;
-            buf.clear();
-            buf.extend_from_slice(&y[b..e]);
-            buf.extend(rows[ns..].iter().map(|&r| y[r as usize]));
-            for c in (0..ns).rev() {
-                let col = &self.vals[base + c * nrows..base + (c + 1) * nrows];
-                let acc = buf[c] - dot8(&col[c + 1..], &buf[c + 1..]);
-                buf[c] = acc / col[c];
-            }
-            y[b..e].copy_from_slice(&buf[..ns]);
-        }
+        self.backward_all(&mut y, &mut buf);
         let mut x = vec![0.0f64; n];
         for (i, &p) in self.perm.iter().enumerate() {
             x[p] = y[i];
@@ -373,6 +477,33 @@ mod tests {
             let wide = unsafe { d.sparse_rhs_supernodal_avx2(&nz) };
             assert!(base.iter().zip(&wide).all(|(p, q)| p.to_bits() == q.to_bits()));
         }
+    }
+
+    /// A factor large enough for the two-worker backward schedule: the sparse solve on
+    /// two threads gives the bits of one thread (the sequential pass), and matches the
+    /// blocked dense solve.
+    #[test]
+    fn two_worker_backward_pass_is_bit_identical_to_one() {
+        let (f, a) = updated_factor(150);
+        let n = a.nrows();
+        let d = f.dynamic.as_ref().unwrap();
+        assert!(d.backward_schedule.is_some(), "a schedule for {n} unknowns");
+        let nz: Vec<(usize, f64)> =
+            [7usize, 900, 901, 5000, n / 2, n - 3].iter().map(|&i| (i, 1.0 + i as f64)).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| d.solve_sparse_rhs_supernodal(&nz))
+        };
+        let (one, two) = (run(1), run(2));
+        assert!(one.iter().zip(&two).all(|(p, q)| p.to_bits() == q.to_bits()));
+        let mut dense = vec![0.0; n];
+        for &(i, v) in &nz {
+            dense[d.perm[i]] += v;
+        }
+        d.solve_supernodal_in_place(&mut dense, 1);
+        let scale = dense.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = two.iter().zip(&dense).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+        assert!(diff <= 1e-12 * scale, "{diff:e} vs {scale:e}");
     }
 
     #[cfg(target_arch = "x86_64")]
