@@ -3,8 +3,8 @@
 //!
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
 //!  [DIR…] [--const DEG…] [--ideal DEG…] [--both] [--no-rosy-fix] [--free-flips]
-//!  [--no-comb] [--nearest] [--no-snap]
-//!  [--passes N] [--finest-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
+//!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid]
+//!  [--passes N] [--finest-passes N] [--coarse-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
 //!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--analysis-k K]
 //!  [--no-metrics]`
 //!
@@ -115,6 +115,8 @@ fn main() {
             "--free-flips" => opts.keep_flips = false,
             "--const" => consts.push(num::<f32>(args.next(), &a)),
             "--no-rosy-fix" => opts.rosy_fix = false,
+            "--coarse-passes" => opts.coarse_passes = Some(num(args.next(), &a)),
+            "--no-trapezoid" => opts.trapezoid_frames = false,
             "--passes" => opts.correction_passes = num(args.next(), &a),
             "--finest-passes" => opts.finest_passes = Some(num(args.next(), &a)),
             "--jitter" => opts.jitter = num(args.next(), &a),
@@ -195,10 +197,11 @@ fn main() {
                 times.push(t.elapsed().as_secs_f64() * 1e3);
             }
             times.sort_by(f64::total_cmp);
+            let min_ms = times[0];
             let res = res.unwrap();
             if no_metrics {
                 println!(
-                    "{:44} fix={} syn_ms={:6.0} levels_ms={:?}",
+                    "{:44} fix={} syn_ms={:6.0} min_ms={min_ms:6.0} levels_ms={:?}",
                     case.name,
                     fix as u8,
                     times[times.len() / 2],

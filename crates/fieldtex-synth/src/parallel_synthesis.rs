@@ -7,7 +7,9 @@
 //! bit `I` per sample. With `F(p) = (−1)^I(p) J(p)` the *effective* frame of sample
 //! `p`, one level `c` (spacing `h = 2^c`) runs:
 //! 1. **Upsampling**: a child at offset `o ∈ {±½}²` from its parent `p` gets
-//!    `S = S[p] + h F(p) o` and `I = I[p] ⊕ c(p, child)`, where the consistency
+//!    `S = S[p] + h F(p) o` (with [`SynthesisOptions::trapezoid_frames`] the mean of
+//!    `F(p)` and the child's `J` sign-aligned with it replaces `F(p)`) and
+//!    `I = I[p] ⊕ c(p, child)`, where the consistency
 //!    `c(a, b)` is true when the representative frames of `a` and `b` point in opposite
 //!    directions (Frobenius product `⟨J(a), J(b)⟩ < 0`, i.e. `u(a)·u(b) < 0` for
 //!    rotations).
@@ -18,7 +20,10 @@
 //!    the initial coordinates are integers (Lefebvre & Hoppe 2005 §3.2).
 //! 3. **Correction** (`passes × subpasses`, 2×2 interleaved): each neighbour `q = p + δ`
 //!    predicts `P = S[q] − h F(q) δ` with flip `α = I[q] ⊕ c(q, p)` — the corrected
-//!    prediction `P̃` of paper D, which uses the neighbour's Jacobian and flip. The
+//!    prediction `P̃` of paper D, which uses the neighbour's Jacobian and flip (with
+//!    [`SynthesisOptions::trapezoid_frames`], default, `½(F(q) + (−1)^α J(p))` replaces
+//!    `F(q)`: the trapezoid rule along the offset, exact to second order on a turning
+//!    field). The
 //!    four-corner neighbourhood of `p` averages, for each corner `Δ ∈ {±1}²`, the
 //!    appearance `Ẽ_α[P + (−1)^α h Δ]` over the three neighbours whose directions are
 //!    closest to the warped offset `J(p)⁻¹ Δ` (Lefebvre & Hoppe 2006 §6 use the same
@@ -70,7 +75,8 @@
 //! distance; candidates are gathered first and scored in one branch-free sweep; on CPUs
 //! with AVX2 the correction runs an AVX2 build (bit-identical results). The finest
 //! level holds ¾ of the samples, so [`SynthesisOptions::finest_passes`] (default 2)
-//! is separate from the coarse levels' [`SynthesisOptions::correction_passes`] (6).
+//! is separate from level 1's [`SynthesisOptions::correction_passes`] (6) and the
+//! cheap levels `c ≥ 2`' [`SynthesisOptions::coarse_passes`] (12).
 //!
 //! With [`SynthesisOptions::rosy_fix`] off, the engine is plain anisometric synthesis:
 //! predictions use `J(p)`, no flips, only `Ẽ₀` (the ablation of paper D Fig. 5).
@@ -243,6 +249,8 @@ struct Pass<'a> {
     keep_flips: bool,
     /// Whether the CPU supports AVX2 (the correction then runs the AVX2 build).
     avx2: bool,
+    /// [`SynthesisOptions::trapezoid_frames`] (with the 2-RoSy fix).
+    trapezoid: bool,
 }
 
 impl Pass<'_> {
@@ -281,7 +289,7 @@ impl Pass<'_> {
                 continue;
             }
             let q = q as usize;
-            let (fq, alpha) = if self.rosy {
+            let (mut fq, alpha) = if self.rosy {
                 let jq = self.t.jac[q];
                 let cons = frobenius(&jq, &jp) < 0.0;
                 let fq = if fl[q] { jq.map(|v| -v) } else { jq };
@@ -289,6 +297,12 @@ impl Pass<'_> {
             } else {
                 (jp, false)
             };
+            if self.trapezoid {
+                // Trapezoid rule: the mean of q's effective frame and p's frame with the
+                // candidate's flip (sign-aligned with it by the choice of α).
+                let fpa = if alpha { jp.map(|v| -v) } else { jp };
+                fq = std::array::from_fn(|i| 0.5 * (fq[i] + fpa[i]));
+            }
             let d = OFFS8[k];
             let off = mat_vec(&fq, [d[0] as f32 * h, d[1] as f32 * h]);
             pred[k] = (ex.wrap([s[q][0] - off[0], s[q][1] - off[1]]), alpha, off);
@@ -475,6 +489,7 @@ fn synthesize_with(
         let (ps, pf, pj) = (&s, &fl, &parent_tables.jac);
         let rosy = options.rosy_fix;
         let snap = options.snap_coordinates;
+        let trapezoid = rosy && options.trapezoid_frames;
         let (mut ns, mut nf): (Vec<[f32; 2]>, Vec<bool>) = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -482,7 +497,14 @@ fn synthesize_with(
                 let par = par as usize;
                 let jpar = pj[par];
                 let flip_par = rosy && pf[par];
-                let f = if flip_par { jpar.map(|v| -v) } else { jpar };
+                let mut f = if flip_par { jpar.map(|v| -v) } else { jpar };
+                if trapezoid {
+                    // Trapezoid rule: the mean of the parent's effective frame and the
+                    // child's representative frame sign-aligned with it.
+                    let jc = tables.jac[i];
+                    let jc = if frobenius(&f, &jc) < 0.0 { jc.map(|v| -v) } else { jc };
+                    f = std::array::from_fn(|k| 0.5 * (f[k] + jc[k]));
+                }
                 let o = mat_vec(&f, [off[0] * spacing, off[1] * spacing]);
                 let idx = ((level * n0 + i) as u64) * 2;
                 let mut jx = (2.0 * hash_unit(seed, "synthesis-jitter", idx) - 1.0) as f32 * amp;
@@ -506,9 +528,12 @@ fn synthesize_with(
             own: options.own_candidates,
             avx2,
             keep_flips: rosy && options.keep_flips,
+            trapezoid: rosy && options.trapezoid_frames,
         };
         let passes = if level == 0 {
             options.finest_passes.unwrap_or(options.correction_passes)
+        } else if level >= 2 {
+            options.coarse_passes.unwrap_or(options.correction_passes)
         } else {
             options.correction_passes
         };

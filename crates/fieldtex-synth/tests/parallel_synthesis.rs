@@ -267,6 +267,7 @@ fn bad_exemplars_and_options_are_refused() {
         SynthesisOptions { jitter: f32::NAN, ..Default::default() },
         SynthesisOptions { scale: 0.0, ..Default::default() },
         SynthesisOptions { finest_passes: Some(17), ..Default::default() },
+        SynthesisOptions { coarse_passes: Some(33), ..Default::default() },
     ] {
         assert!(matches!(
             synthesize(&an, &dom, &o, &NoProgress),
@@ -371,4 +372,35 @@ fn snapped_coordinates_copy_exemplar_pixels_for_an_axis_aligned_field() {
     let opts = SynthesisOptions { snap_coordinates: false, ..Default::default() };
     let r = synthesize(&an, &dom, &opts, &NoProgress).unwrap();
     assert!(r.coords.iter().any(|u| u[0].fract() != 0.5));
+}
+
+#[test]
+fn trapezoid_frames_change_nothing_where_the_orientation_is_constant() {
+    // One horizontal orientation whose representatives jump by 180° at the middle: the
+    // sign-aligned mean of two frames is the frame itself (bit for bit), so the
+    // trapezoid rule must leave the result unchanged; a sign error would average
+    // opposite frames to zero across the jump.
+    let an = analyse(&blotches(32, 32));
+    let (w, h) = (64usize, 48usize);
+    let flip: Vec<f32> =
+        (0..w * h).flat_map(|i| if i % w < w / 2 { [1.0, 0.0] } else { [-1.0, 0.0] }).collect();
+    let dom = ImageDomain::from_direction_field(w, h, &flip, 1.0).unwrap();
+    let opts = SynthesisOptions { seed: 5, ..Default::default() };
+    let off = SynthesisOptions { trapezoid_frames: false, ..opts.clone() };
+    let a = synthesize(&an, &dom, &opts, &NoProgress).unwrap();
+    let b = synthesize(&an, &dom, &off, &NoProgress).unwrap();
+    assert!(a.flips.iter().any(|&f| f), "the jump needs flipped samples");
+    assert_eq!(a.coords, b.coords);
+    assert_eq!(a.flips, b.flips);
+    // On a turning field the rule is active: the results differ.
+    let swirl: Vec<f32> = (0..w * h)
+        .flat_map(|i| {
+            let a = 0.05 * (i % w) as f32 + 0.03 * (i / w) as f32;
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    let dom = ImageDomain::from_direction_field(w, h, &swirl, 1.0).unwrap();
+    let a = synthesize(&an, &dom, &opts, &NoProgress).unwrap();
+    let b = synthesize(&an, &dom, &off, &NoProgress).unwrap();
+    assert_ne!(a.coords, b.coords);
 }
