@@ -18,34 +18,57 @@
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR DIR… --both
 //! --const 0` on the fields of `out/orient-bench/<exemplar>-<preset>` (512², seed 1,
 //! the `fieldtex orient` metrics: guided coherence at stride 8, phase defects within 3
-//! periods of the designed singularities), load 2–4 (another engineer compiling).
-//! Guided coherence over the five presets, 2-RoSy fix on, before (engine of 5fe893f) →
-//! after, against Embark `texture-synthesis` unguided (scored at a constant 0°):
+//! periods of the designed singularities), load 2–4 (other engineers compiling and
+//! benchmarking). Guided coherence, 2-RoSy fix on, over the presets arch / tented-arch /
+//! left-loop / right-loop / whorl, against Embark `texture-synthesis` unguided (scored
+//! at a constant 0°). "6787fb4" is the engine of that commit (cubic colours, kept and
+//! combed flips), "now" adds the trapezoid frames
+//! ([`SynthesisOptions::trapezoid_frames`]) and 12 passes on levels `c ≥ 2`
+//! ([`SynthesisOptions::coarse_passes`]):
 //!
-//! | exemplar | before | after | after, constant 0° | exact rotated copy 10–45° | Embark |
+//! | exemplar | 6787fb4 | now | now, constant 0° | exact rotated copy 6–45° | Embark |
 //! |---|---|---|---|---|---|
-//! | stripes | .00109–.00174 | .00092–.00144 | .00033 | .00018–.00026 | .00137 |
-//! | bands | .00055–.00058 | .00044–.00046 | .00027 | .00023–.00026 | .00024 |
-//! | woodgrain | .000080–.000082 | .000070–.000077 | .000046 | .000037–.000038 | .000039 |
-//! | weave-diagonal | .0047–.0050 | .0031–.0035 | .0024 | .0010–.0013 | .0026 |
+//! | stripes | .00092 .00113 .00118 .00119 .00144 | .00063 .00084 .00102 .00096 .00100 | .00034 | .00018–.00026 | .00137 |
+//! | bands (left-loop, whorl) | .00046 .00046 | .00047 .00046 | .00028 | .00023–.00026 | .00024 |
+//! | woodgrain (left-loop, whorl) | .000071 .000077 | .000071 .000071 | .000048 | .000037–.000038 | .000039 |
+//! | weave-diagonal | .00308 .00312 .00332 .00316 .00354 | .00279 .00294 .00298 .00316 .00327 | .00218 | .00086–.0013 | .00244 |
+//!
+//! Seeds 2 and 3 agree: weave left-loop / whorl / tented-arch, seed 2, .00351 / .00336 /
+//! .00319 → .00306 / .00303 / .00302; stripes, the four presets with singularities,
+//! lower in 8 of 8 runs (seeds 2, 3), e.g. whorl seed 2 .00144 → .00114, seed 3
+//! .00129 → .00111. The orientation
+//! error (against the field turned by the exemplar's dominant direction) fell with it:
+//! stripes whorl 5.5° → 4.3°, weave whorl 3.8° → 3.7°.
 //!
 //! The "exact rotated copy" column is the exemplar itself rotated to a constant field
 //! (`orient_probe --ideal DEG`): for bands and woodgrain even a perfect rotated copy
 //! scores about Embark's unguided value, so the target "no worse than Embark" cannot
-//! be met by any rotated output of those two under this metric; unguided (constant 0°)
-//! the engine is below Embark on stripes and weave and within 15–20 % on the others.
-//! Phase defects near singularities (fix / `--no-rosy-fix`, 16 cells with
-//! singularities): stripes 9/4, 4/7, 3/7, 4/7 (tented-arch, left-loop, right-loop,
-//! whorl); on bands, woodgrain and weave the counts (2–18) equal what the image-wide
-//! defect density (500–850 defects per image) puts into the discs, with or without
-//! the fix, so that criterion cannot separate the two there (see
-//! [`parallel_synthesis`] for the analysis). Synthesis of 512² after analysis: 545–704
-//! ms wall through `fieldtex orient` (load 1.0–1.7). Same-session A/B (`orient_probe
-//! --no-metrics --runs 7`, whorl, median, load ≈ 2.2, alternating): the previous
-//! defaults (`--free-flips --no-comb --nearest --unjittered 0 --passes 4 --no-snap`)
-//! 483–520 ms, the new ones 547–591 ms (+14 %: the two extra coarse passes; kept flips
-//! and the unjittered finest level make each pass cheaper); 8 coarse passes would cost
-//! 591–698 ms for a gain on weave only.
+//! be met by any rotated output of those two under this metric. Stripes now meets it
+//! on all five presets. Weave does not: even 3× the synthesis work (`--passes 16
+//! --coarse-passes 16 --finest-passes 6 --analysis-k 4 --k 4 --jitter 0.25`, 3.2–3.6 s
+//! on one thread) reaches only .00254 (left-loop) / .00261 (whorl), .00182 at 0°. On
+//! weave only ≈ 36 % of neighbour pairs are coherent even at 0° (`orient_probe`'s
+//! "coherent pairs"): the exemplar is periodic (period ≈ 6 px), so many exemplar
+//! places have nearly equal neighbourhoods and the corrections keep moving samples
+//! between them (at the finest level 55–70 % of the samples change in every subpass);
+//! the output is a mosaic of small fragments whose fine detail disagrees at the
+//! joins. Penalising the k-coherence jumps (distance × 1.1, 1.3, 2) to keep patches
+//! together made it worse (whorl .00327 → .00339, .00347, .00402).
+//!
+//! Phase defects near singularities on stripes (fix / `--no-rosy-fix`, tented-arch,
+//! left-loop, right-loop, whorl, seed 1): 3/4, 8/5, 4/7, 9/8; summed over the four
+//! presets and seeds 1–3 the fix leaves 53 against 64 with the 6787fb4 engine. On
+//! bands, woodgrain and weave the counts (2–18) equal what the image-wide defect
+//! density (500–850 defects per image) puts into the discs, with or without the fix,
+//! so that criterion cannot separate the two there (see [`parallel_synthesis`] for the
+//! analysis).
+//!
+//! Speed, 512² after analysis (`orient_probe --no-metrics --runs 7`, 2 threads, same
+//! session, alternating): weave whorl 588 → 660 ms (median, load ≈ 1.5; the trapezoid
+//! frames are free, the coarse passes cost ≈ 65 ms: level 2 goes from 47 to 98 ms);
+//! at load 3–4 (min of 7) weave whorl 1050 → 1160 ms, stripes whorl and left-loop
+//! 540–940 → 590–1020 ms. The earlier same-session A/B of the 6787fb4 defaults against their
+//! predecessors: 483–520 → 547–591 ms (whorl, load ≈ 2.2).
 //!
 //! # Conventions
 //! - Colours are sRGB-encoded `f32` as stored in [`fieldtex_core::Image`]; the engine

@@ -12,8 +12,8 @@ pub(crate) const MAX_K: usize = 8;
 pub struct SynthesisOptions {
     /// Seed of the initialisation and jitter streams. Default 0.
     pub seed: u64,
-    /// Correction passes per level (all but the finest when [`Self::finest_passes`] is
-    /// set). Default 6: coarse levels hold a quarter of the samples, and extra passes
+    /// Correction passes per level (level 1 only when [`Self::finest_passes`] and
+    /// [`Self::coarse_passes`] are set, as by default). Default 6: coarse levels hold a quarter of the samples, and extra passes
     /// there settle the layout (measured: lower patch coherence distance on stripes,
     /// weave and bands exemplars than 2 passes; 6 instead of 4 lowered the guided
     /// coherence on the whorl preset for weave-diagonal .00376 → .00340, stripes .00137
