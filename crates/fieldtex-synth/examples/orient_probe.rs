@@ -5,7 +5,7 @@
 //!  [DIR…] [--const DEG…] [--ideal DEG…] [--both] [--no-rosy-fix] [--free-flips]
 //!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid]
 //!  [--passes N] [--finest-passes N] [--coarse-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
-//!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--analysis-k K]
+//!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--radius R] [--analysis-k K]
 //!  [--no-metrics]`
 //!
 //! Each `DIR` holds `field.npy` (H × W × 2) and `report.json` (its
@@ -110,6 +110,7 @@ fn main() {
             "--no-snap" => opts.snap_coordinates = false,
             "--ideal" => ideal.push(num::<f32>(args.next(), &a)),
             "--scan" => aopts.coherence_scan = num(args.next(), &a),
+            "--radius" => aopts.coherence_radius = num(args.next(), &a),
             "--analysis-k" => aopts.k = num(args.next(), &a),
             "--nearest" => opts.color_filter = fieldtex_synth::ColorFilter::Nearest,
             "--free-flips" => opts.keep_flips = false,
