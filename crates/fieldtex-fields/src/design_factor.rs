@@ -53,6 +53,21 @@
 //! backward substitution was tried again and measured no faster here (under load 9.8 →
 //! 11.6 ms per singularity move; quiet, within noise).
 //!
+//! Session 6: the backward pass now runs on two workers with a schedule built once per
+//! analysis (`fieldtex-linalg`'s `subtree_schedule`, same bits): solve alone 8.8–13 →
+//! 5.8–6.3 ms; frames (other jobs paused, load ≈ 1, the best of several runs on a host
+//! that varied by up to 50 % between runs): move a singularity 7.2–7.5 ms, add a
+//! ~250 px stroke 21.3–22.3 ms, drag it 21.9–23.1 ms (1 px per event 22.6–22.9 ms),
+//! remove it 8.9–9.0 ms, a short stroke 11.3–11.5 ms. The update of the stroke's ~250
+//! edges stays ~12 ms and uses one core: on this VM the two vCPUs behave as two hardware
+//! threads of one core (the update's dense products, 1 against 2 threads: 3.4 against
+//! 3.4 ms for the 393 × 393 root block with 240 modifications), so only fewer operations
+//! would help. Tried and dropped (no gain beyond noise): trailing chunks of 64 rows, a
+//! look-ahead that reflects the next panel while the current one's trailing update runs,
+//! panels split in two halves with a compact WY product between them, the root block by
+//! forming `L Lᵀ + W Wᵀ` and a dense Cholesky (3.2 against 3.4 ms), a fused
+//! reflection/dot pass over the panel rows (−17 % panel time, ~0.3 ms per update).
+//!
 //! Not implemented: a Woodbury (capacitance-matrix) correction of the solve instead of a
 //! factor modification: it needs `A⁻¹` at the stroke's ~250–500 edges, i.e. as many
 //! sparse solves reaching the top separators, about the cost of the update itself.

@@ -63,7 +63,10 @@
 //! the path copies between the factor and its checkpoint and the faster multiple-rank
 //! update): add a ~250 px stroke 22.5–23.5 ms, drag it 23.5–24.7 ms (1 px per event
 //! 23.5–24.2 ms), remove it 10.2–11.0 ms, a short stroke 13.2–13.7 ms, move a singularity
-//! 9.2–9.6 ms, a full design solve 10.9–11.1 ms —
+//! 9.2–9.6 ms, a full design solve 10.9–11.1 ms. Session 6 (two-worker backward pass;
+//! other jobs paused, best of several runs on a noisy host): move a singularity
+//! 7.2–7.5 ms, add a ~250 px stroke 21.3–22.3 ms, drag it 21.9–23.1 ms, remove it
+//! 8.9–9.0 ms, a short stroke 11.3–11.5 ms —
 //! issue 3's 20 ms is met for singularities, short strokes and removals, not for adding
 //! or moving long strokes (their factor update, see [`crate::design_factor`]).
 
