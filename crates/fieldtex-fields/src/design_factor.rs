@@ -59,10 +59,12 @@
 //! that varied by up to 50 % between runs): move a singularity 7.2–7.5 ms, add a
 //! ~250 px stroke 21.3–22.3 ms, drag it 21.9–23.1 ms (1 px per event 22.6–22.9 ms),
 //! remove it 8.9–9.0 ms, a short stroke 11.3–11.5 ms. The update of the stroke's ~250
-//! edges stays ~12 ms and uses one core: on this VM the two vCPUs behave as two hardware
-//! threads of one core (the update's dense products, 1 against 2 threads: 3.4 against
-//! 3.4 ms for the 393 × 393 root block with 240 modifications), so only fewer operations
-//! would help. Tried and dropped (no gain beyond noise): trailing chunks of 64 rows, a
+//! edges stays ~12 ms and gains nothing from the second core: its parallel sections are
+//! one panel's trailing product each (0.1–0.3 ms, 1–3 chunks of rows), between
+//! sequential panel reflections, so waking the second worker and the sequential part
+//! eat the gain (the 393 × 393 root block with 240 modifications: 3.4 ms median on 1
+//! and on 2 threads; two independent FMA loops do run at full speed on the two vCPUs).
+//! Tried and dropped (no gain beyond noise): trailing chunks of 64 rows, a
 //! look-ahead that reflects the next panel while the current one's trailing update runs,
 //! panels split in two halves with a compact WY product between them, the root block by
 //! forming `L Lᵀ + W Wᵀ` and a dense Cholesky (3.2 against 3.4 ms), a fused
