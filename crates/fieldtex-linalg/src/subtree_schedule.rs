@@ -77,7 +77,9 @@ impl SubtreeSchedule {
                 best = Some((time, top_list.clone(), pack(&candidates, &assign)));
             }
             let Some(&heaviest) = candidates.first() else { break };
-            if children[heaviest as usize].is_empty() {
+            // small enough subtrees pack evenly already (and many roots, e.g. of a
+            // block-diagonal matrix, are not re-sorted over and over)
+            if children[heaviest as usize].is_empty() || sub[heaviest as usize] * 16 <= total {
                 break;
             }
             candidates.remove(0);
