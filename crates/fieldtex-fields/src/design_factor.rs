@@ -57,8 +57,8 @@
 //! analysis (`fieldtex-linalg`'s `subtree_schedule`, same bits): solve alone 8.8–13 →
 //! 5.8–6.3 ms; frames (other jobs paused, load ≈ 1, the best of several runs on a host
 //! that varied by up to 50 % between runs): move a singularity 7.2–7.5 ms, add a
-//! ~250 px stroke 21.3–22.3 ms, drag it 21.9–23.1 ms (1 px per event 22.6–22.9 ms),
-//! remove it 8.9–9.0 ms, a short stroke 11.3–11.5 ms. The update of the stroke's ~250
+//! ~250 px stroke 20.5–22.3 ms, drag it 21.4–23.1 ms (1 px per event 21.3–22.9 ms),
+//! remove it 8.4–9.0 ms, a short stroke 11.3–11.5 ms. The update of the stroke's ~250
 //! edges stays ~12 ms and gains nothing from the second core: its parallel sections are
 //! one panel's trailing product each (0.1–0.3 ms, 1–3 chunks of rows), between
 //! sequential panel reflections, so waking the second worker and the sequential part

@@ -65,8 +65,8 @@
 //! 23.5–24.2 ms), remove it 10.2–11.0 ms, a short stroke 13.2–13.7 ms, move a singularity
 //! 9.2–9.6 ms, a full design solve 10.9–11.1 ms. Session 6 (two-worker backward pass;
 //! other jobs paused, best of several runs on a noisy host): move a singularity
-//! 7.2–7.5 ms, add a ~250 px stroke 21.3–22.3 ms, drag it 21.9–23.1 ms, remove it
-//! 8.9–9.0 ms, a short stroke 11.3–11.5 ms —
+//! 7.2–7.5 ms, add a ~250 px stroke 20.5–22.3 ms, drag it 21.4–23.1 ms, remove it
+//! 8.4–9.0 ms, a short stroke 11.3–11.5 ms —
 //! issue 3's 20 ms is met for singularities, short strokes and removals, not for adding
 //! or moving long strokes (their factor update, see [`crate::design_factor`]).
 
