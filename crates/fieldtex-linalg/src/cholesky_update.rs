@@ -205,24 +205,8 @@ impl DynamicFactor {
             parent[j] = col.iter().map(|&r| r as usize).min().unwrap_or(NONE);
             run_ptr.push(push_runs(col, &mut runs));
         }
-        let backward_schedule = if faer_layout && supernodes.len() > 1 {
-            let nsn = supernodes.len() - 1;
-            let cost: Vec<usize> = (0..nsn)
-                .map(|s| (supernodes[s + 1] - supernodes[s]) * len[supernodes[s]])
-                .collect();
-            let parent_sn: Vec<u32> = (0..nsn)
-                .map(|s| match parent[supernodes[s + 1] - 1] {
-                    NONE => u32::MAX,
-                    p => (supernodes.partition_point(|&b| b <= p) - 1) as u32,
-                })
-                .collect();
-            crate::subtree_schedule::SubtreeSchedule::build(&cost, &parent_sn)
-                .map(std::sync::Arc::new)
-        } else {
-            None
-        };
-        Self {
-            backward_schedule,
+        let mut factor = Self {
+            backward_schedule: None,
             faer_layout,
             perm,
             inv,
@@ -244,7 +228,9 @@ impl DynamicFactor {
             blocked_count: 0,
             multi_buf: Scratch::default(),
             blocked_buf: Scratch::default(),
-        }
+        };
+        factor.backward_schedule = factor.build_backward_schedule();
+        factor
     }
 
     /// Makes `self` a copy of `s`, a factor of the same pattern and ordering. When both

@@ -26,7 +26,10 @@
 //! the reach enters it at; the backward pass every supernode, with plain (unpadded)
 //! column dot products as eight interleaved partial sums.
 
+use std::sync::Arc;
+
 use crate::cholesky_update::DynamicFactor;
+use crate::subtree_schedule::SubtreeSchedule;
 
 impl DynamicFactor {
     /// Whether [`DynamicFactor::solve_supernodal_in_place`] can run (faer's supernodal
@@ -211,25 +214,12 @@ impl DynamicFactor {
                 // SAFETY: `y` is borrowed mutably for the whole call; the top runs alone,
                 // then the bins write disjoint columns and read only columns of their own
                 // subtrees or of the (finished) top.
-                unsafe {
-                    self.backward_list(plan.top.iter().map(|&s| s as usize), shared, buf);
-                    rayon::join(
-                        || {
-                            self.backward_list(
-                                plan.bins[0].iter().map(|&s| s as usize),
-                                shared,
-                                &mut Vec::new(),
-                            )
-                        },
-                        || {
-                            self.backward_list(
-                                plan.bins[1].iter().map(|&s| s as usize),
-                                shared,
-                                &mut Vec::new(),
-                            )
-                        },
-                    );
-                }
+                let bin = |list: &[u32]| unsafe {
+                    self.backward_list(list.iter().map(|&s| s as usize), shared, &mut Vec::new())
+                };
+                // SAFETY: as above; the top runs before either bin starts.
+                unsafe { self.backward_list(plan.top.iter().map(|&s| s as usize), shared, buf) };
+                rayon::join(|| bin(&plan.bins[0]), || bin(&plan.bins[1]));
             }
             // SAFETY: one worker, `y` borrowed mutably.
             _ => unsafe { self.backward_list((0..nsn).rev(), shared, buf) },
@@ -306,6 +296,24 @@ impl DynamicFactor {
 }
 
 impl DynamicFactor {
+    /// The two-worker backward schedule of this factor's supernodal layout (`None`:
+    /// simplicial, or too small to gain): per supernode its stored entries and parent.
+    pub(crate) fn build_backward_schedule(&self) -> Option<Arc<SubtreeSchedule>> {
+        if !self.has_supernodal_layout() {
+            return None;
+        }
+        let sn = &self.supernodes;
+        let nsn = sn.len() - 1;
+        let cost: Vec<usize> = (0..nsn).map(|s| (sn[s + 1] - sn[s]) * self.len[sn[s]]).collect();
+        let parent: Vec<u32> = (0..nsn)
+            .map(|s| match self.parent[sn[s + 1] - 1] {
+                crate::cholesky_update::NONE => u32::MAX,
+                p => self.supernode_of(p) as u32,
+            })
+            .collect();
+        SubtreeSchedule::build(&cost, &parent).map(Arc::new)
+    }
+
     /// Supernode holding permuted column `j`.
     #[inline]
     fn supernode_of(&self, j: usize) -> usize {
