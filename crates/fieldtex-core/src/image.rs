@@ -60,19 +60,28 @@ impl Image {
         let b = self.get_clamped(x0 + 1, y0);
         let c = self.get_clamped(x0, y0 + 1);
         let d = self.get_clamped(x0 + 1, y0 + 1);
-        let mut out = [0.0f32; 4];
-        for k in 0..4 {
-            let top = a[k] + (b[k] - a[k]) * tx;
-            let bot = c[k] + (d[k] - c[k]) * tx;
-            out[k] = top + (bot - top) * ty;
-        }
-        out
+        bilerp([a, b, c, d], tx, ty)
     }
 
     /// Luminance (Rec. 709 weights on the sRGB-encoded values) of every pixel.
     pub fn luminance(&self) -> Vec<f32> {
         self.pixels.iter().map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]).collect()
     }
+}
+
+/// Bilinear blend of four RGBA samples `[top-left, top-right, bottom-left,
+/// bottom-right]` at fractions `(tx, ty)` in `[0, 1]`: the one interpolation behind every
+/// bilinear image lookup (each caller resolves its own border: clamp, repeat, UV flip).
+#[inline]
+pub fn bilerp(corners: [[f32; 4]; 4], tx: f32, ty: f32) -> [f32; 4] {
+    let [a, b, c, d] = corners;
+    let mut out = [0.0f32; 4];
+    for k in 0..4 {
+        let top = a[k] + (b[k] - a[k]) * tx;
+        let bot = c[k] + (d[k] - c[k]) * tx;
+        out[k] = top + (bot - top) * ty;
+    }
+    out
 }
 
 /// sRGB transfer function, encoded → linear.

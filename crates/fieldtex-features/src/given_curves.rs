@@ -3,7 +3,7 @@
 //!
 //! This is the "users can pass their own curves" path of paper A's pipeline (the
 //! orientation step does not care where curves come from). Every point gets its
-//! nearest triangle ([`crate::surface_snapping`]); with
+//! nearest triangle (the mesh's BVH, `fieldtex_mesh::Bvh::closest_points`); with
 //! [`GivenCurvesOptions::snap_to_surface`] the point also moves to the closest surface
 //! point. Strength is `∫ max(|k_max|, |k_min|) ds` (for ordering only: nothing is
 //! dropped by strength, every curve gets level 0).
@@ -14,11 +14,9 @@ use crate::curve_preprocessing::{
     CurvePreprocessOptions, check_finite, given_line, preprocess_lines,
 };
 use crate::mesh_scale::mean_edge_length_of;
-use crate::surface_snapping::SurfaceLocator;
 use fieldtex_core::Warning;
 use fieldtex_core::vec3::V3;
-use fieldtex_mesh::{CurvatureOptions, Topology, TriMesh};
-use rayon::prelude::*;
+use fieldtex_mesh::{Bvh, CurvatureOptions, Topology, TriMesh};
 use serde::Serialize;
 
 /// Options of [`given_curves`].
@@ -58,14 +56,15 @@ pub fn given_curves(
     let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
     let h = mean_edge_length_of(mesh, &topo)?;
     let diagonal = mesh.bounding_box().map_or(0.0, |b| b.diagonal());
-    let locator = SurfaceLocator::new(mesh, 2.0 * h);
+    let bvh = Bvh::build(mesh)?;
     let mut farthest: f64 = 0.0;
     let mut lines = Vec::with_capacity(curves.len());
     for c in curves.iter().filter(|c| c.len() >= 2) {
-        let located: Vec<(V3, u32)> = c
-            .par_iter()
-            .with_min_len(256)
-            .map(|&p| locator.closest_point(p).unwrap_or((p, 0)))
+        let located: Vec<(V3, u32)> = bvh
+            .closest_points(c)
+            .into_iter()
+            .zip(c)
+            .map(|(q, &p)| q.map_or((p, 0), |q| (q.point, q.triangle)))
             .collect();
         for (p, (q, _)) in c.iter().zip(&located) {
             farthest = farthest.max(fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(*p, *q)));

@@ -26,7 +26,6 @@ pub mod given_curves;
 pub mod mesh_scale;
 pub mod sharp_edges;
 mod spatial_grid;
-pub mod surface_snapping;
 #[cfg(test)]
 mod test_shapes;
 
@@ -45,4 +44,3 @@ pub use feature_quality::{SharpEdgeCoverage, sharp_edge_coverage};
 pub use given_curves::{GivenCurvesOptions, given_curves};
 pub use mesh_scale::mean_edge_length;
 pub use sharp_edges::{SharpChain, SharpEdge, salient_creases, sharp_edge_chains, sharp_edges};
-pub use surface_snapping::SurfaceLocator;

@@ -1,6 +1,5 @@
 //! A uniform spatial grid over axis-aligned boxes, for "what lies near this point"
-//! queries in the curve-matching code (coverage metric, endpoint joining, surface
-//! snapping), so none of them is `O(n²)`.
+//! queries in the curve-matching code (coverage metric, endpoint joining), so none of them is `O(n²)`.
 //!
 //! Layout: every item is entered in each cell its box overlaps, as a `(cell key, item)`
 //! pair; the pairs are sorted by key, so a cell is one binary search away and the grid

@@ -9,7 +9,8 @@
 //! `+x` towards `+y`, which is *clockwise on screen*. Indices of singularities do not
 //! depend on this choice; the sign of a vortex's rotation and the angle α do.
 
-use fieldtex_core::vec3::{add, cross, dot, normalize, scale, sub};
+use fieldtex_core::vec3::{cross, dot, normalize, scale, sub};
+use fieldtex_mesh::bvh::closest_point_on_triangle;
 use fieldtex_mesh::{TriMesh, primitives};
 
 use crate::dec::Dec;
@@ -93,7 +94,7 @@ pub fn locate_in_mesh(dec: &Dec, p: [f64; 3]) -> Option<(usize, [f64; 3], f64)> 
         let a = dec.positions[t[0] as usize];
         let b = dec.positions[t[1] as usize];
         let c = dec.positions[t[2] as usize];
-        let (q, bary) = closest_point_on_triangle(p, a, b, c);
+        let (q, bary) = closest_point_on_triangle(p, [a, b, c]);
         let d = sub(p, q);
         let dist = dot(d, d).sqrt();
         if best.as_ref().is_none_or(|bb| dist < bb.2) {
@@ -101,58 +102,6 @@ pub fn locate_in_mesh(dec: &Dec, p: [f64; 3]) -> Option<(usize, [f64; 3], f64)> 
         }
     }
     best
-}
-
-/// Closest point on triangle `abc` to `p` and its barycentric coordinates
-/// (Ericson 2005, "Real-Time Collision Detection", §5.1.5, in my own words).
-pub fn closest_point_on_triangle(
-    p: [f64; 3],
-    a: [f64; 3],
-    b: [f64; 3],
-    c: [f64; 3],
-) -> ([f64; 3], [f64; 3]) {
-    let ab = sub(b, a);
-    let ac = sub(c, a);
-    let ap = sub(p, a);
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let bp = sub(p, b);
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, [0.0, 1.0, 0.0]);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (add(a, scale(ab, v)), [1.0 - v, v, 0.0]);
-    }
-    let cp = sub(p, c);
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, [0.0, 0.0, 1.0]);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (add(a, scale(ac, w)), [1.0 - w, 0.0, w]);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (add(b, scale(sub(c, b), w)), [0.0, 1.0 - w, w]);
-    }
-    let denom = va + vb + vc;
-    if denom.abs() < f64::MIN_POSITIVE || !denom.is_finite() {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let v = vb / denom;
-    let w = vc / denom;
-    (add(a, add(scale(ab, v), scale(ac, w))), [1.0 - v - w, v, w])
 }
 
 /// Per-face orthonormal tangent frames `(e1, e2)` with `e1 × e2 = n`: the projection of

@@ -198,7 +198,7 @@ impl FieldDesign {
             // Orientation designs measure angles in frames made from one fixed vector, which
             // needs a single disk-like patch (paper D, §3: trivial topology).
             let (_, components) = dec.topology.face_components(&dec.triangles);
-            let euler = dec.n_vertices() as i64 - dec.n_edges() as i64 + dec.n_faces() as i64;
+            let euler = dec.topology.euler_characteristic();
             if components != 1 || euler != 1 {
                 warnings.push(fieldtex_core::Warning::new(
                     "field-domain-not-a-disk",

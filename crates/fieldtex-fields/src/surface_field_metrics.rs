@@ -74,18 +74,6 @@ pub struct SurfaceFieldMetrics {
     pub alignment: AlignmentError,
 }
 
-/// Euler characteristic `V − E + F` of the vertices used by triangles.
-pub fn euler_characteristic(mesh: &TriMesh, topology: &Topology) -> i64 {
-    let mut used = vec![false; mesh.n_vertices()];
-    for t in &mesh.triangles {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    let v = used.iter().filter(|&&u| u).count() as i64;
-    v - topology.n_edges() as i64 + mesh.n_triangles() as i64
-}
-
 /// Signed angle from `a` to `b` about `n`.
 fn signed_angle(a: V3, b: V3, n: V3) -> f64 {
     vec3::dot(n, vec3::cross(a, b)).atan2(vec3::dot(a, b))
@@ -352,7 +340,7 @@ pub fn surface_field_metrics(
         field_dirichlet_energy(mesh, &topology, &normals, field, &weights);
     Ok(SurfaceFieldMetrics {
         index_sum: singularities.iter().map(|s| s.index).sum(),
-        euler_characteristic: euler_characteristic(mesh, &topology),
+        euler_characteristic: topology.euler_characteristic(),
         singularities,
         undetermined_faces,
         dirichlet_energy,

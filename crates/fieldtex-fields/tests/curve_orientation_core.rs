@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_fields::harmonic_diffusion::{CurveFieldOptions, CurveFieldSolver};
-use fieldtex_fields::surface_field_metrics::{euler_characteristic, surface_field_metrics};
+use fieldtex_fields::surface_field_metrics::surface_field_metrics;
 use fieldtex_fields::{
     CurveOrientationOptions, OverlapPolicy, VertexFieldStatus, orient_curves, orientation_score,
 };
@@ -142,7 +142,7 @@ fn check_index_sum(mesh: &TriMesh, field: &[V3], chi: i32, what: &str) -> usize 
 fn index_sums_equal_the_euler_characteristic() {
     let sphere = icosphere(3);
     let topo = Topology::build(sphere.n_vertices(), &sphere.triangles);
-    assert_eq!(euler_characteristic(&sphere, &topo), 2);
+    assert_eq!(topo.euler_characteristic(), 2);
     // Rotation about a tilted axis: two +1 vortices.
     let axis = vec3::normalize([0.3, 0.2, 1.0]).unwrap();
     let n = check_index_sum(&sphere, &field_of(&sphere, |p| vec3::cross(axis, p)), 2, "vortex");
@@ -160,7 +160,7 @@ fn index_sums_equal_the_euler_characteristic() {
 
     let tor = torus(2.0, 0.7, 48, 24);
     let topo = Topology::build(tor.n_vertices(), &tor.triangles);
-    assert_eq!(euler_characteristic(&tor, &topo), 0);
+    assert_eq!(topo.euler_characteristic(), 0);
     let n = check_index_sum(&tor, &field_of(&tor, |p| [-p[1], p[0], 0.0]), 0, "torus circles");
     assert_eq!(n, 0, "the field along the major circles has no singularity");
     let m = check_index_sum(&tor, &field_of(&tor, |_| [1.0, 0.35, 0.1]), 0, "torus constant");
@@ -173,7 +173,7 @@ fn index_sum_on_genus_four_fixture() {
         .join("../../../shared/data/meshes/fertility.obj");
     let mesh = fieldtex_io::read_mesh(&path).unwrap().mesh;
     let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
-    assert_eq!(euler_characteristic(&mesh, &topo), -6);
+    assert_eq!(topo.euler_characteristic(), -6);
     check_index_sum(&mesh, &field_of(&mesh, |_| [0.31, 0.9, 0.17]), -6, "fertility constant");
 }
 

@@ -143,8 +143,7 @@ mod tests {
     use crate::Topology;
 
     fn euler(m: &TriMesh) -> i64 {
-        let t = Topology::build(m.n_vertices(), &m.triangles);
-        m.n_vertices() as i64 - t.n_edges() as i64 + m.n_triangles() as i64
+        Topology::build(m.n_vertices(), &m.triangles).euler_characteristic()
     }
 
     #[test]

@@ -108,6 +108,14 @@ impl Topology {
         self.face_edges.len()
     }
 
+    /// Euler characteristic `V − E + F` of the whole mesh, counting only vertices used
+    /// by a triangle (an unreferenced vertex is not a component). Per-component values
+    /// are in [`crate::inspect`].
+    pub fn euler_characteristic(&self) -> i64 {
+        let used = (0..self.n_vertices).filter(|&v| !self.vertex_faces(v).is_empty()).count();
+        used as i64 - self.n_edges() as i64 + self.n_faces() as i64
+    }
+
     /// Triangles using edge `e`.
     #[inline]
     pub fn edge_faces(&self, e: usize) -> &[u32] {

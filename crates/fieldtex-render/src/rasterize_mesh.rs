@@ -81,13 +81,7 @@ fn sample_texture(tex: &Image, uv: [f64; 2]) -> [f32; 4] {
     let b = tex.get_wrapped(x0 + 1, y0);
     let c = tex.get_wrapped(x0, y0 + 1);
     let d = tex.get_wrapped(x0 + 1, y0 + 1);
-    let mut out = [0.0f32; 4];
-    for k in 0..4 {
-        let top = a[k] + (b[k] - a[k]) * tx;
-        let bot = c[k] + (d[k] - c[k]) * tx;
-        out[k] = top + (bot - top) * ty;
-    }
-    out
+    fieldtex_core::image::bilerp([a, b, c, d], tx, ty)
 }
 
 /// Rasterises and shades the mesh of `scene` into a `width × width` sample frame.

@@ -185,13 +185,7 @@ impl ExemplarLevel {
         let b = self.pixel(x0 + 1, y0);
         let c = self.pixel(x0, y0 + 1);
         let d = self.pixel(x0 + 1, y0 + 1);
-        let mut out = [0.0f32; 4];
-        for k in 0..4 {
-            let top = a[k] + (b[k] - a[k]) * tx;
-            let bot = c[k] + (d[k] - c[k]) * tx;
-            out[k] = top + (bot - top) * ty;
-        }
-        out
+        fieldtex_core::image::bilerp([a, b, c, d], tx, ty)
     }
 
     /// Writes the descriptor of position `p` into `out` (`DIM`).

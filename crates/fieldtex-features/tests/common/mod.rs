@@ -43,7 +43,7 @@ pub fn check_invariants(name: &str, mesh: &TriMesh, crest: &CrestLines) {
         for (p, &f) in l.points.iter().zip(&l.faces) {
             assert!(fieldtex_core::vec3::is_finite(*p), "{name}: line {i} non-finite point");
             assert!((f as usize) < mesh.n_triangles(), "{name}: line {i} face {f}");
-            let q = fieldtex_features::surface_snapping::closest_point_on_triangle(
+            let (q, _) = fieldtex_mesh::bvh::closest_point_on_triangle(
                 *p,
                 mesh.triangle_positions(f as usize),
             );
