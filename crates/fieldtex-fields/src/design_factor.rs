@@ -30,48 +30,7 @@
 //!   (default 640) edges would be modified, after `16 ×` that many modifications since
 //!   the last factorisation (rounding drift), or when a downdate is refused.
 //!
-//! Measured on the 128² grid of the interactive benchmark (49K unknowns, 2.3M factor
-//! entries, 2 cores shared with other jobs, `cargo build --release -p fieldtex-fields
-//! --examples && target/release/examples/bench_fields`, medians of 15), one frame =
-//! edit + solve + 512² sampling. Session 4 (load 4.4–5.0, against the sweeps-only
-//! factor): adding a ~250 px stroke (~250 edges, direct update) 75 → 44 ms, dragging it
-//! by 2–6 px 128 → 50 ms, removing it 118 → 24 ms, a ~18 px stroke 42 → 19 ms. Session 5,
-//! with the path copies, the faster multiple-rank update and the downdate weight 4 (three
-//! runs at load 1.2–1.3): add 22.5–23.5 ms, drag by 2–6 px 23.5–24.7 ms, drag by 1 px per
-//! event (`field_drag_stroke_1px`) 23.5–24.2 ms (90th percentile 24.8–25.4), remove
-//! 10.2–11.0 ms, ~18 px stroke 13.2–13.7 ms. A numeric refactorisation includes the
-//! take-over for updates and the checkpoint copy (~90–170 ms).
-//!
-//! Issue 3's 20 ms stays out of reach for long strokes: the update of `k` edges touches
-//! the factor columns on the edges' elimination-tree paths, which on a 2-D grid always
-//! include the top separators. Counted for the benchmark's ~250-edge strokes (rows ×
-//! modifications over the union of the paths): 38–52M operations, of which 38–57 % in
-//! the chain of supernodes above the first branching of the union, which every
-//! modification crosses; below it the union splits into unbalanced subtrees (e.g. 31M
-//! against 0.2M), so running the subtrees of the update in parallel would save at most
-//! ~20 %; the update stays ~13 ms and the solve ~8 ms on this machine. A tree-parallel
-//! backward substitution was tried again and measured no faster here (under load 9.8 →
-//! 11.6 ms per singularity move; quiet, within noise).
-//!
-//! Session 6: the backward pass now runs on two workers with a schedule built once per
-//! analysis (`fieldtex-linalg`'s `subtree_schedule`, same bits): solve alone 8.8–13 →
-//! 5.8–6.3 ms; frames (other jobs paused, load ≈ 1, the best of several runs on a host
-//! that varied by up to 50 % between runs): move a singularity 7.2–7.5 ms, add a
-//! ~250 px stroke 20.5–22.3 ms, drag it 21.4–23.1 ms (1 px per event 21.3–22.9 ms),
-//! remove it 8.4–9.0 ms, a short stroke 11.3–11.5 ms. The update of the stroke's ~250
-//! edges stays ~12 ms and gains nothing from the second core: its parallel sections are
-//! one panel's trailing product each (0.1–0.3 ms, 1–3 chunks of rows), between
-//! sequential panel reflections, so waking the second worker and the sequential part
-//! eat the gain (the 393 × 393 root block with 240 modifications: 3.4 ms median on 1
-//! and on 2 threads; two independent FMA loops do run at full speed on the two vCPUs).
-//! Tried and dropped (no gain beyond noise): trailing chunks of 64 rows, a
-//! look-ahead that reflects the next panel while the current one's trailing update runs,
-//! panels split in two halves with a compact WY product between them, the root block by
-//! forming `L Lᵀ + W Wᵀ` and a dense Cholesky (3.2 against 3.4 ms), a fused
-//! reflection/dot pass over the panel rows (−17 % panel time, ~0.3 ms per update), and a
-//! second worker that takes trailing chunks as soon as their panel is published (claimed
-//! units, spinning instead of one fork per panel: the root block 3.5 → 3.0 ms in
-//! isolation, frames unchanged within noise).
+//! Measurements, and what was tried for long strokes: `docs/perf/field-design-edits.md`.
 //!
 //! Not implemented: a Woodbury (capacitance-matrix) correction of the solve instead of a
 //! factor modification: it needs `A⁻¹` at the stroke's ~250–500 edges, i.e. as many

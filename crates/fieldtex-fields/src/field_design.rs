@@ -51,24 +51,8 @@
 //! change at most [`FieldDesignOptions::rank1_update_limit`] edges (default 640) are
 //! multiple-rank updates/downdates of the factor or a copy of a kept earlier factor plus
 //! one update (whichever modifies fewer edges), larger ones a numeric refactorisation
-//! with the kept symbolic analysis ([`crate::design_factor`], with the measurements).
-//! Cost of one interactive frame on the 128² grid (49K unknowns) as a front end sees it
-//! (edit, then [`FieldDesign::solve_and_sample_into`] at 512², from a thread outside the
-//! rayon pool; `cargo build --release -p fieldtex-fields --examples &&
-//! target/release/examples/bench_fields`, 2 cores shared with other jobs, load average
-//! 4.4–5.0, medians of three interleaved runs against the previous binary): moving a
-//! singularity 21 → 18 ms (solve alone 19 → 11 ms: the deviation's sparse right-hand
-//! side now runs supernodal dense column loops, `Cholesky::solve_sparse_with_residual`;
-//! plus ~2.5 ms sampling), a full design solve 33 → 16 ms. Session 5 (load 1.2–1.3, after
-//! the path copies between the factor and its checkpoint and the faster multiple-rank
-//! update): add a ~250 px stroke 22.5–23.5 ms, drag it 23.5–24.7 ms (1 px per event
-//! 23.5–24.2 ms), remove it 10.2–11.0 ms, a short stroke 13.2–13.7 ms, move a singularity
-//! 9.2–9.6 ms, a full design solve 10.9–11.1 ms. Session 6 (two-worker backward pass;
-//! other jobs paused, best of several runs on a noisy host): move a singularity
-//! 7.2–7.5 ms, add a ~250 px stroke 20.5–22.3 ms, drag it 21.4–23.1 ms, remove it
-//! 8.4–9.0 ms, a short stroke 11.3–11.5 ms —
-//! issue 3's 20 ms is met for singularities, short strokes and removals, not for adding
-//! or moving long strokes (their factor update, see [`crate::design_factor`]).
+//! with the kept symbolic analysis ([`crate::design_factor`]).
+//! Frame costs, session by session: `docs/perf/field-design-edits.md`.
 
 use std::sync::Arc;
 

@@ -31,22 +31,14 @@
 //! path: new pivot² ≤ 4 ε · old pivot²) is refused with [`LinalgError::UpdateFailed`] and
 //! every factor column is restored — none of the `k` modifications is applied.
 //!
-//! Speed (refined horse, 194K unknowns, 40 crest curves of 5–200 penalties each, via
-//! `fieldtex-fields/examples/bench_orientation.rs`): the earlier row-by-row form (all
-//! modifications of a row in a chain, latency-bound) took 3.5 s for the 40 updates; the
-//! sweep form 1.2 s, same factor bit for bit. An AVX-512 build gave nothing more.
+//! Speed measurements of each form: `docs/perf/multiple-rank-update.md`.
 //!
 //! **Blocked supernodes (updates only).** Where many modifications pass through a wide
 //! supernode of faer's layout (at least 8 columns and 8 modifications), an update
 //! handles the whole supernode at once with structured Householder reflections in
 //! panels (`crate::blocked_update`), whose trailing work is two dense matrix products.
 //! There the result equals the sweeps' to rounding, no longer bit for bit (it is still
-//! independent of the thread count). Measured (same benchmark, 178 greedy steps): the
-//! steps' updates 3.3–3.5 s → 2.2–2.7 s, the slowest step 85 ms → 38–46 ms, the
-//! smallest ratio refactorisation / step update 6.5–8.5× → 15.5–18.4× (load ~1.4; 12.6×
-//! and up under load ~2.9); a 61-penalty curve on a 448² grid
-//! (`examples/bench_linalg.rs`) 15–16 ms against 28–36 ms for the same downdate by
-//! sweeps.
+//! independent of the thread count).
 //!
 //! **Per-column modification lists.** A column is changed only by the modifications whose
 //! path holds it, so a CSR list of those (ascending, from one walk up each path) replaces
@@ -54,11 +46,7 @@
 //! miss each; blocked supernodes take their candidates from the list of their last
 //! column, and gather and scatter `W` by runs of consecutive slots; the work buffer is
 //! kept zero between updates (every entry is consumed by its column) instead of being
-//! refilled. Same operations, same bits. Measured (load 2.4–2.9, same commands as
-//! above): the 178 horse steps' updates 2.2–2.7 s → 1.4 s, the slowest step 38–46 →
-//! 23 ms, the smallest ratio refactorisation / step update 15.5–18.4× → 24.7×, the greedy
-//! orientation 6.7–7.1 s → 5.1 s; a ~250-edge stroke on the 128² field grid 16.7 →
-//! 15.2 ms (list) → 14.6–15.4 ms (no refill), old and new binaries interleaved.
+//! refilled. Same operations, same bits.
 //!
 //! Not implemented: multiple-rank modifications by general (non-diagonal) vectors, which
 //! can create fill (use [`Cholesky::update`] per vector); a blocked form of downdates

@@ -44,31 +44,8 @@
 //! ([`SynthesisOptions::comb_flips`], [`crate::flip_combing`]), so the effective frame
 //! has seams only where the field's singularities force them.
 //!
-//! # Why the 2-RoSy fix did not reduce defects near singularities (issue 3)
-//! Measured with `examples/orient_probe` on the `out/orient-bench` whorl field, stripes
-//! exemplar, seed 1, load ≈ 2.5: with free flips (paper D lets the winner's `α` become
-//! `I[p]`) the flipped regions grew ragged boundaries — 13 853 horizontal/vertical
-//! neighbour pairs whose effective frames point in opposite directions, against the 463
-//! representative jumps of the field itself (the `--no-rosy-fix` run). Each such seam
-//! is a break in the texture (only ≈ 25 % of the pairs across one are coherent): the
-//! fix moved the discontinuities around instead of removing them. With kept flips and
-//! combing 417 seam pairs remain (left-loop: 565 against 235 representative jumps: the
-//! combing seams of the coarse initialisation level are straight and longer than the
-//! field's own cut, but they do not wander). Final defaults, whorl: phase defects near
-//! the singularities 4 with the fix against 7 without (before: 9 / 11).
-//!
-//! The remaining defects near singularities are mostly not the engine's: on woodgrain,
-//! bands and weave the phase-defect detector finds 500–850 defects all over the image,
-//! and the count inside the discs of radius 3 periods is what that density predicts
-//! (e.g. woodgrain whorl: 18 found, 15.8 expected), with or without the fix. On stripes
-//! they sit where the field spreads or squeezes the stripes (the deltas, the core): a
-//! texture of one period following a line field `d` needs `div d = 0` to have no stripe
-//! ends, and `∫ |div d| dA / period` over the counted annuli (1.5–3 periods around each
-//! singularity) is 5.8–9.7 stripe ends on the four presets with singularities — more
-//! than the 3–9 found, so these are forced by the field, not by seams. The nofix seams
-//! that the fix removes (straight cuts from the singularities to the border, paper D
-//! Fig. 5) shift the stripe phase along a line and mostly do not produce a ±2π
-//! winding, so the criterion hardly sees them.
+//! Why the 2-RoSy fix did not reduce the defect count near singularities (issue 3),
+//! measured: `docs/perf/orient-synthesis.md`.
 //!
 //! Speed: the 32-D neighbourhood vector of every exemplar pixel (both copies) is
 //! tabulated per level, so a candidate costs one 32-byte load and an exact integer
