@@ -24,7 +24,7 @@ struct GlobalArgs {
     /// Random seed; the same inputs, options and seed give byte-identical outputs.
     #[arg(long, global = true, default_value_t = 1)]
     seed: u64,
-    /// Worker threads (default: all cores). Output does not depend on it.
+    /// Worker threads, 1 to 256 (default: all cores). Output does not depend on it.
     #[arg(long, global = true)]
     threads: Option<usize>,
     /// No progress bars or summaries (errors are still printed).
@@ -34,17 +34,20 @@ struct GlobalArgs {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the main job on built-in inputs (no files needed).
+    /// Run the main job on built-in inputs (no files needed): procedural stripes aligned
+    /// to the creases of a cube (`align`), and the whorl preset of `orient` beside it.
     Demo {
-        /// Output directory (created if missing).
+        /// Output directory (created if missing): model.glb, preview.png, orient.png,
+        /// report.json.
         #[arg(long)]
         out: PathBuf,
-        /// Texture resolution of the atlas.
-        #[arg(long, default_value_t = 1024)]
+        /// Texture resolution of the cube's atlas, 64 to 2048.
+        #[arg(long, default_value_t = 256)]
         size: usize,
     },
     /// Print counts, topology and defects of a mesh.
     Inspect {
+        /// Mesh file: OBJ, PLY, STL, glTF or GLB (format read from the content).
         mesh: PathBuf,
         /// Print the full report as JSON.
         #[arg(long)]
@@ -53,6 +56,7 @@ enum Command {
     /// Weld, drop degenerate and unreferenced elements, fix orientation, split
     /// non-manifold vertices; lists every change.
     Repair {
+        /// Mesh file: OBJ, PLY, STL, glTF or GLB.
         mesh: PathBuf,
         /// Output mesh (.obj, .ply or .glb); never the input file.
         #[arg(long)]
@@ -67,7 +71,9 @@ enum Command {
     },
     /// Segment into charts, flatten, pack; writes model.glb, preview.png, report.json.
     Atlas {
+        /// Mesh file: OBJ, PLY, STL, glTF or GLB.
         mesh: PathBuf,
+        /// Output directory (created if missing); never a folder's input files.
         #[arg(long)]
         out: PathBuf,
         /// Atlas resolution in texels (square).
@@ -89,7 +95,7 @@ enum Command {
         /// External field .npy (H×W×2 float32 (dx, dy), x right, y down).
         #[arg(long, group = "source")]
         field: Option<PathBuf>,
-        /// Exemplar image (PNG/JPEG).
+        /// Exemplar image (PNG/JPEG), e.g. stripes; its x axis follows the field.
         #[arg(long)]
         exemplar: PathBuf,
         /// Output size in pixels (square).
@@ -98,47 +104,60 @@ enum Command {
         /// Field grid cells per side (presets).
         #[arg(long, default_value_t = 128)]
         grid: usize,
-        /// Exemplar pixels per output pixel (below 1 enlarges the pattern).
+        /// Exemplar pixels per output pixel, 1/64 to 16 (below 1 enlarges the pattern).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
         /// Disable the 2-RoSy fix of paper D §4 (ablation).
         #[arg(long)]
         no_rosy_fix: bool,
-        /// Skip the image metrics of report.json (coherence, orientation error, defects:
-        /// ~15 s for a 512² output); timings and the designed singularities are kept.
+        /// Skip the image metrics of report.json (coherence, orientation error, defects);
+        /// timings and the designed singularities are kept.
         #[arg(long)]
         no_metrics: bool,
-        /// Disk-topology mesh patch: parameterise it (LSCM), design the field on it and
+        /// Exhaustive nearest-patch searches in the metrics (coherence, completeness,
+        /// guided coherence) instead of the default approximate ones (PCA + kd-tree,
+        /// within a few per cent; see docs/first-hour.md); tens of seconds at 512².
+        #[arg(long)]
+        exact_metrics: bool,
+        /// Mesh file (OBJ, PLY, STL, glTF/GLB) of a disk-topology patch; default: the
+        /// plane. Parameterise it (LSCM), design the field on it and
         /// synthesise in parameter space; also writes model.glb. Plane designs and
         /// presets are laid on the patch's UV bounding box.
         #[arg(long)]
         mesh: Option<PathBuf>,
         /// With --mesh: texture only the connected region within radius R of the point
         /// (X, Y, Z), e.g. to cut a disk out of a closed mesh.
-        #[arg(long, value_name = "X,Y,Z,R", value_delimiter = ',', allow_negative_numbers = true)]
+        #[arg(long, value_name = "X,Y,Z,R", value_delimiter = ',', allow_hyphen_values = true)]
         patch: Option<Vec<f64>>,
+        /// Output directory (created if missing): texture.png, field.npy, preview.png,
+        /// report.json (and model.glb with --mesh).
         #[arg(long)]
         out: PathBuf,
     },
     /// Crest lines (ridges, valleys) and salient creases as OBJ polylines (paper A).
     Crest {
+        /// Mesh file: OBJ, PLY, STL, glTF or GLB.
         mesh: PathBuf,
         /// Output OBJ with `l` polylines.
         #[arg(long)]
         out: PathBuf,
-        /// Ascending strength thresholds (comma-separated), one level of detail each.
-        #[arg(long, value_delimiter = ',')]
+        /// Ascending strength thresholds (comma-separated), one level of detail each; a
+        /// line's strength is ∫|k| ds along it (unitless). Default: the detector's own
+        /// thresholds, relative to the mesh (see `crest` in report).
+        #[arg(long, value_delimiter = ',', value_name = "T1,T2,...")]
         levels: Option<Vec<f64>>,
         /// Keep only lines of this level and above.
         #[arg(long, default_value_t = 0)]
         level: usize,
-        /// Render the mesh with the lines drawn (red ridges, blue valleys).
+        /// Also render the mesh with the lines drawn (red ridges, blue valleys) to this
+        /// PNG; never one of the inputs.
         #[arg(long)]
         preview: Option<PathBuf>,
     },
     /// A tangent field following oriented feature curves (paper A §4); writes a PLY with
     /// per-vertex `x y z nx ny nz fx fy fz`.
     Field {
+        /// Mesh file: OBJ, PLY, STL, glTF or GLB.
         mesh: PathBuf,
         /// OBJ polylines (`l` elements); default: detected crest lines.
         #[arg(long)]
@@ -146,6 +165,7 @@ enum Command {
         /// Curve orientation: greedy (paper A §4.1) or arbitrary (random, from --seed).
         #[arg(long, default_value = "greedy", value_parser = ["greedy", "arbitrary"])]
         orient: String,
+        /// Output PLY (per-vertex x y z nx ny nz fx fy fz).
         #[arg(long)]
         out: PathBuf,
     },
@@ -153,8 +173,10 @@ enum Command {
     /// field, texture optimisation on the surface with feature-to-feature alignment;
     /// writes model.glb, preview.png, report.json (and curves.obj, field.ply with --keep).
     Align {
+        /// Mesh file: OBJ, PLY, STL, glTF or GLB.
         #[arg(long)]
         mesh: PathBuf,
+        /// Exemplar image (PNG/JPEG) with clear feature lines (stripes, bricks, weave).
         #[arg(long)]
         exemplar: PathBuf,
         /// OBJ polylines (`l` elements) to align to; default: detected crest lines.
@@ -182,12 +204,15 @@ enum Command {
         /// Draw the curves on preview.png.
         #[arg(long)]
         draw_curves: bool,
+        /// Output directory (created if missing): model.glb, preview.png, report.json.
         #[arg(long)]
         out: PathBuf,
     },
     /// Render a shaded preview of a mesh (textured when it has a texture).
     Render {
+        /// Mesh file (OBJ, PLY, STL, glTF or GLB), textured when it has a texture.
         model: PathBuf,
+        /// Output image: .png, .jpg or .jpeg (format from the extension).
         #[arg(long)]
         out: PathBuf,
         /// Image size in pixels (square).
@@ -210,10 +235,26 @@ enum Command {
         /// Constant guidance direction in degrees (counter-clockwise from +x on screen).
         #[arg(long)]
         angle: Option<f64>,
+        /// Exhaustive nearest-patch searches instead of the default approximate ones
+        /// (PCA + kd-tree, within a few per cent; see docs/first-hour.md); minutes at
+        /// 1024².
+        #[arg(long)]
+        exact_metrics: bool,
         /// Write the metrics JSON here as well as printing it.
         #[arg(long)]
         out: Option<PathBuf>,
     },
+}
+
+/// Largest accepted `--threads`.
+const MAX_THREADS: usize = 256;
+
+/// Prints a line to stdout; a closed pipe (`fieldtex inspect M --json | head -1`) ends
+/// the output quietly instead of panicking.
+fn print_stdout(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{text}").and_then(|()| out.flush());
 }
 
 fn parse_view(s: &str) -> Result<(f64, f64), String> {
@@ -239,8 +280,12 @@ fn main() -> ExitCode {
         }
     };
     if let Some(n) = cli.global.threads {
-        if n == 0 {
-            eprintln!("error: --threads must be at least 1");
+        // Regression: --threads 100000 hung or aborted while spawning threads.
+        if n == 0 || n > MAX_THREADS {
+            eprintln!(
+                "error: --threads must be in 1..={MAX_THREADS}, got {n} (leave it out to use all \
+                 cores)"
+            );
             return ExitCode::from(2);
         }
         if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
@@ -270,16 +315,19 @@ fn run(cli: Cli) -> Result<(), Error> {
             let opts = fieldtex::DemoOptions { seed: g.seed, size, ..Default::default() };
             let report = fieldtex::demo(&out, &opts, &progress)?;
             print_warnings(&report.warnings, g.quiet);
-            say(&format!("wrote {}/model.glb, preview.png, report.json", out.display()));
+            say(&format!(
+                "wrote {}/model.glb, preview.png, orient.png, report.json",
+                out.display()
+            ));
         }
         Command::Inspect { mesh, json } => {
             let (report, warnings) = fieldtex::inspect_file(&mesh)?;
             print_warnings(&warnings, g.quiet);
             if json {
-                println!("{}", serde_json::to_string_pretty(&report).unwrap_or_default());
+                print_stdout(&serde_json::to_string_pretty(&report).unwrap_or_default());
             } else {
                 for line in report.summary_lines() {
-                    println!("{line}");
+                    print_stdout(&line);
                 }
             }
         }
@@ -287,10 +335,10 @@ fn run(cli: Cli) -> Result<(), Error> {
             let opts = fieldtex::RepairCommandOptions { weld_epsilon };
             let summary = fieldtex::repair_file(&mesh, &out, &opts)?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+                print_stdout(&serde_json::to_string_pretty(&summary).unwrap_or_default());
             } else {
                 for line in summary.lines() {
-                    println!("{line}");
+                    print_stdout(&line);
                 }
             }
         }
@@ -300,7 +348,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             print_warnings(&report.warnings, g.quiet);
             say(&format!("wrote {}/model.glb, preview.png, report.json", out.display()));
             if !g.quiet {
-                println!("{}", serde_json::to_string_pretty(&report.metrics).unwrap_or_default());
+                print_stdout(&serde_json::to_string_pretty(&report.metrics).unwrap_or_default());
             }
         }
         Command::Orient {
@@ -313,6 +361,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             scale,
             no_rosy_fix,
             no_metrics,
+            exact_metrics,
             mesh,
             patch,
             out,
@@ -334,6 +383,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             opts.scale = scale;
             opts.rosy_fix = !no_rosy_fix;
             opts.metrics = !no_metrics;
+            opts.exact_metrics = exact_metrics;
             opts.seed = g.seed;
             let model = if mesh.is_some() { "model.glb, " } else { "" };
             opts.mesh = mesh;
@@ -357,15 +407,15 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Crest { mesh, out, levels, level, preview } => {
             let opts = fieldtex::CrestCommandOptions { levels, min_level: level, preview };
             let summary = fieldtex::crest_file(&mesh, &out, &opts)?;
-            print_warnings(&summary.warnings, g.quiet);
-            println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+            // The warnings are in the printed summary; printing them again doubled them.
+            print_stdout(&serde_json::to_string_pretty(&summary).unwrap_or_default());
         }
         Command::Field { mesh, curves, orient, out } => {
             let opts =
                 fieldtex::FieldCommandOptions { curves, greedy: orient == "greedy", seed: g.seed };
             let summary = fieldtex::field_file(&mesh, &out, &opts, &progress)?;
-            print_warnings(&summary.warnings, g.quiet);
-            println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+            // The warnings are in the printed summary (not printed twice).
+            print_stdout(&serde_json::to_string_pretty(&summary).unwrap_or_default());
         }
         Command::Align {
             mesh,
@@ -402,28 +452,48 @@ fn run(cli: Cli) -> Result<(), Error> {
             fieldtex::render_file(&model, &out, &opts)?;
             say(&format!("wrote {}", out.display()));
         }
-        Command::Eval { image, exemplar, field, angle, out } => {
+        Command::Eval { image, exemplar, field, angle, exact_metrics, out } => {
             let guide = match (field, angle) {
                 (Some(f), _) => Some(fieldtex::Guidance::FieldFile(f)),
                 (None, Some(a)) => Some(fieldtex::Guidance::Angle(a)),
                 (None, None) => None,
             };
-            let metrics = fieldtex::eval_files(&image, &exemplar, guide.as_ref(), g.seed)?;
+            let metrics = fieldtex::eval_files(
+                &image,
+                &exemplar,
+                guide.as_ref(),
+                g.seed,
+                exact_metrics,
+                &progress,
+            )?;
             let text = serde_json::to_string_pretty(&metrics).unwrap_or_default();
             if let Some(o) = out {
                 fieldtex::write_text(&o, &text)?;
             }
-            println!("{text}");
+            print_stdout(&text);
         }
     }
     Ok(())
 }
 
+/// Prints each warning once, in its own words (the message, not the library's code);
+/// warnings repeating a code are counted on the first one's line.
 fn print_warnings(w: &[fieldtex::Warning], quiet: bool) {
     if quiet {
         return;
     }
+    let mut seen: Vec<(&str, &str, usize)> = Vec::new();
     for x in w {
-        eprintln!("warning: {x}");
+        match seen.iter_mut().find(|s| s.0 == x.code || s.1 == x.message) {
+            Some(s) => s.2 += 1,
+            None => seen.push((x.code.as_str(), x.message.as_str(), 0)),
+        }
+    }
+    for (_, message, more) in seen {
+        if more > 0 {
+            eprintln!("warning: {message} (and {more} more like this; see report.json)");
+        } else {
+            eprintln!("warning: {message}");
+        }
     }
 }

@@ -63,11 +63,17 @@ fn demo_is_byte_identical_for_one_and_two_threads() {
     let a = tmp("demo-t1");
     let b = tmp("demo-t2");
     let limit = Duration::from_secs(120);
-    let oa = run(&["demo", "--out", a.to_str().unwrap(), "--threads", "1", "--quiet"], limit);
+    let oa = run(
+        &["demo", "--size", "128", "--out", a.to_str().unwrap(), "--threads", "1", "--quiet"],
+        limit,
+    );
     assert_eq!(code(&oa), 0, "{}", stderr(&oa));
-    let ob = run(&["demo", "--out", b.to_str().unwrap(), "--threads", "2", "--quiet"], limit);
+    let ob = run(
+        &["demo", "--size", "128", "--out", b.to_str().unwrap(), "--threads", "2", "--quiet"],
+        limit,
+    );
     assert_eq!(code(&ob), 0, "{}", stderr(&ob));
-    for f in ["model.glb", "preview.png"] {
+    for f in ["model.glb", "preview.png", "orient.png"] {
         let x = std::fs::read(a.join(f)).unwrap();
         let y = std::fs::read(b.join(f)).unwrap();
         assert!(!x.is_empty());
@@ -82,11 +88,17 @@ fn different_seeds_change_the_demo_texture() {
     let b = tmp("demo-s2");
     let limit = Duration::from_secs(120);
     assert_eq!(
-        code(&run(&["demo", "--out", a.to_str().unwrap(), "--quiet", "--seed", "1"], limit)),
+        code(&run(
+            &["demo", "--size", "128", "--out", a.to_str().unwrap(), "--quiet", "--seed", "1"],
+            limit
+        )),
         0
     );
     assert_eq!(
-        code(&run(&["demo", "--out", b.to_str().unwrap(), "--quiet", "--seed", "2"], limit)),
+        code(&run(
+            &["demo", "--size", "128", "--out", b.to_str().unwrap(), "--quiet", "--seed", "2"],
+            limit
+        )),
         0
     );
     let x = std::fs::read(a.join("model.glb")).unwrap();
@@ -239,7 +251,10 @@ fn pipeline_glbs_pass_the_khronos_validator() {
     );
     let demo = tmp("validate-demo");
     assert_eq!(
-        code(&run(&["demo", "--out", demo.to_str().unwrap(), "--quiet"], Duration::from_secs(120))),
+        code(&run(
+            &["demo", "--size", "128", "--out", demo.to_str().unwrap(), "--quiet"],
+            Duration::from_secs(120)
+        )),
         0
     );
     let atlas = tmp("validate-atlas");

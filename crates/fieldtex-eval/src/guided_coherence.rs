@@ -70,11 +70,15 @@ pub struct GuidedCoherenceOptions {
     /// Also compare the output patch rotated by 180° (for 2-RoSy orientation fields,
     /// where `d` and `−d` are the same direction). Default true.
     pub sign_free: bool,
+    /// `Some`: approximate nearest search (PCA + kd-tree, an upper bound of the exact
+    /// distances, [`crate::approximate_nearest_patch`]; its `query_stride` is not used,
+    /// [`stride`] is); `None`: the exact search. Default `None`.
+    pub approximate: Option<crate::ApproximateSearchOptions>,
 }
 
 impl Default for GuidedCoherenceOptions {
     fn default() -> Self {
-        Self { patch_size: 7, stride: 8, wrap_exemplar: true, sign_free: true }
+        Self { patch_size: 7, stride: 8, wrap_exemplar: true, sign_free: true, approximate: None }
     }
 }
 
@@ -120,6 +124,8 @@ pub struct GuidedCoherenceReport {
     pub patch_size: usize,
     pub stride: usize,
     pub sign_free: bool,
+    /// `"exact"` or `"approximate"`.
+    pub search: String,
 }
 
 /// Bilinear sample of all channels at `(x, y)` (pixel centres at integers), with
@@ -294,6 +300,19 @@ pub fn guided_coherence(
     let dim = n * n * c;
     let row_len = n * c;
     let (db, count) = exemplar_patches(exemplar, n, options.wrap_exemplar);
+    let dense = crate::approximate_nearest_patch::DensePatches { data: &db, dim };
+    let index = match &options.approximate {
+        Some(a) => {
+            Some(crate::approximate_nearest_patch::PatchIndex::build(&dense, a).map_err(|_| {
+                EvalError::InvalidOption {
+                    name: "approximate",
+                    value: format!("{a:?}"),
+                    reason: "the patch PCA failed (constant or degenerate exemplar?)",
+                }
+            })?)
+        }
+        None => None,
+    };
     let s = options.stride;
     let xs: Vec<usize> = (s / 2..output.width).step_by(s).collect();
     let ys: Vec<usize> = (s / 2..output.height).step_by(s).collect();
@@ -303,6 +322,7 @@ pub fn guided_coherence(
         .map(|&py| {
             let mut q = vec![0f32; dim];
             let mut q_flip = vec![0f32; dim];
+            let mut scratch = vec![0f32; dim];
             let mut dists = Vec::with_capacity(xs.len());
             let (mut border, mut no_dir) = (0, 0);
             let mut hint = 0usize;
@@ -310,6 +330,14 @@ pub fn guided_coherence(
                 match sample_query(output, field, px, py, n, &mut q, &mut q_flip) {
                     Query::Border => border += 1,
                     Query::NoDirection => no_dir += 1,
+                    Query::Ok if index.is_some() => {
+                        let idx = index.as_ref().expect("checked");
+                        let mut d = idx.nearest(&q, &mut scratch).0;
+                        if options.sign_free {
+                            d = d.min(idx.nearest(&q_flip, &mut scratch).0);
+                        }
+                        dists.push(d);
+                    }
                     Query::Ok => {
                         let (d, arg) = nearest(
                             &q,
@@ -355,6 +383,7 @@ pub fn guided_coherence(
         patch_size: n,
         stride: s,
         sign_free: options.sign_free,
+        search: if options.approximate.is_some() { "approximate" } else { "exact" }.into(),
     })
 }
 

@@ -18,6 +18,7 @@
 //! Architecture invariant: no file I/O (reading `.npy`/PNG is `fieldtex-io`'s job), no
 //! printing; results are identical for any number of rayon threads.
 
+pub mod approximate_nearest_patch;
 pub mod coherence;
 pub mod color_sliced_wasserstein;
 pub mod completeness;
@@ -31,6 +32,7 @@ pub mod phase_defects;
 pub mod singularities;
 pub mod surface_metrics;
 
+pub use approximate_nearest_patch::ApproximateSearchOptions;
 pub use coherence::coherence;
 pub use color_sliced_wasserstein::{
     SlicedWassersteinOptions, SlicedWassersteinReport, color_sliced_wasserstein,

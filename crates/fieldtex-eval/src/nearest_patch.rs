@@ -27,6 +27,7 @@
 //! search was data-dependent: 15 s on a patchwork output, minutes on noise).
 
 use crate::EvalError;
+use crate::approximate_nearest_patch::{ApproximateSearchOptions, PatchIndex, PatchSource};
 use crate::image_view::ImageView;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -41,12 +42,18 @@ pub struct PatchDistanceOptions {
     pub wrap_exemplar: bool,
     /// Refuse comparisons of more patch pairs than this (the cost is linear in it:
     /// about 3 ns per pair per core). Default 2·10¹⁰ (512² vs 256² is 1.6·10¹⁰).
+    /// Exact search only.
     pub max_pairs: u64,
+    /// `Some`: the approximate search of [`crate::approximate_nearest_patch`] (PCA +
+    /// kd-tree, bounded cost, an upper bound on the exact distances); `None`: the exact
+    /// displacement scan. Default `None` (exact) for the library; the pipelines' default
+    /// reports use the approximate search and offer the exact one as an option.
+    pub approximate: Option<ApproximateSearchOptions>,
 }
 
 impl Default for PatchDistanceOptions {
     fn default() -> Self {
-        Self { patch_size: 7, wrap_exemplar: false, max_pairs: 20_000_000_000 }
+        Self { patch_size: 7, wrap_exemplar: false, max_pairs: 20_000_000_000, approximate: None }
     }
 }
 
@@ -57,6 +64,11 @@ impl PatchDistanceOptions {
     }
     pub fn with_wrap_exemplar(mut self, wrap: bool) -> Self {
         self.wrap_exemplar = wrap;
+        self
+    }
+    /// The approximate search (`Some`) or the exact scan (`None`).
+    pub fn with_approximate(mut self, approximate: Option<ApproximateSearchOptions>) -> Self {
+        self.approximate = approximate;
         self
     }
     pub(crate) fn validate(&self) -> Result<(), EvalError> {
@@ -125,6 +137,67 @@ impl PatchGrid {
         let s = (ch * self.height + y) * self.stride + x;
         &self.planes[s..s + len]
     }
+}
+
+impl PatchSource for PatchGrid {
+    fn len(&self) -> usize {
+        self.count()
+    }
+    fn dim(&self) -> usize {
+        PatchGrid::dim(self)
+    }
+    /// Patch `i` (top-left `(i % cols, i / cols)`), row, column, channel order.
+    fn fill(&self, i: usize, out: &mut [f32]) {
+        let (x, y) = (i % self.cols, i / self.cols);
+        let (n, c) = (self.n, self.channels);
+        for r in 0..n {
+            for ch in 0..c {
+                let row = self.span(ch, y + r, x, n);
+                for (t, v) in row.iter().enumerate() {
+                    out[(r * n + t) * c + ch] = *v;
+                }
+            }
+        }
+    }
+}
+
+/// Approximate nearest squared distances of the `queries` patches (indices into `q`)
+/// to the database `db` (module `approximate_nearest_patch`).
+fn approximate_ssd(
+    q: &PatchGrid,
+    queries: &[usize],
+    db: &PatchGrid,
+    options: &ApproximateSearchOptions,
+) -> Result<Vec<f32>, EvalError> {
+    let index = PatchIndex::build(db, options).map_err(|_| EvalError::InvalidOption {
+        name: "approximate",
+        value: format!("{options:?}"),
+        reason: "the patch PCA failed (constant or degenerate patches?)",
+    })?;
+    let dim = q.dim();
+    Ok(queries
+        .par_chunks(256)
+        .flat_map_iter(|chunk| {
+            let mut buf = vec![0f32; dim];
+            let mut scratch = vec![0f32; dim];
+            chunk
+                .iter()
+                .map(|&i| {
+                    q.fill(i, &mut buf);
+                    index.nearest(&buf, &mut scratch).0
+                })
+                .collect::<Vec<f32>>()
+        })
+        .collect())
+}
+
+/// Indices of the patches of `g` on a regular sub-grid of step `stride`.
+fn strided(g: &PatchGrid, stride: usize) -> Vec<usize> {
+    let s = stride.max(1);
+    (0..g.rows)
+        .step_by(s)
+        .flat_map(|y| (0..g.cols).step_by(s).map(move |x| y * g.cols + x))
+        .collect()
 }
 
 /// Running minima and scratch rows of one scanning task.
@@ -418,8 +491,14 @@ pub struct PatchDistanceReport {
     /// Database patches searched.
     pub candidates: usize,
     pub patch_size: usize,
-    /// Patch pairs compared (`queries · candidates`).
+    /// Patch pairs compared (`queries · candidates` for the exact scan; at most
+    /// `queries · (max_checks + rerank)` for the approximate search).
     pub pairs_compared: u64,
+    /// `"exact"` or `"approximate"` (an upper bound of the exact values; see
+    /// `docs/first-hour.md` for the measured gap).
+    pub search: String,
+    /// Step of the query sub-grid (1 = every patch).
+    pub query_stride: usize,
 }
 
 pub(crate) fn summarize(
@@ -445,7 +524,25 @@ pub(crate) fn summarize(
         candidates,
         patch_size: n,
         pairs_compared: dists.len() as u64 * candidates as u64,
+        search: "exact".into(),
+        query_stride: 1,
     }
+}
+
+fn approximate_report(
+    dists: &[f32],
+    dim: usize,
+    candidates: usize,
+    n: usize,
+    stride: usize,
+    options: &ApproximateSearchOptions,
+) -> PatchDistanceReport {
+    let mut r = summarize(dists, dim, candidates, n);
+    r.search = "approximate".into();
+    r.query_stride = stride;
+    r.pairs_compared =
+        dists.len() as u64 * candidates.min(options.max_checks + options.rerank) as u64;
+    r
 }
 
 /// The two patch grids of a comparison, checked.
@@ -462,7 +559,7 @@ fn grids(
     let out = PatchGrid::new(output, options.patch_size, false, "output")?;
     let ex = PatchGrid::new(exemplar, options.patch_size, options.wrap_exemplar, "exemplar")?;
     let pairs = out.count() as u64 * ex.count() as u64;
-    if pairs > options.max_pairs {
+    if options.approximate.is_none() && pairs > options.max_pairs {
         return Err(EvalError::TooLarge { what, pairs, limit: options.max_pairs });
     }
     Ok((out, ex))
@@ -476,8 +573,18 @@ pub fn coherence_and_completeness(
     options: &PatchDistanceOptions,
 ) -> Result<(PatchDistanceReport, PatchDistanceReport), EvalError> {
     let (out, ex) = grids(output, exemplar, options, "coherence/completeness")?;
-    let (to_ex, to_out) = nearest_patch_ssd(&out, &ex, true, true);
     let n = options.patch_size;
+    if let Some(a) = &options.approximate {
+        let qs = strided(&out, a.query_stride);
+        let to_ex = approximate_ssd(&out, &qs, &ex, a)?;
+        let all_ex: Vec<usize> = (0..ex.count()).collect();
+        let to_out = approximate_ssd(&ex, &all_ex, &out, a)?;
+        return Ok((
+            approximate_report(&to_ex, out.dim(), ex.count(), n, a.query_stride, a),
+            approximate_report(&to_out, ex.dim(), out.count(), n, 1, a),
+        ));
+    }
+    let (to_ex, to_out) = nearest_patch_ssd(&out, &ex, true, true);
     Ok((summarize(&to_ex, out.dim(), ex.count(), n), summarize(&to_out, ex.dim(), out.count(), n)))
 }
 
@@ -488,6 +595,24 @@ pub(crate) fn coherence_distances(
     options: &PatchDistanceOptions,
 ) -> Result<(PatchDistanceReport, Vec<f32>, usize, usize), EvalError> {
     let (out, ex) = grids(output, exemplar, options, "coherence")?;
+    if let Some(a) = &options.approximate {
+        let qs = strided(&out, a.query_stride);
+        let to_ex = approximate_ssd(&out, &qs, &ex, a)?;
+        let report = approximate_report(
+            &to_ex,
+            out.dim(),
+            ex.count(),
+            options.patch_size,
+            a.query_stride,
+            a,
+        );
+        return Ok((
+            report,
+            to_ex,
+            out.cols.div_ceil(a.query_stride.max(1)),
+            out.rows.div_ceil(a.query_stride.max(1)),
+        ));
+    }
     let (to_ex, _) = nearest_patch_ssd(&out, &ex, true, false);
     let report = summarize(&to_ex, out.dim(), ex.count(), options.patch_size);
     Ok((report, to_ex, out.cols, out.rows))
@@ -500,6 +625,11 @@ pub(crate) fn completeness_distances(
     options: &PatchDistanceOptions,
 ) -> Result<PatchDistanceReport, EvalError> {
     let (out, ex) = grids(output, exemplar, options, "completeness")?;
+    if let Some(a) = &options.approximate {
+        let all_ex: Vec<usize> = (0..ex.count()).collect();
+        let to_out = approximate_ssd(&ex, &all_ex, &out, a)?;
+        return Ok(approximate_report(&to_out, ex.dim(), out.count(), options.patch_size, 1, a));
+    }
     let (_, to_out) = nearest_patch_ssd(&out, &ex, false, true);
     Ok(summarize(&to_out, ex.dim(), out.count(), options.patch_size))
 }

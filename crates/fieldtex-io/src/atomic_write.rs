@@ -13,11 +13,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// Writes `bytes` to `path` atomically (temporary file, fsync, rename).
+/// Writes `bytes` to `path` atomically (temporary file, fsync, rename). Refuses a path
+/// that is a file read on this thread ([`crate::ensure_not_read`]).
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
     let file_name = path
         .file_name()
         .ok_or_else(|| IoError::invalid(path, "the output path has no file name"))?;
+    crate::ensure_not_read(path)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),

@@ -22,7 +22,7 @@ pub enum IoError {
     },
 
     /// The file has no bytes at all.
-    #[error("{file}: the file is empty (0 bytes). Re-export the mesh or pick another file.")]
+    #[error("{file}: the file is empty (0 bytes). Re-export it or pick another file.")]
     EmptyFile { file: String },
 
     /// Neither the content nor the extension identifies a supported format.
@@ -79,6 +79,28 @@ pub enum IoError {
     /// A writer was handed data it cannot write (caller's data, not a file problem).
     #[error("{file}: cannot write: {message}")]
     InvalidData { file: String, message: String },
+
+    /// The path is not a regular file (a FIFO, a device, a socket, a directory).
+    #[error(
+        "{file}: not a regular file ({what}); fieldtex reads only regular files. \
+         Copy the data into a file and pass that."
+    )]
+    NotRegularFile { file: String, what: String },
+
+    /// The file is larger than the cap for its kind.
+    #[error(
+        "{file}: the file is {size} bytes, more than the {max} bytes fieldtex reads for this \
+         kind of input. Use a smaller file."
+    )]
+    TooLarge { file: String, size: u64, max: u64 },
+
+    /// A file named inside an asset (OBJ `mtllib`/`map_Kd`, glTF URI) is outside the
+    /// asset's folder.
+    #[error(
+        "{file}: the {what} {reference:?} is refused: {why}. Only files inside the asset's \
+         folder are read; copy the file next to the asset and name it relatively."
+    )]
+    OutsideAssetFolder { file: String, what: String, reference: String, why: String },
 
     /// An output path is one of the inputs; inputs are never overwritten.
     #[error(

@@ -81,7 +81,7 @@ pub fn read_gltf_bytes(
                     "refers to a GLB BIN chunk that is missing",
                 )
             })?,
-            gltf::buffer::Source::Uri(uri) => load_uri(uri, base, name)?,
+            gltf::buffer::Source::Uri(uri) => load_uri(uri, base, name, Some(b.length() as u64))?,
         };
         if data.len() < b.length() {
             return Err(IoError::Truncated {
@@ -577,7 +577,7 @@ fn load_image(
             })?;
         crate::read_image_bytes(bytes, &label)
     } else if let Some(uri) = &json.uri {
-        let bytes = load_uri(uri, base, name)?;
+        let bytes = load_uri(uri, base, name, None)?;
         crate::read_image_bytes(&bytes, &label)
     } else {
         Err(IoError::parse(name, format!("image {index}"), "has neither a uri nor a bufferView"))

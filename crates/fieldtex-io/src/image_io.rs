@@ -24,7 +24,7 @@ pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 
 /// Reads a PNG or JPEG file (format from content, not extension).
 pub fn read_image(path: &Path) -> Result<Image, IoError> {
-    let bytes = std::fs::read(path).map_err(|e| IoError::os(path, "read the image", e))?;
+    let bytes = crate::read_input_file(path, crate::InputKind::Image, "read the image")?;
     read_image_bytes(&bytes, &path.display().to_string())
 }
 
@@ -32,7 +32,7 @@ pub fn read_image(path: &Path) -> Result<Image, IoError> {
 pub fn read_image_bytes(bytes: &[u8], name: &str) -> Result<Image, IoError> {
     let img_err = |m: String| IoError::Image { file: name.to_string(), message: m };
     if bytes.is_empty() {
-        return Err(IoError::EmptyFile { file: name.to_string() });
+        return Err(img_err("the file is empty (0 bytes)".into()));
     }
     let reader = || {
         ImageReader::new(Cursor::new(bytes))
@@ -142,6 +142,44 @@ pub fn write_png(path: &Path, image: &Image) -> Result<(), IoError> {
     atomic_write(path, &bytes)
 }
 
+/// Writes an image in the format named by the extension of `path`: `.png` (8-bit, as
+/// [`write_png`]) or `.jpg`/`.jpeg` (baseline JPEG, quality 92, alpha dropped); any
+/// other extension is refused with a message naming the supported ones.
+pub fn write_image(path: &Path, image: &Image) -> Result<(), IoError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => write_png(path, image),
+        Some("jpg" | "jpeg") => {
+            let bytes = encode_jpeg(image, 92).map_err(|e| rename_file(e, path))?;
+            atomic_write(path, &bytes)
+        }
+        _ => {
+            Err(IoError::invalid(path, "unknown image format: use a .png, .jpg or .jpeg extension"))
+        }
+    }
+}
+
+/// Encodes an image as a baseline 8-bit RGB JPEG of the given quality (1–100).
+pub fn encode_jpeg(image: &Image, quality: u8) -> Result<Vec<u8>, IoError> {
+    let name = "<jpeg encoder>";
+    if image.width == 0 || image.height == 0 || image.pixels.len() != image.width * image.height {
+        return Err(IoError::InvalidData {
+            file: name.into(),
+            message: format!("image is {} × {}", image.width, image.height),
+        });
+    }
+    let data: Vec<u8> = image
+        .pixels
+        .iter()
+        .flat_map(|p| [quantize8(p[0]), quantize8(p[1]), quantize8(p[2])])
+        .collect();
+    let mut out = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, quality.clamp(1, 100))
+        .write_image(&data, image.width as u32, image.height as u32, image::ExtendedColorType::Rgb8)
+        .map_err(|e| IoError::Image { file: name.into(), message: e.to_string() })?;
+    Ok(out)
+}
+
 /// Writes a 16-bit single-channel PNG from `width * height` values in `[0, 1]` (row-major,
 /// top row first; clamped, NaN → 0) atomically.
 pub fn write_png_gray16(
@@ -203,7 +241,10 @@ mod tests {
 
     #[test]
     fn corrupt_and_empty_images_are_errors() {
-        assert!(matches!(read_image_bytes(b"", "e.png"), Err(IoError::EmptyFile { .. })));
+        // Regression: an empty .png was told to "re-export the mesh".
+        let e = read_image_bytes(b"", "e.png").unwrap_err();
+        assert!(matches!(e, IoError::Image { .. }), "{e:?}");
+        assert!(!e.to_string().contains("mesh"), "{e}");
         let mut png = encode_png(&Image::new(4, 4, [0.5; 4])).unwrap();
         png.truncate(png.len() / 2);
         let e = read_image_bytes(&png, "t.png").unwrap_err().to_string();

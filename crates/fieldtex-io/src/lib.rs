@@ -22,12 +22,14 @@ mod error;
 mod glb_writer;
 mod gltf_reader;
 mod image_io;
+mod input_files;
 mod mesh_checks;
 mod mesh_format;
 mod mtl_reader;
 mod npy;
 mod obj_reader;
 mod obj_writer;
+mod output_dir;
 mod ply_reader;
 mod ply_writer;
 mod polyline_reader;
@@ -38,12 +40,16 @@ pub use atomic_write::{atomic_write, ensure_not_input};
 pub use error::{IoError, MEMORY_NAME};
 pub use glb_writer::{GlbOptions, encode_glb, write_glb};
 pub use image_io::{
-    MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, encode_png, read_image, read_image_bytes, write_png,
-    write_png_gray16,
+    MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, encode_jpeg, encode_png, read_image, read_image_bytes,
+    write_image, write_png, write_png_gray16,
+};
+pub use input_files::{
+    InputKind, ensure_not_read, files_read, forget_files_read, read_input_file, resolve_confined,
 };
 pub use mesh_format::{MeshFormat, sniff_mesh_format};
 pub use npy::{decode_npy_f32, encode_npy_f32, read_npy_f32, write_npy_f32};
 pub use obj_writer::{write_obj, write_obj_polylines};
+pub use output_dir::OutputDir;
 pub use ply_writer::{encode_ply, write_ply};
 pub use polyline_reader::{parse_obj_polylines, read_obj_polylines};
 pub use read_mesh::{LoadedMesh, read_mesh, read_mesh_bytes};

@@ -48,7 +48,7 @@ pub fn write_npy_f32(path: &Path, shape: &[usize], data: &[f32]) -> Result<(), I
 
 /// Reads a `.npy` file of little-endian `float32` in C order; returns `(shape, data)`.
 pub fn read_npy_f32(path: &Path) -> Result<(Vec<usize>, Vec<f32>), IoError> {
-    let bytes = std::fs::read(path).map_err(|e| IoError::os(path, "read the array", e))?;
+    let bytes = crate::read_input_file(path, crate::InputKind::Array, "read the array")?;
     decode_npy_f32(&bytes, &path.display().to_string())
 }
 

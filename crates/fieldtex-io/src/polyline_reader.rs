@@ -4,17 +4,10 @@
 use crate::IoError;
 use std::path::Path;
 
-/// Largest accepted file (curves files are small; this bounds memory).
-const MAX_BYTES: u64 = 1 << 30;
-
 /// Reads the polylines of an OBJ file: one `Vec` of points per `l` element
 /// (1-based or negative relative indices, as in OBJ).
 pub fn read_obj_polylines(path: &Path) -> Result<Vec<Vec<[f64; 3]>>, IoError> {
-    let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, "read the curves", e))?;
-    if meta.len() > MAX_BYTES {
-        return Err(IoError::invalid(path, "the curves file is larger than 1 GiB; split it"));
-    }
-    let bytes = std::fs::read(path).map_err(|e| IoError::os(path, "read the curves", e))?;
+    let bytes = crate::read_input_file(path, crate::InputKind::Text, "read the curves")?;
     parse_obj_polylines(&bytes, &path.display().to_string())
 }
 

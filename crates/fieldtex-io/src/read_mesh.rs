@@ -25,7 +25,7 @@ pub struct LoadedMesh {
 /// the extension second; a mismatch is a warning. Textures named by the file are looked
 /// up relative to it; a missing one is a warning, not an error.
 pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
-    let bytes = std::fs::read(path).map_err(|e| IoError::os(path, "read the mesh", e))?;
+    let bytes = crate::read_input_file(path, crate::InputKind::Mesh, "read the mesh")?;
     let base = path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p });
     read_impl(&bytes, MeshFormat::from_extension(path), base, &path.display().to_string())
 }
@@ -112,15 +112,24 @@ fn obj_texture(
     let mut materials: Vec<(String, Option<String>, std::path::PathBuf)> = Vec::new();
     for lib in &refs.mtllibs {
         // A name with spaces is one file if it exists, otherwise several files.
-        let candidates: Vec<String> = if base.join(lib).is_file() {
+        let candidates: Vec<String> = if base.join(lib.replace('\\', "/")).is_file() {
             vec![lib.clone()]
         } else {
             lib.split_whitespace().map(str::to_string).collect()
         };
         for c in candidates {
-            let p = base.join(c.replace('\\', "/"));
-            match std::fs::read(&p) {
-                Ok(b) => {
+            let read = crate::resolve_confined(base, &c, name, "material library (mtllib)")
+                .and_then(|p| {
+                    let b = crate::read_input_file(
+                        &p,
+                        crate::InputKind::Text,
+                        "read the material library",
+                    )?;
+                    Ok((p, b))
+                });
+            match read {
+                Ok((p, b)) => {
+                    // Textures are named relative to the MTL file's folder.
                     let dir = p.parent().unwrap_or(base).to_path_buf();
                     materials.extend(
                         crate::mtl_reader::parse_mtl(&b)
@@ -130,10 +139,7 @@ fn obj_texture(
                 }
                 Err(e) => warnings.push(Warning::new(
                     "mtl-missing",
-                    format!(
-                        "{name}: material library {} could not be read ({e}); no texture loaded",
-                        p.display()
-                    ),
+                    format!("material library {c:?} not read ({e}); no texture loaded"),
                 )),
             }
         }
@@ -158,7 +164,16 @@ fn obj_texture(
         }
         used_with_tex.first().copied()
     }?;
-    load_texture(chosen.1.as_deref()?, Some(&chosen.2), name, warnings)
+    // Confine the texture to the OBJ's folder: name it relative to that folder.
+    let root = std::fs::canonicalize(base).ok()?;
+    let rel_dir = chosen.2.strip_prefix(&root).unwrap_or(Path::new(""));
+    let file = chosen.1.as_deref()?;
+    let reference = if rel_dir.as_os_str().is_empty() {
+        file.to_string()
+    } else {
+        format!("{}/{file}", rel_dir.display())
+    };
+    load_texture(&reference, Some(base), name, warnings)
 }
 
 /// Loads `file` relative to `base`; failure is a `texture-not-loaded` warning.
@@ -175,7 +190,9 @@ fn load_texture(
         ));
         return None;
     };
-    match crate::read_image(&base.join(file)) {
+    let image =
+        crate::resolve_confined(base, file, name, "texture").and_then(|p| crate::read_image(&p));
+    match image {
         Ok(im) => Some(im),
         Err(e) => {
             warnings.push(Warning::new(

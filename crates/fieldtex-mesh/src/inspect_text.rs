@@ -8,8 +8,22 @@ fn list<T: std::fmt::Debug>(e: &Examples<T>) -> String {
         return String::new();
     }
     let items: Vec<String> = e.examples.iter().map(|x| format!("{x:?}")).collect();
-    let more = if e.count > e.examples.len() { ", …" } else { "" };
-    format!(" (e.g. {}{more})", items.join(", "))
+    format!(" (e.g. {})", bounded(items, e.count))
+}
+
+/// Items shown in plain-text lists; the rest are counted ("… and K more").
+pub const LISTED_ITEMS: usize = 10;
+
+/// The first [`LISTED_ITEMS`] of `items` joined by commas, then "… and K more" when
+/// `total` (the full count) is larger than what is shown.
+fn bounded(mut items: Vec<String>, total: usize) -> String {
+    items.truncate(LISTED_ITEMS);
+    let shown = items.len();
+    let mut s = items.join(", ");
+    if total > shown {
+        s.push_str(&format!(", … and {} more", total - shown));
+    }
+    s
 }
 
 impl InspectReport {
@@ -42,12 +56,22 @@ impl InspectReport {
             format!("{} triangles repeat a vertex{}", e.count, list(e)),
         );
         let e = &self.non_manifold_edges;
-        let ex: Vec<String> =
-            e.examples.iter().map(|x| format!("{:?}→{:?}", x.vertices, x.triangles)).collect();
+        let ex: Vec<String> = e
+            .examples
+            .iter()
+            .map(|x| {
+                let t: Vec<String> = x.triangles.iter().map(|t| t.to_string()).collect();
+                format!("{:?}→[{}]", x.vertices, bounded(t, x.triangles.len()))
+            })
+            .collect();
         add(
             "non-manifold-edges",
             e.count,
-            format!("{} edges shared by more than two triangles ({})", e.count, ex.join(", ")),
+            format!(
+                "{} edges shared by more than two triangles ({})",
+                e.count,
+                bounded(ex, e.count)
+            ),
         );
         let e = &self.non_manifold_vertices;
         let ex: Vec<String> =
@@ -55,7 +79,11 @@ impl InspectReport {
         add(
             "non-manifold-vertices",
             e.count,
-            format!("{} vertices joining separate fans of triangles ({})", e.count, ex.join(", ")),
+            format!(
+                "{} vertices joining separate fans of triangles ({})",
+                e.count,
+                bounded(ex, e.count)
+            ),
         );
         let e = &self.orientation.inconsistent_edges;
         add(
@@ -71,7 +99,11 @@ impl InspectReport {
         add(
             "non-orientable",
             n.len(),
-            format!("{} non-orientable components (Möbius-like): {:?}", n.len(), n),
+            format!(
+                "{} non-orientable components (Möbius-like): {}",
+                n.len(),
+                bounded(n.iter().map(|c| c.to_string()).collect(), n.len())
+            ),
         );
         let s = &self.shape;
         add(
@@ -173,7 +205,7 @@ impl InspectReport {
                 String::new()
             }
         ));
-        for c in &self.components.listed {
+        for c in self.components.listed.iter().take(LISTED_ITEMS) {
             let topo = match (c.genus, c.nonorientable_genus) {
                 (Some(g), _) => format!("genus {g}"),
                 (None, Some(k)) => format!("non-orientable, {k} cross-caps"),
@@ -184,10 +216,12 @@ impl InspectReport {
                 c.id, c.triangles, c.vertices, c.euler_characteristic, c.boundary_loops
             ));
         }
-        if self.components.listed.len() < self.components.count {
+        let shown = self.components.listed.len().min(LISTED_ITEMS);
+        if shown < self.components.count {
             out.push(format!(
-                "  … {} smaller components not listed",
-                self.components.count - self.components.listed.len()
+                "  … and {} more components (smaller; `inspect --json` lists up to {})",
+                self.components.count - shown,
+                self.components.listed.len()
             ));
         }
         if let Some(a) = self.shape.min_angle_deg {

@@ -113,6 +113,48 @@ pub fn torus(major: f64, minor: f64, nu: usize, nv: usize) -> TriMesh {
     TriMesh::new(positions, triangles)
 }
 
+/// The cube `[-1, 1]³` with each face an `n × n`-cell grid (`12 n²` triangles, split
+/// along alternating diagonals), vertices shared along the edges and corners, outward
+/// normals. Closed, genus 0, with twelve sharp 90° creases: the simplest shape whose
+/// features a texture should follow.
+pub fn cube(n: usize) -> TriMesh {
+    let n = n.max(1);
+    let mut index = std::collections::HashMap::new();
+    let mut positions = Vec::with_capacity(6 * n * n + 2);
+    let mut triangles = Vec::with_capacity(12 * n * n);
+    let coord = |k: usize| 2.0 * k as f64 / n as f64 - 1.0;
+    for axis in 0..3 {
+        for side in [0usize, n] {
+            // Tangent axes with e_u × e_v = e_axis; the far side (+) keeps that order.
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut id = |i: usize, j: usize| -> u32 {
+                let mut lattice = [0usize; 3];
+                lattice[axis] = side;
+                lattice[u] = i;
+                lattice[v] = j;
+                *index.entry(lattice).or_insert_with(|| {
+                    positions.push(lattice.map(coord));
+                    (positions.len() - 1) as u32
+                })
+            };
+            for j in 0..n {
+                for i in 0..n {
+                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                    let pair = if (i + j) % 2 == 0 {
+                        [[a, b, c], [a, c, d]]
+                    } else {
+                        [[a, b, d], [b, c, d]]
+                    };
+                    for t in pair {
+                        triangles.push(if side == n { t } else { [t[0], t[2], t[1]] });
+                    }
+                }
+            }
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
 /// Splits every triangle into four through its edge midpoints (1→4 subdivision,
 /// positions only; attributes are dropped). Shared edges get one shared midpoint, so
 /// the result keeps the input's topology.
@@ -152,5 +194,29 @@ mod tests {
         assert_eq!(icosphere(2).n_triangles(), 320);
         assert_eq!(euler(&torus(2.0, 0.5, 24, 12)), 0);
         assert_eq!(euler(&grid(5, 4, 1.0, 1.0)), 1);
+        let c = cube(3);
+        assert_eq!((euler(&c), c.n_triangles(), c.n_vertices()), (2, 108, 56));
+    }
+
+    #[test]
+    fn cube_normals_point_outward() {
+        let c = cube(2);
+        for t in &c.triangles {
+            let [a, b, d] = t.map(|k| c.positions[k as usize]);
+            let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let e2 = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+            let nrm = [
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ];
+            let centre = [
+                (a[0] + b[0] + d[0]) / 3.0,
+                (a[1] + b[1] + d[1]) / 3.0,
+                (a[2] + b[2] + d[2]) / 3.0,
+            ];
+            let dot: f64 = (0..3).map(|k| nrm[k] * centre[k]).sum();
+            assert!(dot > 0.0, "inward triangle {t:?}");
+        }
     }
 }

@@ -24,8 +24,8 @@ mod report;
 
 pub use error::{Error, Result};
 pub use fieldtex_core::{Image, NoProgress, Progress, Warning};
-pub use outputs::write_text;
-pub use pipelines::align::{AlignOptions, align};
+pub use outputs::{guard_output, write_text};
+pub use pipelines::align::{AlignOptions, align, align_in_memory};
 pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
 pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};

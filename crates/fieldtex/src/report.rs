@@ -24,6 +24,9 @@ pub struct Report {
     pub warnings: Vec<Warning>,
     /// Plain statements of what is a substitute or not implemented in this run.
     pub notes: Vec<String>,
+    /// The files of this run in its output folder (all from this run; see `outputs.rs`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub outputs: Vec<String>,
 }
 
 impl Report {
@@ -40,6 +43,7 @@ impl Report {
             metrics: Value::Object(Default::default()),
             warnings: Vec::new(),
             notes: Vec::new(),
+            outputs: Vec::new(),
         }
     }
 

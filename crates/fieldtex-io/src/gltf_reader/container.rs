@@ -58,8 +58,15 @@ pub(crate) fn split_glb<'a>(
 }
 
 /// Resolves a glTF URI: `data:` URIs are decoded; anything else must be a relative path
-/// next to the glTF file (percent-escapes decoded). `base` is `None` for in-memory data.
-pub(crate) fn load_uri(uri: &str, base: Option<&Path>, name: &str) -> Result<Vec<u8>, IoError> {
+/// inside the glTF file's folder (percent-escapes decoded; [`crate::resolve_confined`]),
+/// read up to `max_len` bytes (a buffer's `byteLength`). `base` is `None` for in-memory
+/// data.
+pub(crate) fn load_uri(
+    uri: &str,
+    base: Option<&Path>,
+    name: &str,
+    max_len: Option<u64>,
+) -> Result<Vec<u8>, IoError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (meta, data) = rest.split_once(',').ok_or_else(|| {
             IoError::parse(name, "data URI", "no `,` separating the header from the data")
@@ -73,12 +80,6 @@ pub(crate) fn load_uri(uri: &str, base: Option<&Path>, name: &str) -> Result<Vec
         return decode_base64(data.as_bytes())
             .ok_or_else(|| IoError::parse(name, "data URI", "invalid base64 data"));
     }
-    if uri.contains("://") || uri.starts_with('/') || uri.starts_with('\\') {
-        return Err(IoError::Unsupported {
-            file: name.to_string(),
-            what: format!("the URI {uri:?} (only relative file names and data URIs are read)"),
-        });
-    }
     let Some(base) = base else {
         return Err(IoError::Unsupported {
             file: name.to_string(),
@@ -88,8 +89,20 @@ pub(crate) fn load_uri(uri: &str, base: Option<&Path>, name: &str) -> Result<Vec
         });
     };
     let rel = percent_decode(uri);
-    let path = base.join(rel);
-    std::fs::read(&path).map_err(|e| IoError::os(&path, "read a file the glTF refers to", e))
+    let path = crate::resolve_confined(base, &rel, name, "glTF URI")?;
+    // A buffer is read up to its declared byteLength only; images up to the image cap.
+    match max_len {
+        Some(len) => crate::input_files::read_input_prefix(
+            &path,
+            len,
+            crate::InputKind::Mesh,
+            "read a file the glTF refers to",
+            true,
+        ),
+        None => {
+            crate::read_input_file(&path, crate::InputKind::Image, "read a file the glTF refers to")
+        }
+    }
 }
 
 fn percent_decode(s: &str) -> String {

@@ -14,7 +14,7 @@
 //! principal curvature directions where no curve constrains the field (a warning says
 //! so); users can pass their own curves.
 
-use crate::outputs::{prepare_out_dir, write_report};
+use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, Warning};
@@ -253,6 +253,36 @@ fn texel_of(mesh: &TriMesh, size: usize, triangle: u32, bary: [f64; 3]) -> Optio
 
 /// Runs `fieldtex align` into `out_dir` (module docs).
 pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) -> Result<Report> {
+    begin_command();
+    align_impl(out_dir, options, None, None, progress)
+}
+
+/// [`align`] on a mesh and an exemplar already in memory (the demo's procedural inputs);
+/// `options.mesh` and `options.exemplar` only name them in the report and in messages.
+/// Same algorithm, outputs and report as [`align`].
+pub fn align_in_memory(
+    out_dir: &Path,
+    options: &AlignOptions,
+    mesh: &TriMesh,
+    exemplar: &Image,
+    progress: &dyn Progress,
+) -> Result<Report> {
+    begin_command();
+    align_impl(out_dir, options, Some((mesh, exemplar)), None, progress)
+}
+
+/// Called with the staging folder and the report just before the outputs are moved into
+/// place: a caller (the demo) adds files and report entries to the same output set.
+pub(crate) type ExtraOutputs<'a> = &'a mut dyn FnMut(&Path, &mut Report) -> Result<()>;
+
+/// The align pipeline on files (`given` = `None`) or in-memory inputs.
+pub(crate) fn align_impl(
+    out_dir: &Path,
+    options: &AlignOptions,
+    given: Option<(&TriMesh, &Image)>,
+    extra: Option<ExtraOutputs<'_>>,
+    progress: &dyn Progress,
+) -> Result<Report> {
     let aopts = atlas_options(options.size, 4)?;
     if !(options.scale.is_finite() && options.scale > 0.0 && options.scale <= 64.0) {
         return Err(Error::bad_input(
@@ -266,9 +296,22 @@ pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) ->
     }
     let mut report =
         Report::new("align", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
+    let (loaded, exemplar) = match given {
+        None => {
+            let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
+            (loaded, fieldtex_io::read_image(&options.exemplar)?)
+        }
+        Some((mesh, exemplar)) => (
+            fieldtex_io::LoadedMesh {
+                mesh: mesh.clone(),
+                base_color: None,
+                warnings: Vec::new(),
+                format: fieldtex_io::MeshFormat::Obj,
+            },
+            exemplar.clone(),
+        ),
+    };
     report.warnings.extend(loaded.warnings.iter().cloned());
-    let exemplar = fieldtex_io::read_image(&options.exemplar)?;
     let min_side = TexOptOptions::default().patch_sizes.into_iter().max().unwrap_or(8);
     if exemplar.width < min_side || exemplar.height < min_side {
         return Err(Error::bad_input(
@@ -279,19 +322,20 @@ pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) ->
             ),
         ));
     }
-    prepare_out_dir(out_dir)?;
     for name in ["model.glb", "preview.png", "report.json", "curves.obj", "field.ply"] {
         fieldtex_io::ensure_not_input(&out_dir.join(name), &inputs)?;
     }
+    let out = begin_outputs(
+        out_dir,
+        &["model.glb", "preview.png", "report.json", "curves.obj", "field.ply"],
+    )?;
+    let stage = out.staging();
     // 1. Repair once; everything below uses this mesh (the atlas keeps its triangles).
     let repaired = report.time("repair", || {
         fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default())
     });
     for c in &repaired.changes {
-        report.warnings.push(Warning::new(
-            format!("repair:{}", c.code),
-            format!("{} ({})", c.message, c.count),
-        ));
+        report.warnings.push(Warning::new(format!("repair:{}", c.code), c.message.clone()));
     }
     report.warnings.extend(repaired.warnings.iter().cloned());
     let mesh = repaired.mesh;
@@ -495,24 +539,27 @@ pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) ->
     })?;
     report.metric("orientation_error", orientation);
     // 7. Outputs.
-    report.time("write", || super::write_model(out_dir, &atlas.mesh, Some(&texture)))?;
+    report.time("write", || super::write_model(stage, &atlas.mesh, Some(&texture)))?;
     let preview = report.time("preview", || {
         preview_with_curves(&atlas.mesh, &texture, options.draw_curves.then_some(&curves[..]), 800)
     });
-    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     if options.keep {
-        fieldtex_io::write_obj_polylines(&out_dir.join("curves.obj"), &curves)?;
+        fieldtex_io::write_obj_polylines(&stage.join("curves.obj"), &curves)?;
         let mut ply_mesh = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
         ply_mesh.vertex_normals = Some(normals.clone());
         let comp = |k: usize| -> Vec<f32> { field.iter().map(|v| v[k] as f32).collect() };
         let (fx, fy, fz) = (comp(0), comp(1), comp(2));
         fieldtex_io::write_ply(
-            &out_dir.join("field.ply"),
+            &stage.join("field.ply"),
             &ply_mesh,
             &[("fx", &fx), ("fy", &fy), ("fz", &fz)],
             true,
         )?;
     }
-    write_report(out_dir, &report)?;
+    if let Some(extra) = extra {
+        extra(stage, &mut report)?;
+    }
+    commit_outputs(out, &mut report)?;
     Ok(report)
 }

@@ -1,7 +1,7 @@
 //! `fieldtex atlas`: segment, flatten, pack; write the UV-mapped model with a checker
 //! texture (so distortion is visible), a preview and the atlas statistics.
 
-use crate::outputs::{prepare_out_dir, write_report};
+use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_param::{Atlas, AtlasOptions, build_atlas};
@@ -70,10 +70,9 @@ pub(crate) fn repaired_atlas(
     let repaired = report
         .time("repair", || fieldtex_mesh::repair(mesh, &fieldtex_mesh::RepairOptions::default()));
     for c in &repaired.changes {
-        report.warnings.push(fieldtex_core::Warning::new(
-            format!("repair:{}", c.code),
-            format!("{} ({})", c.message, c.count),
-        ));
+        report
+            .warnings
+            .push(fieldtex_core::Warning::new(format!("repair:{}", c.code), c.message.clone()));
     }
     report.warnings.extend(repaired.warnings.iter().cloned());
     if repaired.mesh.triangles.is_empty() {
@@ -99,6 +98,7 @@ pub fn atlas_file(
     options: &AtlasCommandOptions,
     progress: &dyn Progress,
 ) -> Result<Report> {
+    begin_command();
     let aopts = atlas_options(options.size, options.gutter)?;
     let mut report =
         Report::new("atlas", options.seed, serde_json::to_value(options).unwrap_or_default());
@@ -109,14 +109,15 @@ pub fn atlas_file(
         "vertices": loaded.mesh.n_vertices(),
         "triangles": loaded.mesh.n_triangles(),
     });
-    prepare_out_dir(out_dir)?;
+    let out = begin_outputs(out_dir, &["model.glb", "preview.png", "report.json"])?;
+    let stage = out.staging();
     let atlas = repaired_atlas(&loaded.mesh, Some(mesh_path), &aopts, &mut report, progress)?;
     let checker = uv_checker(options.size.min(2048), 32);
-    report.time("write", || super::write_model(out_dir, &atlas.mesh, Some(&checker)))?;
+    report.time("write", || super::write_model(stage, &atlas.mesh, Some(&checker)))?;
     let preview =
         report.time("preview", || super::render::preview(&atlas.mesh, Some(&checker), 800, None));
-    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     report.metric("atlas", atlas.stats);
-    write_report(out_dir, &report)?;
+    commit_outputs(out, &mut report)?;
     Ok(report)
 }

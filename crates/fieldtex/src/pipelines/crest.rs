@@ -38,6 +38,7 @@ pub fn crest_file(
     out: &Path,
     options: &CrestCommandOptions,
 ) -> Result<CrestSummary> {
+    crate::outputs::begin_command();
     fieldtex_io::ensure_not_input(out, &[mesh_path])?;
     let mut copts = CrestOptions::default();
     if let Some(l) = &options.levels {
@@ -47,6 +48,11 @@ pub fn crest_file(
         copts.levels = l.clone();
     }
     let loaded = fieldtex_io::read_mesh(mesh_path)?;
+    // Refuse before any work when an output is the mesh or a file it names.
+    crate::outputs::guard_output(out)?;
+    if let Some(p) = &options.preview {
+        crate::outputs::guard_output(p)?;
+    }
     let repaired = fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default());
     if repaired.mesh.triangles.is_empty() {
         return Err(Error::bad_input(Some(mesh_path), "no usable triangle is left after repair"));

@@ -1,130 +1,158 @@
 //! `fieldtex demo`: the main job on built-in inputs (no files needed).
 //!
-//! Mesh: a bumpy sphere (an icosphere displaced by a smooth angular pattern), made
-//! procedurally. Exemplar: procedural brick-like stripes. The mesh is atlased, the
-//! exemplar is mapped through the atlas at a uniform texel density and baked; the
-//! model, a preview and a report are written.
+//! Shape: a cube (`fieldtex_mesh::primitives::cube`), the simplest shape with crisp
+//! features: twelve sharp creases. Exemplar: procedural stripes (two colours with soft
+//! edges, a little seeded noise), generated in code. Both go through the real `align`
+//! pipeline ([`crate::align_in_memory`], paper A): crease/crest curves → greedy curve
+//! orientation and harmonic field (§4) → atlas → texture optimisation on the surface
+//! with feature-to-feature alignment (§5) → `model.glb`, `preview.png`, `report.json`
+//! with align's metrics (feature coverage, surface orientation error). The stripes run
+//! along the cube's edges and bend smoothly across each face, which a chart-space tiling
+//! cannot do.
 //!
-//! What this demo does NOT do yet: field-guided synthesis on the surface (issues for
-//! `orient`/`align`). The texture is the exemplar tiled in chart space, so it shows
-//! seams at chart borders; the report says so in `notes`.
+//! Beside it, with [`DemoOptions::orient`] (default on), the `orient` pipeline (paper D)
+//! synthesises the same stripes in the plane along the built-in "whorl" fingerprint
+//! preset: `orient.png` (with the designed singularities marked) and its metrics under
+//! `orient` in the report.
 
-use crate::outputs::{prepare_out_dir, write_report};
-use crate::pipelines::atlas::{atlas_options, repaired_atlas};
-use crate::{Progress, Report, Result};
+use crate::pipelines::orient::{FieldSource, OrientOptions};
+use crate::{AlignOptions, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_mesh::TriMesh;
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Options of [`demo`].
 #[derive(Debug, Clone, Serialize)]
 pub struct DemoOptions {
     pub seed: u64,
-    /// Atlas resolution in texels. Default 1024.
+    /// Atlas resolution in texels of the aligned cube. Default 256.
     pub size: usize,
-    /// Subdivision level of the sphere (20·4^level triangles). Default 5.
-    pub level: usize,
-    /// Exemplar repeats per unit of surface length. Default 3.
-    pub tiles_per_unit: f64,
+    /// Grid cells per cube face side (`12·cells²` triangles). Default 12.
+    pub cells: usize,
+    /// Exemplar side in pixels. Default 64.
+    pub exemplar_size: usize,
+    /// Also run the `orient` whorl preset on the same stripes (`orient.png`). Default
+    /// true.
+    pub orient: bool,
+    /// Output side of the orient image in pixels. Default 256.
+    pub orient_size: usize,
 }
 
 impl Default for DemoOptions {
     fn default() -> Self {
-        Self { seed: 1, size: 1024, level: 5, tiles_per_unit: 3.0 }
+        Self { seed: 1, size: 256, cells: 12, exemplar_size: 64, orient: true, orient_size: 256 }
     }
 }
 
-/// The demo mesh: a unit icosphere with radius `1 + 0.12·bump(direction)`.
-pub fn demo_mesh(level: usize) -> TriMesh {
-    let mut m = fieldtex_mesh::primitives::icosphere(level);
-    for p in &mut m.positions {
-        let (x, y, z) = (p[0], p[1], p[2]);
-        let bump = (3.0 * x).sin() * (2.0 * y).cos() + 0.5 * (4.0 * z + x).sin();
-        let r = 1.0 + 0.12 * bump;
-        *p = [x * r, y * r, z * r];
-    }
-    m
+/// The demo mesh: the cube `[-1, 1]³` with `cells × cells` cells per face.
+pub fn demo_mesh(cells: usize) -> TriMesh {
+    fieldtex_mesh::primitives::cube(cells.clamp(2, 64))
 }
 
-/// The demo exemplar: `size²` staggered bricks with mortar and a little seeded noise.
+/// The demo exemplar: `size²` horizontal stripes (period `size / 4`, so the image
+/// tiles), alternating a warm and a cool colour with soft edges, plus seeded noise.
+/// The stripes run along the exemplar's x axis, the axis the pipelines steer.
 pub fn demo_exemplar(size: usize, seed: u64) -> Image {
+    let size = size.max(16);
     let mut im = Image::new(size, size, [0.0; 4]);
-    let rows = 4usize;
-    let cols = 2usize;
-    let bh = size as f64 / rows as f64;
-    let bw = size as f64 / cols as f64;
+    let period = size as f64 / 4.0;
+    let warm = [0.80, 0.42, 0.16];
+    let cool = [0.93, 0.88, 0.78];
     for y in 0..size {
+        // Smooth square wave in y: flat bands with short soft transitions.
+        let phase = (2.0 * std::f64::consts::PI * (y as f64 + 0.5) / period).sin();
+        let t = (0.5 + 0.5 * (3.0 * phase).tanh()) as f32;
         for x in 0..size {
-            let row = (y as f64 / bh).floor();
-            let shift = if !(row as usize).is_multiple_of(2) { 0.5 * bw } else { 0.0 };
-            let fx = ((x as f64 + shift) % bw) / bw;
-            let fy = (y as f64 % bh) / bh;
-            let mortar = fx < 0.06 || fy < 0.12;
-            let brick = ((x as f64 + shift) / bw).floor() as u64 * 31 + row as u64 * 17;
-            let tone =
-                0.85 + 0.15 * fieldtex_core::rng::hash_unit(seed, "demo-brick", brick) as f32;
-            let n = 0.06
-                * fieldtex_core::rng::hash_unit(seed, "demo-noise", (y * size + x) as u64) as f32;
-            let c = if mortar {
-                [0.78 + n, 0.76 + n, 0.72 + n, 1.0]
-            } else {
-                [0.62 * tone + n, 0.27 * tone + n, 0.18 * tone + n, 1.0]
-            };
-            im.set(x, y, c);
+            let n = 0.08
+                * (fieldtex_core::rng::hash_unit(seed, "demo-stripes", (y * size + x) as u64)
+                    as f32
+                    - 0.5);
+            let c: [f32; 3] = std::array::from_fn(|k| {
+                (warm[k] as f32 * t + cool[k] as f32 * (1.0 - t) + n).clamp(0.0, 1.0)
+            });
+            im.set(x, y, [c[0], c[1], c[2], 1.0]);
         }
     }
     im
 }
 
-/// Runs the demo into `out_dir`.
+/// Runs the demo into `out_dir` (module docs).
 pub fn demo(out_dir: &Path, options: &DemoOptions, progress: &dyn Progress) -> Result<Report> {
-    let aopts = atlas_options(options.size, 4)?;
-    let mut report =
-        Report::new("demo", options.seed, serde_json::to_value(options).unwrap_or_default());
-    prepare_out_dir(out_dir)?;
-    let mesh = report.time("mesh", || demo_mesh(options.level.min(7)));
-    let exemplar = report.time("exemplar", || demo_exemplar(128, options.seed));
-    report.input = serde_json::json!({
-        "mesh": "procedural bumpy icosphere",
-        "vertices": mesh.n_vertices(),
-        "triangles": mesh.n_triangles(),
-        "exemplar": "procedural bricks 128x128",
-    });
-    let atlas = repaired_atlas(&mesh, None, &aopts, &mut report, progress)?;
-    // UV → exemplar: one atlas unit holds `resolution / texels_per_unit` surface units.
-    let texture = report.time("bake", || -> Result<Image> {
-        let res = atlas.resolution as usize;
-        let map = fieldtex_param::build_texel_map(&atlas.mesh, res, res, atlas.gutter)
-            .map_err(|e| crate::Error::Internal(format!("texel map: {e}")))?;
-        let s = atlas.resolution as f64 / atlas.stats.texels_per_unit.max(1e-12)
-            * options.tiles_per_unit;
-        let uvs = atlas.mesh.uvs.as_ref();
-        let bg = [0.5, 0.5, 0.5, 1.0];
-        fieldtex_param::bake_surface(&atlas.mesh, &map, bg, |f, bary, _p| {
-            let Some(uv) = uvs else { return [0.5, 0.5, 0.5, 1.0] };
-            let t = uv.indices[f as usize];
-            let mut u = 0.0;
-            let mut v = 0.0;
-            for k in 0..3 {
-                u += bary[k] as f64 * uv.values[t[k] as usize][0];
-                v += bary[k] as f64 * uv.values[t[k] as usize][1];
-            }
-            let ex = exemplar.width as f64;
-            exemplar.get_wrapped((u * s * ex).floor() as i64, ((1.0 - v) * s * ex).floor() as i64)
-        })
-        .map_err(|e| crate::Error::Internal(format!("bake: {e}")))
-    })?;
-    report.time("write", || super::write_model(out_dir, &atlas.mesh, Some(&texture)))?;
-    let preview =
-        report.time("preview", || super::render::preview(&atlas.mesh, Some(&texture), 800, None));
-    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
-    report.metric("atlas", atlas.stats);
-    report.notes.push(
-        "substitute: the texture is the exemplar tiled in chart space at uniform texel density; \
-         field-guided synthesis is not wired into the demo yet, so chart borders show seams"
-            .to_string(),
-    );
-    write_report(out_dir, &report)?;
-    Ok(report)
+    if !(64..=2048).contains(&options.size) {
+        return Err(crate::Error::bad_input(
+            None,
+            format!("--size must be in 64..=2048 texels for the demo, got {}", options.size),
+        ));
+    }
+    let t0 = std::time::Instant::now();
+    let mesh = demo_mesh(options.cells);
+    let exemplar = demo_exemplar(options.exemplar_size, options.seed);
+    let (w, h) = (exemplar.width, exemplar.height);
+    let aopts = AlignOptions {
+        mesh: PathBuf::from(format!(
+            "<built-in: cube, {} cells per face side, {} triangles>",
+            options.cells.clamp(2, 64),
+            mesh.n_triangles()
+        )),
+        exemplar: PathBuf::from(format!("<built-in: stripes {w}×{h}>")),
+        size: options.size,
+        seed: options.seed,
+        ..Default::default()
+    };
+    // The orient image first (in memory), so that every output is written together.
+    let orient =
+        if options.orient { Some(orient_beside(options, &exemplar, progress)?) } else { None };
+    let n_tris = mesh.n_triangles();
+    let mut add = |stage: &Path, report: &mut Report| -> Result<()> {
+        report.command = "demo".to_string();
+        report.options = serde_json::json!({ "demo": options, "align": &aopts });
+        report.notes.push(format!(
+            "demo: the built-in cube ({n_tris} triangles, 12 sharp creases) and procedural \
+             stripes ({w}×{h}) went through `align` (paper A): crease curves, greedy curve \
+             orientation, harmonic field, atlas, texture optimisation on the surface with \
+             feature alignment; the metrics are align's"
+        ));
+        if let Some((image, metrics)) = &orient {
+            fieldtex_io::write_png(&stage.join("orient.png"), image)?;
+            report.metric("orient", metrics);
+            report.notes.push(
+                "demo: orient.png is the `orient` pipeline (paper D) on the same stripes along \
+                 the built-in whorl fingerprint preset, in the plane (designed singularities \
+                 marked); its metrics are under metrics.orient"
+                    .to_string(),
+            );
+        }
+        report.timings_ms.push(("demo_total".to_string(), t0.elapsed().as_secs_f64() * 1e3));
+        Ok(())
+    };
+    // The aligned cube: the real align pipeline; model.glb, preview.png, orient.png and
+    // report.json appear together.
+    super::align::align_impl(out_dir, &aopts, Some((&mesh, &exemplar)), Some(&mut add), progress)
+}
+
+/// The orient whorl preset on `exemplar`: the image with the designed singularities
+/// marked, and its metrics for the report.
+fn orient_beside(
+    options: &DemoOptions,
+    exemplar: &Image,
+    progress: &dyn Progress,
+) -> Result<(Image, serde_json::Value)> {
+    let n = options.orient_size.clamp(64, 1024);
+    let mut oopts = OrientOptions::new(FieldSource::Preset("whorl".into()), PathBuf::new());
+    oopts.size = n;
+    oopts.grid = 64;
+    oopts.seed = options.seed;
+    // A scratch report: only its metrics and timings are kept.
+    let mut sub = Report::new("orient", options.seed, serde_json::Value::Null);
+    let image = super::orient::orient_in_memory(&oopts, exemplar, &mut sub, progress)?;
+    Ok((
+        image,
+        serde_json::json!({
+            "preset": "whorl",
+            "size": n,
+            "metrics": sub.metrics,
+            "timings_ms": sub.timings_ms,
+        }),
+    ))
 }

@@ -1,7 +1,7 @@
 //! `fieldtex eval`: the image metrics of DESIGN.md §6 for a synthesised image against
 //! its exemplar and, optionally, the guidance field.
 
-use crate::{Error, Result};
+use crate::{Error, Progress, Result};
 use fieldtex_core::Image;
 use fieldtex_eval as ev;
 use serde::Serialize;
@@ -51,6 +51,7 @@ pub(crate) fn bad(e: ev::EvalError, what: &Path) -> Error {
 /// Computes every metric; `field` is `H×W×2` of the output's size when present.
 /// `exemplar_angle_deg` is the exemplar's own stripe direction for the orientation error
 /// (the texture is expected at field angle + this; 0 = stripes along the exemplar's x).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn image_metrics(
     output: &Image,
     exemplar: &Image,
@@ -58,16 +59,26 @@ pub(crate) fn image_metrics(
     angle_deg: Option<f64>,
     exemplar_angle_deg: f64,
     seed: u64,
+    exact: bool,
+    progress: &dyn Progress,
 ) -> std::result::Result<ImageMetrics, ev::EvalError> {
+    progress.stage(if exact { "metrics (exact)" } else { "metrics" }, 6);
     let ob = ev::rgb_buffer(output);
     let eb = ev::rgb_buffer(exemplar);
     let o = ev::ImageView::new(&ob, output.width, output.height, 3)?;
     let e = ev::ImageView::new(&eb, exemplar.width, exemplar.height, 3)?;
-    let popts = ev::PatchDistanceOptions::default().with_wrap_exemplar(true);
-    let coherence = ev::coherence(&o, &e, &popts)?;
-    let completeness = ev::completeness(&o, &e, &popts)?;
+    // Default: the approximate nearest-patch search (PCA + kd-tree, an upper bound of
+    // the exact distances; docs/first-hour.md gives the measured gap); `exact`: the
+    // exhaustive scan.
+    let approximate = (!exact).then(ev::ApproximateSearchOptions::default);
+    let popts = ev::PatchDistanceOptions::default()
+        .with_wrap_exemplar(true)
+        .with_approximate(approximate.clone());
+    let (coherence, completeness) = ev::coherence_and_completeness(&o, &e, &popts)?;
+    progress.advance(2);
     let swo = ev::SlicedWassersteinOptions { seed, ..Default::default() };
     let color_sliced_wasserstein = ev::color_sliced_wasserstein(&o, &e, &swo)?;
+    progress.advance(1);
     let mut skipped = Vec::new();
     let reference = match (field, angle_deg) {
         (Some(f), _) => Some(ev::OrientationReference::Field(ev::FieldView::new(
@@ -80,7 +91,11 @@ pub(crate) fn image_metrics(
     };
     let guided_coherence = match &reference {
         Some(ev::OrientationReference::Field(f)) => {
-            Some(ev::guided_coherence(&o, &e, f, &ev::GuidedCoherenceOptions::default())?)
+            let gopts = ev::GuidedCoherenceOptions {
+                approximate: approximate.clone(),
+                ..Default::default()
+            };
+            Some(ev::guided_coherence(&o, &e, f, &gopts)?)
         }
         _ => None,
     };
@@ -94,6 +109,7 @@ pub(crate) fn image_metrics(
             None
         }
     };
+    progress.advance(1);
     let singularities = match ev::image_orientation(&o, &ev::OrientationOptions::default()) {
         Ok(map) => {
             let r = ev::singularities(&map, &ev::SingularityOptions::default());
@@ -109,6 +125,7 @@ pub(crate) fn image_metrics(
             None
         }
     };
+    progress.advance(1);
     let phase_defects = match ev::phase_defects(&o, &ev::PhaseDefectOptions::default()) {
         Ok(r) => Some(r),
         Err(err) => {
@@ -116,6 +133,8 @@ pub(crate) fn image_metrics(
             None
         }
     };
+    progress.advance(1);
+    progress.finish_stage();
     Ok(ImageMetrics {
         coherence,
         guided_coherence,
@@ -128,15 +147,33 @@ pub(crate) fn image_metrics(
     })
 }
 
-/// Reads the images (and field) and computes [`ImageMetrics`].
+/// Reads the images (and field) and computes [`ImageMetrics`]; `exact` replaces the
+/// approximate nearest-patch searches by the exhaustive ones (slow: minutes at 1024²).
 pub fn eval_files(
     image: &Path,
     exemplar: &Path,
     guidance: Option<&Guidance>,
     seed: u64,
+    exact: bool,
+    progress: &dyn Progress,
 ) -> Result<ImageMetrics> {
+    crate::outputs::begin_command();
     let out = fieldtex_io::read_image(image)?;
     let ex = fieldtex_io::read_image(exemplar)?;
+    // Name the file that is too small (regression: a tiny exemplar was blamed on IMG).
+    let min = ev::PatchDistanceOptions::default().patch_size;
+    for (im, path, what) in [(&out, image, "image"), (&ex, exemplar, "exemplar")] {
+        if im.width < min || im.height < min {
+            return Err(Error::bad_input(
+                Some(path),
+                format!(
+                    "the {what} is {}×{} pixels; eval compares {min}×{min} patches, so it needs \
+                     at least {min}×{min}",
+                    im.width, im.height
+                ),
+            ));
+        }
+    }
     let (field, angle) = match guidance {
         Some(Guidance::FieldFile(p)) => {
             let (shape, data) = fieldtex_io::read_npy_f32(p)?;
@@ -159,5 +196,13 @@ pub fn eval_files(
         }
         None => (None, None),
     };
-    image_metrics(&out, &ex, field.as_deref(), angle, 0.0, seed).map_err(|e| bad(e, image))
+    image_metrics(&out, &ex, field.as_deref(), angle, 0.0, seed, exact, progress).map_err(|e| {
+        let about_exemplar = match &e {
+            ev::EvalError::TooSmall { what, .. }
+            | ev::EvalError::NonFinite { what, .. }
+            | ev::EvalError::BufferSize { what, .. } => what.starts_with("exemplar"),
+            _ => false,
+        };
+        bad(e, if about_exemplar { exemplar } else { image })
+    })
 }

@@ -64,6 +64,7 @@ pub fn field_file(
     if let Some(c) = &options.curves {
         inputs.push(c);
     }
+    crate::outputs::begin_command();
     fieldtex_io::ensure_not_input(out, &inputs)?;
     let loaded = fieldtex_io::read_mesh(mesh_path)?;
     let mut warnings = loaded.warnings.clone();

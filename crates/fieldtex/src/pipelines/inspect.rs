@@ -9,6 +9,7 @@ use std::path::Path;
 
 /// Reads `path` and inspects it; the warnings are those of the reader.
 pub fn inspect_file(path: &Path) -> Result<(InspectReport, Vec<Warning>)> {
+    crate::outputs::begin_command();
     let loaded = fieldtex_io::read_mesh(path)?;
     let report = inspect(&loaded.mesh, &InspectOptions::default());
     Ok((report, loaded.warnings))
@@ -72,6 +73,7 @@ pub fn repair_file(
             format!("--weld-epsilon must be in [0, 1), got {}", options.weld_epsilon),
         ));
     }
+    crate::outputs::begin_command();
     fieldtex_io::ensure_not_input(output, &[input])?;
     let loaded = fieldtex_io::read_mesh(input)?;
     let opts = RepairOptions { weld_epsilon_relative: options.weld_epsilon, ..Default::default() };

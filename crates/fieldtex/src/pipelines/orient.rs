@@ -10,7 +10,7 @@
 //! [`super::orient_patch`]: the patch is parameterised, the field is designed on the
 //! mesh and the texture is synthesised in parameter space (paper D §4, curved patches).
 
-use crate::outputs::{prepare_out_dir, write_report};
+use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::eval::image_metrics;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
@@ -29,6 +29,9 @@ pub enum FieldSource {
     Field(PathBuf),
 }
 
+/// Smallest `--scale`: one exemplar pixel spread over 64 output pixels.
+pub const MIN_SCALE: f64 = 1.0 / 64.0;
+
 /// Options of [`orient`].
 #[derive(Debug, Clone, Serialize)]
 pub struct OrientOptions {
@@ -38,7 +41,7 @@ pub struct OrientOptions {
     pub size: usize,
     /// Field grid cells per side for presets. Default 128.
     pub grid: usize,
-    /// Exemplar pixels per output pixel. Default 1.
+    /// Exemplar pixels per output pixel, in [`MIN_SCALE`, 16]. Default 1.
     pub scale: f64,
     /// The 2-RoSy fix of paper D §4 (off only for the ablation). Default true.
     pub rosy_fix: bool,
@@ -51,6 +54,9 @@ pub struct OrientOptions {
     /// Compute the image metrics of the report (`--no-metrics` turns them off: they take
     /// ~15 s for a 512² output, mostly the exact patch searches). Default true.
     pub metrics: bool,
+    /// Exact (exhaustive) nearest-patch searches in the metrics instead of the
+    /// approximate ones (`--exact-metrics`; tens of seconds at 512²). Default false.
+    pub exact_metrics: bool,
 }
 
 impl OrientOptions {
@@ -66,6 +72,7 @@ impl OrientOptions {
             mesh: None,
             patch: None,
             metrics: true,
+            exact_metrics: false,
         }
     }
 }
@@ -111,9 +118,7 @@ fn build_field(
             return Ok((field, Vec::new()));
         }
         FieldSource::Design(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| {
-                Error::bad_input(Some(p), format!("cannot read the design file: {e}"))
-            })?;
+            let text = read_design_text(p)?;
             DesignFile::from_toml_str(&text)
                 .map_err(|e| Error::bad_input(Some(p), e.to_string()))?
         }
@@ -156,18 +161,32 @@ fn build_field(
     Ok((pixels, designed))
 }
 
+/// Reads a design file (UTF-8 TOML) through the bounded reader.
+pub(crate) fn read_design_text(p: &Path) -> Result<String> {
+    let bytes =
+        fieldtex_io::read_input_file(p, fieldtex_io::InputKind::Text, "read the design file")?;
+    String::from_utf8(bytes)
+        .map_err(|_| Error::bad_input(Some(p), "the design file is not UTF-8 text (TOML)"))
+}
+
 /// Runs the orient pipeline into `out_dir`.
 pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) -> Result<Report> {
+    begin_command();
     if !(16..=4096).contains(&options.size) {
         return Err(Error::bad_input(
             None,
             format!("--size must be in 16..=4096, got {}", options.size),
         ));
     }
-    if !(options.scale > 0.0 && options.scale <= 16.0) {
+    // Regression: 1e-30 passed here and failed later as an "internal failure".
+    if !(options.scale >= MIN_SCALE && options.scale <= 16.0) {
         return Err(Error::bad_input(
             None,
-            format!("--scale must be in (0, 16], got {}", options.scale),
+            format!(
+                "--scale must be in [{MIN_SCALE}, 16] exemplar pixels per output pixel (below 1 \
+                 enlarges the pattern), got {}",
+                options.scale
+            ),
         ));
     }
     if options.patch.is_some() && options.mesh.is_none() {
@@ -183,28 +202,53 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         "exemplar": options.exemplar.display().to_string(),
         "exemplar_size": [exemplar.width, exemplar.height],
     });
-    prepare_out_dir(out_dir)?;
     let (field, designed) = build_field(options, &mut report)?;
+    let out = begin_outputs(out_dir, &["texture.png", "field.npy", "preview.png", "report.json"])?;
+    let stage = out.staging();
     let n = options.size;
     let synth =
         super::synthesis::synthesize_image(&exemplar, &field, n, n, options, &mut report, progress)
             .map_err(|e| e.with_path(&options.exemplar))?;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
-    fieldtex_io::write_png(&out_dir.join("texture.png"), &synth)?;
-    fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
+    fieldtex_io::write_png(&stage.join("texture.png"), &synth)?;
+    fieldtex_io::write_npy_f32(&stage.join("field.npy"), &[n, n, 2], &flat)?;
     report.metric("designed_singularities", &designed);
     if options.metrics {
         let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
         let (metrics, _) =
-            texture_metrics(&mut report, &synth, &exemplar, &flat, &pts, options.seed)?;
+            texture_metrics(&mut report, &synth, &exemplar, &flat, &pts, options, progress)?;
         report.metric("texture", &metrics);
     } else {
         report.notes.push("image metrics skipped (--no-metrics)".into());
     }
     let preview = preview_with_singularities(&synth, &designed);
-    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
-    write_report(out_dir, &report)?;
+    fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
+    commit_outputs(out, &mut report)?;
     Ok(report)
+}
+
+/// The plane orient pipeline on an exemplar in memory, for the demo: field, synthesis
+/// and (with `options.metrics`) the metrics into `report`; returns the preview (texture
+/// with the designed singularities marked). Writes nothing.
+pub(crate) fn orient_in_memory(
+    options: &OrientOptions,
+    exemplar: &Image,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<Image> {
+    let (field, designed) = build_field(options, report)?;
+    let n = options.size;
+    let synth =
+        super::synthesis::synthesize_image(exemplar, &field, n, n, options, report, progress)?;
+    let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
+    report.metric("designed_singularities", &designed);
+    if options.metrics {
+        let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
+        let (metrics, _) =
+            texture_metrics(report, &synth, exemplar, &flat, &pts, options, progress)?;
+        report.metric("texture", &metrics);
+    }
+    Ok(preview_with_singularities(&synth, &designed))
 }
 
 /// The image metrics of an orient texture (`flat`: its `H×W×2` field) against the field
@@ -218,15 +262,19 @@ pub(crate) fn texture_metrics(
     exemplar: &Image,
     flat: &[f32],
     points: &[[f64; 2]],
-    seed: u64,
+    options: &OrientOptions,
+    progress: &dyn Progress,
 ) -> Result<(super::eval::ImageMetrics, f64)> {
+    let (seed, exact) = (options.seed, options.exact_metrics);
     let own = exemplar_orientation(exemplar);
     let angle = own.as_ref().map_or(0.0, |o| o.dominant_angle_deg);
     if let Some(own) = &own {
         report.metric("exemplar_orientation", own);
     }
     let metrics = report
-        .time("metrics", || image_metrics(texture, exemplar, Some(flat), None, angle, seed))
+        .time("metrics", || {
+            image_metrics(texture, exemplar, Some(flat), None, angle, seed, exact, progress)
+        })
         .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
     if let Some(pd) = &metrics.phase_defects {
         let near = fieldtex_eval::count_defects_near(&pd.defects, points, 3.0 * pd.period_px);

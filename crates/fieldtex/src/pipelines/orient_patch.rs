@@ -52,7 +52,7 @@ mod plane_design_mapping;
 mod texel_jacobians;
 
 use super::orient::{DesignedSingularity, FieldSource, OrientOptions, kind_index};
-use crate::outputs::{prepare_out_dir, write_report};
+use crate::outputs::{begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_core::vec3::{add, cross, normalize, sub};
@@ -110,7 +110,11 @@ pub(crate) fn orient_patch(
         "mesh_vertices": mesh.n_vertices(),
         "mesh_triangles": mesh.n_triangles(),
     });
-    prepare_out_dir(out_dir)?;
+    let out = begin_outputs(
+        out_dir,
+        &["texture.png", "field.npy", "model.glb", "preview.png", "report.json"],
+    )?;
+    let stage = out.staging();
     let mut param_warnings = Vec::new();
     let patch = report.time("parameterize", || parameterize(mesh, n, &mut param_warnings))?;
     report.warnings.extend(param_warnings);
@@ -156,9 +160,9 @@ pub(crate) fn orient_patch(
         .map_err(|e| Error::Internal(format!("synthesis: {e}")))?
         .colors;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
-    fieldtex_io::write_png(&out_dir.join("texture.png"), &texture)?;
-    fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
-    report.time("model", || super::write_model(out_dir, &patch.mesh, Some(&texture)))?;
+    fieldtex_io::write_png(&stage.join("texture.png"), &texture)?;
+    fieldtex_io::write_npy_f32(&stage.join("field.npy"), &[n, n, 2], &flat)?;
+    report.time("model", || super::write_model(stage, &patch.mesh, Some(&texture)))?;
     let marks: Vec<DesignedSingularity> = designed
         .iter()
         .map(|s| DesignedSingularity { x: s.texel[0], y: s.texel[1], index: kind_index(s.kind) })
@@ -173,7 +177,8 @@ pub(crate) fn orient_patch(
             &exemplar,
             &flat,
             &pts,
-            options.seed,
+            options,
+            progress,
         )?;
         if let Some(e) = chart_orientation_error(&texture, &field, &inside, exemplar_angle) {
             report.metric("chart_orientation_error", e);
@@ -189,8 +194,8 @@ pub(crate) fn orient_patch(
         report.notes.push("image metrics skipped (--no-metrics)".into());
     }
     let preview = report.time("preview", || preview(&patch.mesh, &texture, &designed));
-    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
-    write_report(out_dir, &report)?;
+    fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
+    commit_outputs(out, &mut report)?;
     Ok(report)
 }
 
@@ -222,9 +227,7 @@ fn texel_field(
             return Ok((field, Vec::new()));
         }
         FieldSource::Design(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| {
-                Error::bad_input(Some(p), format!("cannot read the design file: {e}"))
-            })?;
+            let text = super::orient::read_design_text(p)?;
             let d = DesignFile::from_toml_str(&text)
                 .map_err(|e| Error::bad_input(Some(p), e.to_string()))?;
             (d, Some(p.as_path()))

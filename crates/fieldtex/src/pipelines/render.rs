@@ -19,7 +19,7 @@ impl Default for RenderCommandOptions {
     }
 }
 
-/// Renders the model at `model` to the PNG `out`.
+/// Renders the model at `model` to `out` (PNG, or JPEG for `.jpg`/`.jpeg`).
 pub fn render_file(model: &Path, out: &Path, options: &RenderCommandOptions) -> Result<()> {
     if options.size == 0 || options.size > 8192 {
         return Err(Error::bad_input(
@@ -27,10 +27,19 @@ pub fn render_file(model: &Path, out: &Path, options: &RenderCommandOptions) -> 
             format!("--size must be in 1..=8192, got {}", options.size),
         ));
     }
+    crate::outputs::begin_command();
     fieldtex_io::ensure_not_input(out, &[model])?;
+    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("png" | "jpg" | "jpeg")) {
+        return Err(Error::bad_input(
+            Some(out),
+            "unknown image format: name the output .png, .jpg or .jpeg",
+        ));
+    }
     let loaded = fieldtex_io::read_mesh(model)?;
     let image = preview(&loaded.mesh, loaded.base_color.as_ref(), options.size, options.view);
-    fieldtex_io::write_png(out, &image)?;
+    // Regression: `--out x.jpg` wrote PNG bytes; the format follows the extension.
+    fieldtex_io::write_image(out, &image)?;
     Ok(())
 }
 

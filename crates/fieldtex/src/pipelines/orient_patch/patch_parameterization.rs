@@ -218,7 +218,10 @@ pub(super) fn cut_ball(mesh: &TriMesh, cut: [f64; 4], path: &Path) -> Result<Tri
     if !(cut.iter().all(|v| v.is_finite()) && r > 0.0) {
         return Err(Error::bad_input(
             None,
-            format!("--patch {cut:?}: give a finite centre X,Y,Z and a positive radius R"),
+            format!(
+                "--patch {},{},{},{}: give a finite centre X,Y,Z and a positive radius R",
+                cut[0], cut[1], cut[2], cut[3]
+            ),
         ));
     }
     let dist: Vec<f64> = (0..mesh.n_triangles())
@@ -231,11 +234,19 @@ pub(super) fn cut_ball(mesh: &TriMesh, cut: [f64; 4], path: &Path) -> Result<Tri
         .filter(|&f| dist[f] < r)
         .min_by(|&a, &b| dist[a].total_cmp(&dist[b]).then(a.cmp(&b)))
     else {
-        let bb = mesh.bounding_box().map(|b| (b.min, b.max));
+        // Regression: this message used to print the bounding box as Rust debug text.
+        let span = match mesh.bounding_box() {
+            Some(b) => format!(
+                "the mesh spans x {:.4} to {:.4}, y {:.4} to {:.4}, z {:.4} to {:.4}",
+                b.min[0], b.max[0], b.min[1], b.max[1], b.min[2], b.max[2]
+            ),
+            None => "the mesh has no finite vertex".to_string(),
+        };
         return Err(Error::bad_input(
             Some(path),
             format!(
-                "--patch: no triangle lies within {r} of ({}, {}, {}); the mesh spans {bb:?}",
+                "--patch: no triangle centre lies within {r} of ({}, {}, {}); {span}. Pick a \
+                 centre on the surface (e.g. a vertex from `fieldtex inspect`) or a larger R",
                 c[0], c[1], c[2]
             ),
         ));
