@@ -47,7 +47,7 @@ impl Default for QuiltingOptions {
 }
 
 /// Appends the texels that show the same surface point as texel `(x, y)`.
-pub type PartnerFn = dyn Fn(usize, usize, &mut Vec<(usize, usize)>) + Sync;
+pub type PartnerFn<'a> = dyn Fn(usize, usize, &mut Vec<(usize, usize)>) + Sync + 'a;
 
 /// Per-texel information the quilting reads.
 pub struct QuiltTarget<'a> {
@@ -58,7 +58,7 @@ pub struct QuiltTarget<'a> {
     /// Level index for a mean `τ` (and for a region without `τ`: `level_for(NaN)`).
     pub level_for: &'a (dyn Fn(f64) -> usize + Sync),
     /// Texels showing the same surface point as `(x, y)`, appended to the vector.
-    pub partners: &'a PartnerFn,
+    pub partners: &'a PartnerFn<'a>,
 }
 
 /// What [`quilt`] did.

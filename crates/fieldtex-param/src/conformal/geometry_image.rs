@@ -2,8 +2,9 @@
 //! rasterised into an image whose longer side has `C` texels, with margins where its
 //! periodic sides meet, and the inverse conformal factor `τ = 1/λ` per texel.
 //!
-//! Canvas texel `(i, j)` (column, row; rows follow increasing `y`) has its centre at
-//! `x = x0 + (i − m + ½)/sx`, `y = y0 + (j − m + ½)/sy`, `m` the margin. In a periodic
+//! Canvas texel `(i, j)` (column, row; rows go *down* while `y` goes up, so the image
+//! keeps the map's orientation) has its centre at `x = x0 + (i − m + ½)/sx`,
+//! `y = y1 − (j − m + ½)/sy`, `m` the margin. In a periodic
 //! direction the scale is rounded so that the period is a whole number of texels (the
 //! x and y scales then differ by less than one texel over the image: a negligible
 //! anisotropy); the second period's shift is rounded to whole texels. `λ` is measured
@@ -27,7 +28,7 @@ pub struct GeometryImage {
     pub origin: [f64; 2],
     /// Period in texels along x (`(W, 0)`), when x is periodic.
     pub period_x: Option<i64>,
-    /// Second period in texels `(shift, H)`, when y is periodic.
+    /// Second period in canvas texels `(shift, −H)` (rows go down), when y is periodic.
     pub period_y: Option<[i64; 2]>,
     /// `width × height` inverse conformal factors (`NaN` outside the surface).
     pub tau: Vec<f32>,
@@ -59,7 +60,7 @@ impl GeometryImage {
         if let Some(b) = component.lattice.b {
             let h = (b[1] * s).round().max(8.0);
             sy = h / b[1];
-            period_y = Some([(b[0] * sx).round() as i64, h as i64]);
+            period_y = Some([(b[0] * sx).round() as i64, -(h as i64)]);
         }
         let w_in = (dx * sx).round() as usize;
         let h_in = (dy * sy).round() as usize;
@@ -80,7 +81,7 @@ impl GeometryImage {
         let corner_texel: Vec<[[f64; 2]; 3]> = component
             .corner_uv
             .iter()
-            .map(|cu| cu.map(|p| [(p[0] - x0) * sx + m, (p[1] - y0) * sy + m]))
+            .map(|cu| cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]))
             .collect();
         let mesh = &component.local_mesh;
         let nf = component.faces.len();
@@ -92,7 +93,7 @@ impl GeometryImage {
             let p = mesh.triangle_positions(f);
             let a3 = 0.5 * vec3::norm(vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0])));
             let t = corner_texel[f];
-            let at = 0.5
+            let at = -0.5
                 * ((t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
                     - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]));
             face_area[f] = a3;

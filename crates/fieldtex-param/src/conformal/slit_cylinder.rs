@@ -3,7 +3,8 @@
 //! A closed genus-0 surface has no holomorphic 1-form (Wang et al. 2005 are silent about
 //! this case). We open it at two extremal vertices `a` (farthest from the centroid) and
 //! `b` (farthest from `a` in edge hops; for a mesh with holes, the centres of the caps of
-//! the longest hole and, when at least half as long, of the second one): removing their triangle fans leaves an annulus.
+//! the longest hole and, when at least half as long and at least half the largest hop
+//! distance away, of the second one): removing their triangle fans leaves an annulus.
 //! On it `u` is harmonic with `u = 0` on the ring of `a` and `u = 1` on the ring of `b`;
 //! its conjugate `v` comes from the harmonic 1-form of the annulus (Neumann boundary,
 //! period 1 around the hole, [`super::harmonic_one_forms`]) scaled to best match
@@ -46,9 +47,12 @@ pub fn slit_cylinder(mesh: &TriMesh, ends: [Option<usize>; 2]) -> Result<Compone
             .unwrap_or(0)
     };
     let a = ends[0].unwrap_or_else(|| far(c));
+    // b: the hinted second hole when it is far from a (at least half the largest hop
+    // distance), else the vertex farthest from a in edge hops.
+    let (far_b, hops) = farthest_in_hops(&topo, a);
     let b = match ends[1] {
-        Some(b) => b,
-        None => farthest_in_hops(&topo, a),
+        Some(b) if 2 * hops[b] as u64 >= hops[far_b] as u64 => b,
+        _ => far_b,
     };
     let mut role = vec![0u8; nv]; // 1: ring of a, 2: ring of b
     for (end, r) in [(a, 1u8), (b, 2u8)] {
@@ -247,8 +251,9 @@ pub fn slit_cylinder(mesh: &TriMesh, ends: [Option<usize>; 2]) -> Result<Compone
     })
 }
 
-/// The vertex with the most edge hops from `a` (lowest index among ties).
-fn farthest_in_hops(topo: &Topology, a: usize) -> usize {
+/// The vertex with the most edge hops from `a` (lowest index among ties) and the hop
+/// distance of every vertex (`u32::MAX` when unreachable).
+fn farthest_in_hops(topo: &Topology, a: usize) -> (usize, Vec<u32>) {
     let nbr = topo.vertex_neighbors();
     let mut dist = vec![u32::MAX; topo.n_vertices];
     dist[a] = 0;
@@ -264,5 +269,5 @@ fn farthest_in_hops(topo: &Topology, a: usize) -> usize {
         }
     }
     let dmax = dist[last];
-    (0..topo.n_vertices).find(|&v| dist[v] == dmax).unwrap_or(last)
+    ((0..topo.n_vertices).find(|&v| dist[v] == dmax).unwrap_or(last), dist)
 }
