@@ -2,6 +2,7 @@
 //! the library, print a summary, map errors to exit codes (0 ok, 1 internal, 2 bad
 //! input or usage).
 
+mod conformal_command;
 mod progress_bar;
 
 use clap::{Args, Parser, Subcommand};
@@ -169,6 +170,10 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Uniform texture synthesis on a global conformal parameterisation (paper C):
+    /// conformal geometry images, multi-scale quilting; writes model.glb, preview.png,
+    /// report.json (and patches.ply, trajectories.obj, images with --keep).
+    Conformal(conformal_command::ConformalArgs),
     /// Feature-aligned texturing (paper A): crest lines or given curves, an oriented
     /// field, texture optimisation on the surface with feature-to-feature alignment;
     /// writes model.glb, preview.png, report.json (and curves.obj, field.ply with --keep).
@@ -447,6 +452,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             print_warnings(&report.warnings, g.quiet);
             say(&format!("wrote {}/{{model.glb,preview.png,report.json}}", out.display()));
         }
+        Command::Conformal(args) => conformal_command::run(args, g.seed, g.quiet, &progress)?,
         Command::Render { model, out, size, view } => {
             let opts = fieldtex::RenderCommandOptions { size, view };
             fieldtex::render_file(&model, &out, &opts)?;

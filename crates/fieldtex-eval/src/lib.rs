@@ -23,12 +23,14 @@ pub mod coherence;
 pub mod color_sliced_wasserstein;
 pub mod completeness;
 mod error;
+pub mod feature_size;
 mod filters;
 pub mod guided_coherence;
 pub mod image_view;
 pub mod nearest_patch;
 pub mod orientation;
 pub mod phase_defects;
+pub mod seam_metrics;
 pub mod singularities;
 pub mod surface_metrics;
 

@@ -30,4 +30,7 @@ pub enum ParamError {
     /// The mesh has no texture coordinates where they are needed.
     #[error("{operation} needs per-corner UVs, but the mesh has none; run build_atlas first")]
     MissingUvs { operation: &'static str },
+    /// The global conformal parameterisation of a component failed.
+    #[error("global conformal parameterisation failed: {reason}")]
+    Conformal { reason: String },
 }

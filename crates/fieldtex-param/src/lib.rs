@@ -36,13 +36,14 @@ mod chart_footprint;
 mod chart_merging;
 pub mod chart_segmentation;
 pub mod chart_topology;
+pub mod conformal;
 pub mod distortion;
 pub mod error;
 pub mod face_graph;
 pub mod lscm;
 pub mod min_area_rectangle;
 pub mod packing;
-mod raster;
+pub mod raster;
 pub mod texel_map;
 
 pub use atlas::{Atlas, AtlasOptions, AtlasStats, build_atlas};

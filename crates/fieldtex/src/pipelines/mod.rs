@@ -1,6 +1,7 @@
 //! One module per pipeline.
 pub mod align;
 pub mod atlas;
+pub mod conformal;
 pub mod crest;
 pub mod demo;
 pub mod eval;

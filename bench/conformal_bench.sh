@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# `fieldtex conformal` (issue 13, paper C) on the shared meshes: wall time, topology,
+# zero points, flips, angle/area distortion, feature-size CV with and without
+# multi-scale, seam length against `fieldtex atlas`, colour jump ratio, mass-spring.
+# Usage: bench/conformal_bench.sh [--runs N] [--exemplar NAME] [--meshes "bunny torus ..."]
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+cd "$root"
+runs=1
+exemplar=pebbles_Rocks002
+meshes="stanford-bunny torus rocker-arm fertility"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --runs) runs="$2"; shift 2 ;;
+    --exemplar) exemplar="$2"; shift 2 ;;
+    --meshes) meshes="$2"; shift 2 ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
+cargo build --release -p fieldtex-cli
+bin=target/release/fieldtex
+ex="../shared/data/exemplars/$exemplar.png"
+out=out/conformal-bench
+mkdir -p "$out"
+for m in $meshes; do
+  f=$(ls ../shared/data/meshes/$m.* | head -1)
+  walls=()
+  for r in $(seq 1 "$runs"); do
+    t0=$(date +%s.%N)
+    $bin conformal --mesh "$f" --exemplar "$ex" --out "$out/$m" --quiet
+    t1=$(date +%s.%N)
+    walls+=("$(python3 -c "print($t1 - $t0)")")
+  done
+  $bin conformal --mesh "$f" --exemplar "$ex" --out "$out/$m-nomulti" --no-multiscale --quiet
+  $bin atlas "$f" --out "$out/$m-atlas" --quiet
+  if [ "$m" = stanford-bunny ]; then
+    $bin conformal --mesh "$f" --exemplar "$ex" --out "$out/$m-qi" --quasi-isometric --quiet
+  fi
+  python3 bench/conformal_summary.py "$m" "$out" "${walls[@]}"
+done

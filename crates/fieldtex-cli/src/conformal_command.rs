@@ -1,0 +1,65 @@
+//! `fieldtex conformal`: flags → [`fieldtex::ConformalOptions`].
+
+use clap::Args;
+use fieldtex::Error;
+use std::path::PathBuf;
+
+/// Uniform texture synthesis on a global conformal parameterisation (paper C).
+#[derive(Args, Debug)]
+pub struct ConformalArgs {
+    #[arg(long)]
+    mesh: PathBuf,
+    #[arg(long)]
+    exemplar: PathBuf,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Long side of each geometry image in texels.
+    #[arg(long, default_value_t = 1024)]
+    size: usize,
+    /// Mass-spring relaxation towards an isometry before synthesis (paper §5).
+    #[arg(long)]
+    quasi_isometric: bool,
+    /// Ablation: one exemplar scale everywhere (paper Fig. 1a/b).
+    #[arg(long)]
+    no_multiscale: bool,
+    /// Number of exemplar scale levels.
+    #[arg(long, default_value_t = 6)]
+    levels: usize,
+    /// Exemplar pixels per texture texel at the reference conformal factor.
+    #[arg(long, default_value_t = 1.0)]
+    scale: f64,
+    /// Quilting patch side in texels (paper: 30–50).
+    #[arg(long, default_value_t = 40)]
+    patch_size: usize,
+    /// Also write patches.ply, trajectories.obj, geometry images and τ maps.
+    #[arg(long)]
+    keep: bool,
+}
+
+/// Runs the command.
+pub fn run(
+    args: ConformalArgs,
+    seed: u64,
+    quiet: bool,
+    progress: &dyn fieldtex::Progress,
+) -> Result<(), Error> {
+    let opts = fieldtex::ConformalOptions {
+        mesh: args.mesh,
+        exemplar: args.exemplar,
+        size: args.size,
+        quasi_isometric: args.quasi_isometric,
+        multiscale: !args.no_multiscale,
+        levels: args.levels,
+        scale: args.scale,
+        patch_size: args.patch_size,
+        keep: args.keep,
+        seed,
+    };
+    let report = fieldtex::conformal(&opts, &args.out, progress)?;
+    crate::print_warnings(&report.warnings, quiet);
+    if !quiet {
+        eprintln!("wrote {}/{{model.glb,preview.png,report.json}}", args.out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,177 @@
+//! End-to-end tests of `fieldtex conformal` (issue 13, paper C): a torus and an open
+//! tube through the whole pipeline, determinism across thread counts, bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_fieldtex")
+}
+
+fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fieldtex-conformal").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(bin()).args(args).output().expect("run fieldtex")
+}
+
+/// A torus (`skip_ring`: leave one ring of quads out, giving an open tube) as OBJ text.
+fn torus_obj(nu: usize, nv: usize, skip_ring: bool) -> String {
+    let mut s = String::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b) = (
+                i as f64 / nu as f64 * std::f64::consts::TAU,
+                j as f64 / nv as f64 * std::f64::consts::TAU,
+            );
+            let r = 1.0 + 0.4 * b.cos();
+            s += &format!("v {} {} {}\n", r * a.cos(), r * a.sin(), 0.4 * b.sin());
+        }
+    }
+    for i in 0..nu {
+        if skip_ring && i == 0 {
+            continue;
+        }
+        for j in 0..nv {
+            let v = |i: usize, j: usize| (i % nu) * nv + (j % nv) + 1;
+            s += &format!(
+                "f {} {} {}\nf {} {} {}\n",
+                v(i, j),
+                v(i + 1, j),
+                v(i + 1, j + 1),
+                v(i, j),
+                v(i + 1, j + 1),
+                v(i, j + 1)
+            );
+        }
+    }
+    s
+}
+
+fn report(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn torus_and_tube_end_to_end_deterministic() {
+    let d = tmp("torus");
+    let mesh = d.join("torus.obj");
+    std::fs::write(&mesh, torus_obj(48, 24, false)).unwrap();
+    let ex = shared().join("exemplars/pebbles_Rocks002.png");
+    let (m, e) = (mesh.to_str().unwrap(), ex.to_str().unwrap());
+    let o1 = d.join("t1");
+    let o2 = d.join("t2");
+    let out = run(&[
+        "conformal",
+        "--mesh",
+        m,
+        "--exemplar",
+        e,
+        "--out",
+        o1.to_str().unwrap(),
+        "--size",
+        "256",
+        "--keep",
+        "--threads",
+        "1",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "conformal",
+        "--mesh",
+        m,
+        "--exemplar",
+        e,
+        "--out",
+        o2.to_str().unwrap(),
+        "--size",
+        "256",
+        "--keep",
+        "--threads",
+        "2",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for f in ["model.glb", "preview.png", "patches.ply", "trajectories.obj"] {
+        assert_eq!(
+            std::fs::read(o1.join(f)).unwrap(),
+            std::fs::read(o2.join(f)).unwrap(),
+            "{f} differs between 1 and 2 threads"
+        );
+    }
+    let r = report(&o1);
+    let c = &r["metrics"]["components"][0];
+    assert_eq!(c["genus"], 1);
+    assert_eq!(c["method"], "holomorphic-torus");
+    assert_eq!(c["zero_points"], 0);
+    assert_eq!(c["distortion"]["flipped"], 0);
+    // Seams are continuous: the colour jump across them is of the order of the jump
+    // between neighbouring texels inside the image.
+    let ratio = r["metrics"]["seams"]["ratio"].as_f64().unwrap();
+    assert!(ratio < 2.0, "seam colour jump ratio {ratio}");
+
+    // The open tube (two boundaries): capped, one cylinder image, no flips.
+    let tube = d.join("tube.obj");
+    std::fs::write(&tube, torus_obj(48, 16, true)).unwrap();
+    let o3 = d.join("tube-out");
+    let out = run(&[
+        "conformal",
+        "--mesh",
+        tube.to_str().unwrap(),
+        "--exemplar",
+        e,
+        "--out",
+        o3.to_str().unwrap(),
+        "--size",
+        "256",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&o3);
+    let c = &r["metrics"]["components"][0];
+    assert_eq!((c["genus"].as_u64(), c["boundaries"].as_u64()), (Some(0), Some(2)));
+    assert_eq!(c["method"], "slit-cylinder");
+    assert_eq!(c["distortion"]["flipped"], 0);
+}
+
+#[test]
+fn bad_inputs_exit_2() {
+    let d = tmp("bad");
+    let mesh = d.join("torus.obj");
+    std::fs::write(&mesh, torus_obj(12, 8, false)).unwrap();
+    let ex = shared().join("exemplars/pebbles_Rocks002.png");
+    let o = d.join("o");
+    let out = run(&[
+        "conformal",
+        "--mesh",
+        "/nonexistent.obj",
+        "--exemplar",
+        ex.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = run(&[
+        "conformal",
+        "--mesh",
+        mesh.to_str().unwrap(),
+        "--exemplar",
+        ex.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+        "--size",
+        "10",
+        "--quiet",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}

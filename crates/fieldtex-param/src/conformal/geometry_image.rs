@@ -1,0 +1,210 @@
+//! Conformal geometry images (Wang et al. 2005 §3–4.1): a component's fundamental domain
+//! rasterised into an image whose longer side has `C` texels, with margins where its
+//! periodic sides meet, and the inverse conformal factor `τ = 1/λ` per texel.
+//!
+//! Canvas texel `(i, j)` (column, row; rows go *down* while `y` goes up, so the image
+//! keeps the map's orientation) has its centre at `x = x0 + (i − m + ½)/sx`,
+//! `y = y1 − (j − m + ½)/sy`, `m` the margin. In a periodic
+//! direction the scale is rounded so that the period is a whole number of texels (the
+//! x and y scales then differ by less than one texel over the image: a negligible
+//! anisotropy); the second period's shift is rounded to whole texels. `λ` is measured
+//! in surface length per texel: per triangle `√(A_surface / A_texels)`; per vertex the
+//! area-weighted mean of `τ` over its triangles; per texel the barycentric
+//! interpolation of the vertex values over the triangle (or its lattice copy) covering
+//! it — a substitute for the paper's Gaussian RBF interpolation.
+
+use super::ConformalComponent;
+use crate::raster::triangle_row_spans;
+use fieldtex_core::vec3;
+
+/// See the module docs.
+#[derive(Debug, Clone)]
+pub struct GeometryImage {
+    pub width: usize,
+    pub height: usize,
+    pub margin: usize,
+    /// Texels per parameter unit in x and y.
+    pub scale: [f64; 2],
+    pub origin: [f64; 2],
+    /// Period in texels along x (`(W, 0)`), when x is periodic.
+    pub period_x: Option<i64>,
+    /// Second period in canvas texels `(shift, −H)` (rows go down), when y is periodic.
+    pub period_y: Option<[i64; 2]>,
+    /// `width × height` inverse conformal factors (`NaN` outside the surface).
+    pub tau: Vec<f32>,
+    /// Per face of the component: corner positions in canvas texel units.
+    pub corner_texel: Vec<[[f64; 2]; 3]>,
+    /// Per face: `λ` (surface length per texel).
+    pub face_lambda: Vec<f64>,
+    /// Per face: surface area.
+    pub face_area: Vec<f64>,
+}
+
+impl GeometryImage {
+    /// Builds the image of `component` (which must have UVs) with long side `c` texels
+    /// inside the margins.
+    pub fn new(component: &ConformalComponent, c: usize) -> Self {
+        let [x0, y0, x1, y1] = component.domain;
+        let (dx, dy) = ((x1 - x0).max(1e-12), (y1 - y0).max(1e-12));
+        let s = c as f64 / dx.max(dy);
+        let mut sx = s;
+        let mut sy = s;
+        let mut period_x = None;
+        if let Some(a) = component.lattice.a {
+            let w = (a * s).round().max(8.0);
+            sx = w / a;
+            sy = sx;
+            period_x = Some(w as i64);
+        }
+        let mut period_y = None;
+        if let Some(b) = component.lattice.b {
+            let h = (b[1] * s).round().max(8.0);
+            sy = h / b[1];
+            period_y = Some([(b[0] * sx).round() as i64, -(h as i64)]);
+        }
+        let w_in = (dx * sx).round() as usize;
+        let h_in = (dy * sy).round() as usize;
+        // Margin: how far corners reach outside the domain, plus filtering slack.
+        let mut spill: f64 = 0.0;
+        for cu in &component.corner_uv {
+            for p in cu {
+                spill = spill
+                    .max((x0 - p[0]) * sx)
+                    .max((p[0] - x1) * sx)
+                    .max((y0 - p[1]) * sy)
+                    .max((p[1] - y1) * sy);
+            }
+        }
+        let margin = (spill.ceil() as usize + 3).max(4);
+        let (width, height) = (w_in + 2 * margin, h_in + 2 * margin);
+        let m = margin as f64;
+        let corner_texel: Vec<[[f64; 2]; 3]> = component
+            .corner_uv
+            .iter()
+            .map(|cu| cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]))
+            .collect();
+        let mesh = &component.local_mesh;
+        let nf = component.faces.len();
+        let mut face_lambda = vec![f64::NAN; nf];
+        let mut face_area = vec![0.0; nf];
+        let mut vtau = vec![0.0; mesh.n_vertices()];
+        let mut vw = vec![0.0; mesh.n_vertices()];
+        for f in 0..nf {
+            let p = mesh.triangle_positions(f);
+            let a3 = 0.5 * vec3::norm(vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0])));
+            let t = corner_texel[f];
+            let at = -0.5
+                * ((t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
+                    - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]));
+            face_area[f] = a3;
+            if at > 0.0 && a3 > 0.0 && !component.slit[f] {
+                face_lambda[f] = (a3 / at).sqrt();
+                for &v in &mesh.triangles[f] {
+                    vtau[v as usize] += a3 / face_lambda[f];
+                    vw[v as usize] += a3;
+                }
+            }
+        }
+        let vtau: Vec<f64> =
+            vtau.iter().zip(&vw).map(|(t, w)| if *w > 0.0 { t / w } else { f64::NAN }).collect();
+        let mut tau = vec![f32::NAN; width * height];
+        let mut shifts = vec![[0.0f64, 0.0f64]];
+        if let Some(px) = period_x {
+            for k in [-1i64, 1] {
+                shifts.push([(k * px) as f64, 0.0]);
+            }
+        }
+        if let Some([bx, h]) = period_y {
+            let base = shifts.clone();
+            for l in [-1i64, 1] {
+                for s0 in &base {
+                    for extra in [-1i64, 0, 1] {
+                        let ex = period_x.map_or(0, |p| extra * p);
+                        if extra != 0 && period_x.is_none() {
+                            continue;
+                        }
+                        shifts.push([s0[0] + (l * bx + ex) as f64, s0[1] + (l * h) as f64]);
+                    }
+                }
+            }
+            shifts.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+            shifts.dedup();
+        }
+        for f in 0..nf {
+            let tv = mesh.triangles[f].map(|v| vtau[v as usize]);
+            let tv = if tv.iter().any(|t| t.is_nan()) {
+                let fl = face_lambda[f];
+                if fl.is_nan() {
+                    continue;
+                }
+                [1.0 / fl; 3]
+            } else {
+                tv
+            };
+            for sh in &shifts {
+                let t = corner_texel[f].map(|p| [p[0] + sh[0], p[1] + sh[1]]);
+                let det = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
+                    - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]);
+                if det.abs() <= 0.0 {
+                    continue;
+                }
+                triangle_row_spans(t, 0.0, |row, c0, c1| {
+                    if row < 0 || row >= height as i64 {
+                        return;
+                    }
+                    let py = row as f64 + 0.5;
+                    for col in c0.max(0)..=c1.min(width as i64 - 1) {
+                        let px = col as f64 + 0.5;
+                        let l1 = ((px - t[0][0]) * (t[2][1] - t[0][1])
+                            - (py - t[0][1]) * (t[2][0] - t[0][0]))
+                            / det;
+                        let l2 = ((t[1][0] - t[0][0]) * (py - t[0][1])
+                            - (t[1][1] - t[0][1]) * (px - t[0][0]))
+                            / det;
+                        let (l1, l2) = (l1.clamp(0.0, 1.0), l2.clamp(0.0, 1.0));
+                        let l0 = (1.0 - l1 - l2).max(0.0);
+                        let sum = l0 + l1 + l2;
+                        tau[row as usize * width + col as usize] =
+                            ((l0 * tv[0] + l1 * tv[1] + l2 * tv[2]) / sum) as f32;
+                    }
+                });
+            }
+        }
+        Self {
+            width,
+            height,
+            margin,
+            scale: [sx, sy],
+            origin: [x0, y0],
+            period_x,
+            period_y,
+            tau,
+            corner_texel,
+            face_lambda,
+            face_area,
+        }
+    }
+
+    /// Texels that show the same surface point as `(i, j)` (its lattice translates that
+    /// fall inside the canvas).
+    pub fn partners(&self, i: usize, j: usize, out: &mut Vec<(usize, usize)>) {
+        let Some(px) = self.period_x else {
+            return;
+        };
+        let (w, h) = (self.width as i64, self.height as i64);
+        let ls: &[i64] = if self.period_y.is_some() { &[-1, 0, 1] } else { &[0] };
+        let [bx, bh] = self.period_y.unwrap_or([0, 0]);
+        for &l in ls {
+            for k in -2i64..=2 {
+                if k == 0 && l == 0 {
+                    continue;
+                }
+                let x = i as i64 + k * px + l * bx;
+                let y = j as i64 + l * bh;
+                if x >= 0 && x < w && y >= 0 && y < h {
+                    out.push((x as usize, y as usize));
+                }
+            }
+        }
+    }
+}

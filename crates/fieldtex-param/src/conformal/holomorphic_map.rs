@@ -1,0 +1,152 @@
+//! Closed surfaces of genus `g ≥ 1`: the holomorphic 1-form basis (Gu & Yau 2003) and,
+//! for `g = 1`, the global conformal map onto one periodic rectangle.
+//!
+//! Steps: tree–cotree generators → closed forms `η_k` of their dual loops → harmonic
+//! forms `ω_k` ([`super::harmonic_one_forms`]) → conjugates `⋆ω_k`
+//! ([`super::holomorphic_basis`]) → a holomorphic form `φ = ω + i ⋆ω`. For `g = 1` the
+//! space is one complex dimension, so `φ` is unique up to a complex factor; we rotate it
+//! so that the first period is real. Then the horizontal trajectories (iso-v curves) are
+//! closed, the torus cut along one of them is a cylinder, and `∫φ` maps it onto the
+//! rectangle `[0, |z1|) × [0, Im z2)` whose sides are identified by `(|z1|, 0)` and
+//! `z2` — one conformal geometry image without zero points.
+//!
+//! For `g ≥ 2` the paper picks the most uniform combination (Jin, Wang, Yau & Gu 2004)
+//! and cuts along critical trajectories. Implemented here: the basis, its conjugates and
+//! the zero points of the basis form with the most uniform `|φ|` (a search over the
+//! `2g` basis forms — a substitute for Jin et al.'s optimisation); the trajectory
+//! patches are **not** implemented, the caller falls back to a chart atlas.
+
+use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
+use super::harmonic_one_forms::{face_vectors, harmonic_projection};
+use super::holomorphic_basis::conjugates;
+use super::periodic_uv::{Lattice, integrate, reduce_faces, signed_area};
+use super::tree_cotree::tree_cotree;
+use super::zero_points::vertex_indices;
+use super::{ComponentMap, ConformalMethod};
+use crate::ParamError;
+use fieldtex_core::vec3;
+use fieldtex_mesh::{CotanOptions, Topology, TriMesh, cotan_face_weights};
+
+/// Holomorphic data of a closed genus-`g ≥ 1` mesh; a UV map when `g = 1`.
+pub fn holomorphic_map(mesh: &TriMesh, genus: usize) -> Result<ComponentMap, ParamError> {
+    let nv = mesh.n_vertices();
+    let nf = mesh.n_triangles();
+    let tris = &mesh.triangles;
+    let topo = Topology::build(nv, tris);
+    let tc = tree_cotree(&topo);
+    if tc.generators.len() != 2 * genus {
+        return Err(conformal_error(&format!(
+            "tree–cotree found {} generators, expected 2g = {}",
+            tc.generators.len(),
+            2 * genus
+        )));
+    }
+    let keep = vec![true; nf];
+    let (half_cot, _) = cotan_face_weights(mesh, &CotanOptions::default())?;
+    let w = edge_weights(&topo, &half_cot, &keep);
+    let fixed: Vec<Option<f64>> = (0..nv)
+        .map(|v| if v == 0 || topo.vertex_faces(v).is_empty() { Some(0.0) } else { None })
+        .collect();
+    let lap = FixedLaplacian::new(&topo, &w, &fixed)?;
+    let mut forms = Vec::with_capacity(tc.generators.len());
+    for &g in &tc.generators {
+        let eta = tc.dual_loop_form(&topo, g);
+        forms.push(harmonic_projection(&topo, &w, &lap, &eta)?);
+    }
+    let xs: Vec<Vec<[f64; 3]>> =
+        forms.iter().map(|om| face_vectors(&topo, &mesh.positions, tris, om, &keep)).collect();
+    let mut areas = vec![0.0; nf];
+    let mut normals = vec![[0.0; 3]; nf];
+    for f in 0..nf {
+        let p = mesh.triangle_positions(f);
+        let n2 = vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0]));
+        areas[f] = 0.5 * vec3::norm(n2);
+        normals[f] = vec3::normalize(n2).unwrap_or([0.0, 0.0, 1.0]);
+    }
+    let conj = conjugates(&xs, &areas, &normals)?;
+    // The basis form with the most uniform |φ| (area-weighted coefficient of variation).
+    let cv = |x: &Vec<[f64; 3]>| {
+        let (mut s, mut s2, mut wsum) = (0.0, 0.0, 0.0);
+        for f in 0..nf {
+            let m = vec3::norm(x[f]);
+            s += areas[f] * m;
+            s2 += areas[f] * m * m;
+            wsum += areas[f];
+        }
+        let mean = s / wsum;
+        ((s2 / wsum - mean * mean).max(0.0)).sqrt() / mean.max(f64::MIN_POSITIVE)
+    };
+    let k = (0..xs.len()).min_by(|&i, &j| cv(&xs[i]).total_cmp(&cv(&xs[j]))).unwrap_or(0);
+    let zero_points =
+        vertex_indices(&mesh.positions, tris, |v| topo.vertex_faces(v).to_vec(), &xs[k], &keep);
+    let star: Vec<f64> = (0..topo.n_edges())
+        .map(|e| (0..forms.len()).map(|j| conj.coefficients[k][j] * forms[j][e]).sum())
+        .collect();
+    if genus != 1 {
+        return Ok(ComponentMap {
+            method: ConformalMethod::HolomorphicBasisOnly,
+            corner: Vec::new(),
+            base: Vec::new(),
+            apex: Vec::new(),
+            lattice: Lattice { a: None, b: None },
+            zero_points,
+            conjugate_residual: conj.residual,
+            slit_vertices: Vec::new(),
+            harmonic_forms: forms.len(),
+        });
+    }
+    let d: Vec<[f64; 2]> = (0..topo.n_edges()).map(|e| [forms[k][e], star[e]]).collect();
+    let puv = integrate(&topo, tris, &keep, &d);
+    let period = |e: u32| {
+        let ed = topo.edges[e as usize];
+        let (b0, b1) = (puv.base[ed[0] as usize], puv.base[ed[1] as usize]);
+        let de = d[e as usize];
+        [b0[0] + de[0] - b1[0], b0[1] + de[1] - b1[1]]
+    };
+    let z1 = period(tc.generators[0]);
+    let z2 = period(tc.generators[1]);
+    let len1 = (z1[0] * z1[0] + z1[1] * z1[1]).sqrt();
+    if len1 <= 0.0 || !len1.is_finite() {
+        return Err(conformal_error("the first period of the holomorphic 1-form vanishes"));
+    }
+    let (cs, sn) = (z1[0] / len1, z1[1] / len1);
+    let rot = |p: [f64; 2]| [cs * p[0] + sn * p[1], -sn * p[0] + cs * p[1]];
+    let mut base: Vec<[f64; 2]> = puv.base.iter().map(|&p| rot(p)).collect();
+    let mut corner: Vec<[[f64; 2]; 3]> =
+        puv.corner.iter().map(|c| [rot(c[0]), rot(c[1]), rot(c[2])]).collect();
+    let mut b = rot(z2);
+    let positive: f64 = corner.iter().map(|c| signed_area(c).signum()).sum();
+    if positive < 0.0 {
+        for p in base.iter_mut() {
+            p[0] = -p[0];
+        }
+        for c in corner.iter_mut() {
+            for p in c.iter_mut() {
+                p[0] = -p[0];
+            }
+        }
+        b[0] = -b[0];
+    }
+    if b[1] < 0.0 {
+        b = [-b[0], -b[1]];
+    }
+    if b[1].abs() <= 1e-12 * len1 {
+        return Err(conformal_error(
+            "the two periods are parallel; the homology basis is degenerate",
+        ));
+    }
+    b[0] = b[0].rem_euclid(len1);
+    let lattice = Lattice { a: Some(len1), b: Some(b) };
+    reduce_faces(&mut corner, &lattice);
+    Ok(ComponentMap {
+        method: ConformalMethod::HolomorphicTorus,
+        corner,
+        base,
+        apex: vec![None; nf],
+        lattice,
+        zero_points,
+        conjugate_residual: conj.residual,
+        slit_vertices: Vec::new(),
+        harmonic_forms: forms.len(),
+    })
+}

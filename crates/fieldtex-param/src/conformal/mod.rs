@@ -1,0 +1,293 @@
+//! Global conformal parameterisation (Gu & Yau 2003; Wang, Gu, Mueller & Yau 2005 §3)
+//! of every connected component of a mesh into *conformal geometry images*: rectangles
+//! whose opposite sides are identified by translations ([`Lattice`]).
+//!
+//! Per component (holes are capped first, [`hole_caps`]; caps are dropped afterwards):
+//! - genus 0 → [`slit_cylinder`]: two point slits, one cylinder image (periodic in x);
+//! - genus 1 → [`holomorphic_map`]: holomorphic 1-form, one torus image (periodic in x
+//!   and, with a shift, in y), no zero points;
+//! - genus ≥ 2 → the holomorphic basis and its zero points are computed, but the
+//!   critical-trajectory patches are not: the component is reported as
+//!   [`ConformalMethod::HolomorphicBasisOnly`] and the caller must parameterise it
+//!   another way (the `conformal` pipeline uses a chart atlas).
+//!
+//! UVs are per corner: a triangle's corners are its local chart of `∫φ` moved into the
+//! fundamental domain by one lattice translation; corners may stick out of the domain by
+//! up to one triangle, which is why texture images get margins (Wang et al. §4.2).
+
+pub mod cotan_system;
+pub mod geometry_image;
+pub mod harmonic_one_forms;
+pub mod hole_caps;
+pub mod holomorphic_basis;
+pub mod holomorphic_map;
+pub mod mass_spring;
+pub mod periodic_uv;
+pub mod slit_cylinder;
+pub mod tree_cotree;
+pub mod zero_points;
+
+pub use geometry_image::GeometryImage;
+pub use mass_spring::{MassSpringOptions, MassSpringStats};
+pub use periodic_uv::Lattice;
+
+use crate::ParamError;
+use fieldtex_core::{Progress, Warning};
+use fieldtex_mesh::{Topology, TriMesh};
+use serde::Serialize;
+
+/// Vertex rings around slit and zero points flagged as near a singularity.
+pub const NEAR_RINGS: usize = 3;
+
+/// How a component was parameterised.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ConformalMethod {
+    /// Genus 0: two point slits, harmonic `u` and its conjugate, one cylinder.
+    SlitCylinder,
+    /// Genus 1: holomorphic 1-form, one periodic rectangle.
+    HolomorphicTorus,
+    /// Genus ≥ 2: holomorphic basis and zero points only; no UVs.
+    HolomorphicBasisOnly,
+    /// The construction failed (see the note); no UVs.
+    Failed,
+}
+
+/// What one construction returns, on the capped component mesh.
+#[derive(Debug, Clone)]
+pub struct ComponentMap {
+    pub method: ConformalMethod,
+    /// Per capped face: corner UVs (empty when no map).
+    pub corner: Vec<[[f64; 2]; 3]>,
+    /// Per capped vertex: integrated position (NaN for slit points).
+    pub base: Vec<[f64; 2]>,
+    /// Per capped face: `(apex corner, at the y-min end)` for slit fan triangles.
+    pub apex: Vec<Option<(u8, bool)>>,
+    pub lattice: Lattice,
+    /// `(vertex, index)` of the zero points (capped-mesh vertex ids).
+    pub zero_points: Vec<(u32, i32)>,
+    /// Relative misfit of the discrete conjugate (see the constructions).
+    pub conjugate_residual: f64,
+    /// The slit points (capped-mesh vertex ids).
+    pub slit_vertices: Vec<u32>,
+    /// Number of harmonic 1-forms computed.
+    pub harmonic_forms: usize,
+}
+
+/// One component's conformal geometry image.
+#[derive(Debug, Clone)]
+pub struct ConformalComponent {
+    pub component: usize,
+    pub genus: usize,
+    /// Boundary loops of the input component.
+    pub boundaries: usize,
+    pub method: ConformalMethod,
+    /// Global triangle ids of the component.
+    pub faces: Vec<u32>,
+    /// Per entry of `faces`: corner UVs in the fundamental domain (empty without a map).
+    pub corner_uv: Vec<[[f64; 2]; 3]>,
+    /// Per entry of `faces`: a slit fan triangle.
+    pub slit: Vec<bool>,
+    /// Per entry of `faces`: within [`NEAR_RINGS`] vertex rings of a slit point or a zero
+    /// point (the "away from zero points and slits" statistics skip these).
+    pub near_singularity: Vec<bool>,
+    pub lattice: Lattice,
+    /// Fundamental domain `[x0, y0, x1, y1]`.
+    pub domain: [f64; 4],
+    /// `(global vertex, index)`; zero points on caps are reported with vertex `u32::MAX`.
+    pub zero_points: Vec<(u32, i32)>,
+    pub conjugate_residual: f64,
+    pub harmonic_forms: usize,
+    pub note: Option<String>,
+    /// Capped component mesh (local indices) and local → global vertex ids.
+    pub local_mesh: TriMesh,
+    pub local_to_global: Vec<u32>,
+    pub map: ComponentMap,
+}
+
+impl ConformalComponent {
+    pub fn has_uv(&self) -> bool {
+        !self.corner_uv.is_empty()
+    }
+
+    /// Recomputes `corner_uv`, `slit` and `domain` from `map` (after relaxation).
+    fn refresh(&mut self) {
+        let nf = self.faces.len();
+        if self.map.corner.is_empty() {
+            return;
+        }
+        self.corner_uv = self.map.corner[..nf].to_vec();
+        self.slit = (0..nf).map(|f| self.map.apex[f].is_some()).collect();
+        let tris = &self.local_mesh.triangles;
+        let mut near_v = vec![false; self.local_mesh.n_vertices()];
+        for &v in self.map.slit_vertices.iter().chain(self.map.zero_points.iter().map(|z| &z.0)) {
+            near_v[v as usize] = true;
+        }
+        for _ in 0..NEAR_RINGS {
+            let cur = near_v.clone();
+            for t in tris.iter() {
+                if t.iter().any(|&v| cur[v as usize]) {
+                    for &v in t {
+                        near_v[v as usize] = true;
+                    }
+                }
+            }
+        }
+        self.near_singularity =
+            (0..nf).map(|f| tris[f].iter().any(|&v| near_v[v as usize])).collect();
+        let (mut x0, mut y0, mut x1, mut y1) =
+            (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for c in &self.corner_uv {
+            for p in c {
+                x0 = x0.min(p[0]);
+                x1 = x1.max(p[0]);
+                y0 = y0.min(p[1]);
+                y1 = y1.max(p[1]);
+            }
+        }
+        if let Some(a) = self.lattice.a {
+            x0 = 0.0;
+            x1 = a;
+        }
+        if let Some(b) = self.lattice.b {
+            y0 = 0.0;
+            y1 = b[1];
+        }
+        self.domain = [x0, y0, x1, y1];
+    }
+
+    /// Quasi-isometric relaxation (Wang et al. 2005 §5) of this component's map.
+    pub fn relax_quasi_isometric(
+        &mut self,
+        options: &MassSpringOptions,
+    ) -> Option<MassSpringStats> {
+        if !self.has_uv() {
+            return None;
+        }
+        let n_orig = self.faces.len();
+        let stats = mass_spring::relax(&self.local_mesh, n_orig, &mut self.map, options);
+        self.refresh();
+        Some(stats)
+    }
+}
+
+/// Parameterises every component of `mesh` (which must be manifold and consistently
+/// oriented; run `fieldtex_mesh::repair` first). Components whose construction fails get
+/// [`ConformalMethod::Failed`] and a warning, never an error.
+pub fn global_conformal(
+    mesh: &TriMesh,
+    progress: &dyn Progress,
+) -> Result<(Vec<ConformalComponent>, Vec<Warning>), ParamError> {
+    mesh.validate()?;
+    let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
+    let (comp, n) = topo.face_components(&mesh.triangles);
+    let mut faces_of: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (f, &c) in comp.iter().enumerate() {
+        faces_of[c as usize].push(f as u32);
+    }
+    let mut warnings = Vec::new();
+    let mut out = Vec::with_capacity(n);
+    progress.stage("conformal map", n as u64);
+    for (ci, faces) in faces_of.into_iter().enumerate() {
+        let mut local_of = std::collections::HashMap::new();
+        let mut local_to_global = Vec::new();
+        let mut tris = Vec::with_capacity(faces.len());
+        for &f in &faces {
+            let t = mesh.triangles[f as usize];
+            let mut lt = [0u32; 3];
+            for k in 0..3 {
+                lt[k] = *local_of.entry(t[k]).or_insert_with(|| {
+                    local_to_global.push(t[k]);
+                    (local_to_global.len() - 1) as u32
+                });
+            }
+            tris.push(lt);
+        }
+        let positions = local_to_global.iter().map(|&v| mesh.positions[v as usize]).collect();
+        let sub = TriMesh::new(positions, tris);
+        let capped = hole_caps::cap_holes(&sub);
+        let ctopo = Topology::build(capped.mesh.n_vertices(), &capped.mesh.triangles);
+        let manifold = (0..ctopo.n_edges()).all(|e| ctopo.edge_faces(e).len() == 2);
+        let chi = capped.mesh.n_vertices() as i64 - ctopo.n_edges() as i64
+            + capped.mesh.n_triangles() as i64;
+        let genus = ((2 - chi).max(0) / 2) as usize;
+        let result = if !manifold {
+            Err(cotan_system::conformal_error(
+                "the capped component is not a closed manifold (non-manifold edges)",
+            ))
+        } else if faces.len() < 8 {
+            Err(cotan_system::conformal_error("fewer than 8 triangles"))
+        } else if genus == 0 {
+            let mut caps = capped.caps.clone();
+            caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+            let a = caps.first().map(|c| c.0 as usize);
+            let b = match (caps.first(), caps.get(1)) {
+                (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),
+                _ => None,
+            };
+            slit_cylinder::slit_cylinder(&capped.mesh, [a, b])
+        } else {
+            holomorphic_map::holomorphic_map(&capped.mesh, genus)
+        };
+        let (map, note) = match result {
+            Ok(m) => {
+                let note = (m.method == ConformalMethod::HolomorphicBasisOnly).then(|| {
+                    format!("genus {genus}: holomorphic basis and zero points computed; critical-trajectory patches not implemented")
+                });
+                (m, note)
+            }
+            Err(e) => {
+                warnings.push(Warning::new(
+                    "conformal-component-failed",
+                    format!("component {ci} ({} triangles, genus {genus}): {e}", faces.len()),
+                ));
+                (
+                    ComponentMap {
+                        method: ConformalMethod::Failed,
+                        corner: Vec::new(),
+                        base: Vec::new(),
+                        apex: Vec::new(),
+                        lattice: Lattice { a: None, b: None },
+                        zero_points: Vec::new(),
+                        conjugate_residual: f64::NAN,
+                        slit_vertices: Vec::new(),
+                        harmonic_forms: 0,
+                    },
+                    Some(e.to_string()),
+                )
+            }
+        };
+        let zero_points = map
+            .zero_points
+            .iter()
+            .map(|&(v, i)| (local_to_global.get(v as usize).copied().unwrap_or(u32::MAX), i))
+            .collect();
+        let mut c = ConformalComponent {
+            component: ci,
+            genus,
+            boundaries: capped.n_holes,
+            method: map.method,
+            faces,
+            corner_uv: Vec::new(),
+            slit: Vec::new(),
+            near_singularity: Vec::new(),
+            lattice: map.lattice,
+            domain: [0.0; 4],
+            zero_points,
+            conjugate_residual: map.conjugate_residual,
+            harmonic_forms: map.harmonic_forms,
+            note,
+            local_mesh: capped.mesh,
+            local_to_global,
+            map,
+        };
+        c.refresh();
+        out.push(c);
+        progress.advance(1);
+    }
+    progress.finish_stage();
+    Ok((out, warnings))
+}
+
+#[cfg(test)]
+mod tests;
