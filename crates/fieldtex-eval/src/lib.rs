@@ -30,6 +30,7 @@ pub mod orientation;
 pub mod phase_defects;
 pub mod singularities;
 pub mod surface_metrics;
+pub mod transfer_fidelity;
 
 pub use coherence::coherence;
 pub use color_sliced_wasserstein::{
@@ -59,3 +60,4 @@ pub use surface_metrics::{
     CurveSample, FeatureCoverageOptions, FeatureCoverageReport, SurfaceOrientationOptions,
     SurfaceOrientationReport, feature_line_coverage, surface_orientation_error,
 };
+pub use transfer_fidelity::{TransferFidelity, transfer_fidelity};
