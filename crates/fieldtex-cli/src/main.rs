@@ -4,6 +4,7 @@
 
 mod conformal_command;
 mod progress_bar;
+mod transfer_command;
 
 use clap::{Args, Parser, Subcommand};
 use fieldtex::Error;
@@ -227,6 +228,8 @@ enum Command {
         #[arg(long, value_parser = parse_view)]
         view: Option<(f64, f64)>,
     },
+    /// Texture transfer by geometry correlation (paper B).
+    Transfer(transfer_command::TransferArgs),
     /// Quality metrics of a synthesised image against its exemplar (DESIGN.md §6).
     Eval {
         /// The synthesised image.
@@ -453,6 +456,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             say(&format!("wrote {}/{{model.glb,preview.png,report.json}}", out.display()));
         }
         Command::Conformal(args) => conformal_command::run(args, g.seed, g.quiet, &progress)?,
+        Command::Transfer(args) => transfer_command::run(args, &g, &progress)?,
         Command::Render { model, out, size, view } => {
             let opts = fieldtex::RenderCommandOptions { size, view };
             fieldtex::render_file(&model, &out, &opts)?;

@@ -33,6 +33,7 @@ pub mod phase_defects;
 pub mod seam_metrics;
 pub mod singularities;
 pub mod surface_metrics;
+pub mod transfer_fidelity;
 
 pub use approximate_nearest_patch::ApproximateSearchOptions;
 pub use coherence::coherence;
@@ -63,3 +64,4 @@ pub use surface_metrics::{
     CurveSample, FeatureCoverageOptions, FeatureCoverageReport, SurfaceOrientationOptions,
     SurfaceOrientationReport, feature_line_coverage, surface_orientation_error,
 };
+pub use transfer_fidelity::{TransferFidelity, transfer_fidelity};

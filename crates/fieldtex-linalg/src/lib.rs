@@ -15,6 +15,7 @@
 //!   [`Cholesky::add_diagonal_penalty`]; Davis & Hager 1999).
 //! - [`least_squares`]: sparse least squares through the normal equations.
 //! - [`symmetric_eigen`] and [`Pca`]: dense symmetric eigendecomposition and PCA.
+//! - [`stats`]: CCA, k-means, 1-D / n-D histogram matching, quantile functions.
 //!
 //! # Conventions
 //! - Sparse SPD inputs are *full* symmetric matrices (both triangles stored). The
@@ -36,6 +37,7 @@ mod multi_rhs_solve;
 mod multiple_rank_update;
 mod partial_solve;
 mod sparse_matrix;
+pub mod stats;
 mod subtree_schedule;
 mod supernodal_solve;
 #[cfg(test)]

@@ -18,11 +18,14 @@ pub use topology::{Csr, Topology, UnionFind};
 pub mod areas;
 pub mod bvh;
 pub mod cotan_laplacian;
+pub mod directional_occlusion;
 pub mod heat_geodesic;
 pub mod mass_matrix;
 pub mod normals;
 pub mod poisson_disk_sampling;
 pub mod principal_curvature;
+pub mod solid_angle_curvature;
+pub mod sphere_directions;
 
 // Inspection and repair.
 pub mod inspect;
@@ -66,6 +69,8 @@ mod repair_tests;
 #[cfg(test)]
 mod test_fixtures;
 pub use bvh::{Bvh, ClosestPoint, Hit, Ray};
+pub use directional_occlusion::{DirectionalOcclusionOptions, directional_occlusion_sh};
 pub use poisson_disk_sampling::{
     PoissonDiskOptions, PoissonDiskSamples, SurfaceSample, poisson_disk_sampling,
 };
+pub use solid_angle_curvature::{OrientedPoint, SolidAngleOptions, solid_angle_curvature};

@@ -16,6 +16,7 @@
 //! | [`field_file`] | `fieldtex field` (paper A §4) |
 //! | [`orient`] | `fieldtex orient` (paper D) |
 //! | [`align`] | `fieldtex align` (paper A) |
+//! | [`transfer_files`] | `fieldtex transfer` (paper B) |
 
 mod error;
 mod outputs;
@@ -35,6 +36,9 @@ pub use pipelines::field::{FieldCommandOptions, FieldSummary, field_file};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
 pub use pipelines::orient::{DesignedSingularity, FieldSource, OrientOptions, orient};
 pub use pipelines::render::{RenderCommandOptions, render_file};
+pub use pipelines::transfer as pipelines_transfer;
+pub use pipelines::transfer::{TransferCommandOptions, transfer_files};
+pub use pipelines::transfer_fidelity::transfer_fidelity_files;
 pub use report::Report;
 
 /// The algorithm crates, re-exported for library users.
@@ -50,4 +54,5 @@ pub mod crates {
     pub use fieldtex_render as render;
     pub use fieldtex_synth as synth;
     pub use fieldtex_texopt as texopt;
+    pub use fieldtex_transfer as transfer;
 }

@@ -11,6 +11,8 @@ pub mod orient;
 pub(crate) mod orient_patch;
 pub mod render;
 pub(crate) mod synthesis;
+pub mod transfer;
+pub mod transfer_fidelity;
 
 use crate::Result;
 use fieldtex_core::Image;

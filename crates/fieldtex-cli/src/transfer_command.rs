@@ -1,0 +1,92 @@
+//! `fieldtex transfer`: flags → `fieldtex::TransferCommandOptions`.
+
+use crate::GlobalArgs;
+use clap::Args;
+use fieldtex::Error;
+use fieldtex::pipelines_transfer as t;
+use std::path::PathBuf;
+
+/// Texture transfer by geometry correlation (paper B): learn how the source's colour
+/// follows its shape and synthesise the same on the target.
+#[derive(Args, Debug)]
+pub struct TransferArgs {
+    /// Textured source mesh (OBJ+MTL+image, glTF/GLB with a base-colour texture).
+    #[arg(long)]
+    source: PathBuf,
+    /// Target mesh (any format the readers take).
+    #[arg(long)]
+    target: PathBuf,
+    /// Output directory: model.glb, preview.png, report.json (+ guidance.ply with --keep).
+    #[arg(long)]
+    out: PathBuf,
+    /// Mask image of the source texture's size; white texels are ignored.
+    #[arg(long)]
+    mask: Option<PathBuf>,
+    /// Up axis for the height descriptor: x, y or z.
+    #[arg(long, default_value = "y")]
+    up: String,
+    /// Dimensionality reduction: cca (default) or pca (ablation).
+    #[arg(long, default_value = "cca")]
+    reduce: String,
+    /// Feature matching: none, marginals or multiscale.
+    #[arg(long = "match", default_value = "multiscale")]
+    matching: String,
+    /// Synthesis engine: parametric (nonparametric is not implemented yet).
+    #[arg(long, default_value = "parametric")]
+    engine: String,
+    /// Surface samples at the finest level on each mesh.
+    #[arg(long, default_value_t = 512_000)]
+    samples: usize,
+    /// Samples on which the ray-cast descriptors are computed (then interpolated).
+    #[arg(long, default_value_t = 32_768)]
+    descriptor_samples: usize,
+    /// k-means clusters of the parametric engine.
+    #[arg(long, default_value_t = 50)]
+    clusters: usize,
+    /// Atlas texture size in texels.
+    #[arg(long, default_value_t = 1024)]
+    size: usize,
+    /// Also write guidance.ply (per-vertex descriptors, guidance and colour of the target).
+    #[arg(long)]
+    keep: bool,
+}
+
+fn bad(flag: &str, value: &str, allowed: &str) -> Error {
+    Error::bad_input(None, format!("--{flag} {value:?}: expected one of {allowed}"))
+}
+
+/// Runs the command.
+pub fn run(
+    args: TransferArgs,
+    g: &GlobalArgs,
+    progress: &dyn fieldtex::Progress,
+) -> Result<(), Error> {
+    let mut opts = fieldtex::TransferCommandOptions {
+        source: args.source,
+        target: args.target,
+        mask: args.mask,
+        size: args.size,
+        keep: args.keep,
+        ..Default::default()
+    };
+    let tr = &mut opts.transfer;
+    tr.descriptors.up = t::parse_up_axis(&args.up).ok_or_else(|| bad("up", &args.up, "x, y, z"))?;
+    tr.reduction =
+        t::parse_reduction(&args.reduce).ok_or_else(|| bad("reduce", &args.reduce, "cca, pca"))?;
+    tr.matching = t::parse_match_mode(&args.matching)
+        .ok_or_else(|| bad("match", &args.matching, "none, marginals, multiscale"))?;
+    tr.engine = t::parse_engine(&args.engine)
+        .ok_or_else(|| bad("engine", &args.engine, "parametric, nonparametric"))?;
+    tr.samples = args.samples;
+    tr.descriptors.samples = args.descriptor_samples;
+    tr.parametric.clusters = args.clusters;
+    tr.seed = g.seed;
+    let report = fieldtex::transfer_files(&args.out, &opts, progress)?;
+    if !g.quiet {
+        for w in &report.warnings {
+            eprintln!("warning: {w}");
+        }
+        println!("wrote {}/{{model.glb,preview.png,report.json}}", args.out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,273 @@
+//! The whole transfer of paper B on surface samples: samples and pyramids on source and
+//! target, source colours, descriptors, guidance (CCA), feature matching, synthesis.
+//! Baking into an atlas and writing files belong to the caller (the facade).
+
+use crate::TransferError;
+use crate::descriptors::{DescriptorOptions, compute_descriptors};
+use crate::feature_matching::{MatchMode, MatchStep, match_features};
+use crate::guidance::{Reduction, build_guidance};
+use crate::parametric_synthesis::{
+    ParametricInput, ParametricOptions, ParametricStats, parametric_synthesis,
+};
+use crate::scattered_interpolation::Interpolator;
+use crate::source_colors::source_sample_colors;
+use crate::surface_samples::{SamplePyramid, SampleSet};
+use fieldtex_core::vec3::{self, V3};
+use fieldtex_core::{Image, Progress, Warning};
+use fieldtex_mesh::TriMesh;
+use serde::Serialize;
+use std::time::Instant;
+
+/// Synthesis engine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Engine {
+    /// Constrained Heeger–Bergen (default).
+    Parametric,
+    /// Image analogies on surface samples (not implemented yet: an error).
+    Nonparametric,
+}
+
+/// Options of [`transfer`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TransferOptions {
+    /// Level-0 samples on each mesh. Default 512 000 (paper B §3.1).
+    pub samples: usize,
+    /// Pyramid levels. Default 3.
+    pub levels: usize,
+    pub descriptors: DescriptorOptions,
+    /// Default CCA.
+    pub reduction: Reduction,
+    /// Default multiscale.
+    pub matching: MatchMode,
+    /// Default parametric.
+    pub engine: Engine,
+    pub parametric: ParametricOptions,
+    pub seed: u64,
+}
+
+impl Default for TransferOptions {
+    fn default() -> Self {
+        Self {
+            samples: 512_000,
+            levels: 3,
+            descriptors: DescriptorOptions::default(),
+            reduction: Reduction::Cca,
+            matching: MatchMode::Multiscale,
+            engine: Engine::Parametric,
+            parametric: ParametricOptions::default(),
+            seed: 1,
+        }
+    }
+}
+
+/// Everything a transfer computed.
+#[derive(Debug, Clone)]
+pub struct TransferResult {
+    pub source_samples: SampleSet,
+    /// `#source × 3` RGB read from the texture.
+    pub source_colors: Vec<f64>,
+    pub source_valid: Vec<bool>,
+    pub target_samples: SampleSet,
+    /// `#target × 3` synthesised RGB (sRGB-encoded, `[0, 1]`).
+    pub target_colors: Vec<f64>,
+    /// `#source × 12`, `#target × 12`.
+    pub source_descriptors: Vec<f64>,
+    pub target_descriptors: Vec<f64>,
+    /// `#source × 3` guidance; `#target × 3` guidance after feature matching.
+    pub source_guidance: Vec<f64>,
+    pub target_guidance: Vec<f64>,
+    /// Canonical correlations (CCA) or explained variance fractions (PCA).
+    pub strengths: Vec<f64>,
+    /// Projection directions on the standardised descriptors.
+    pub directions: Vec<Vec<f64>>,
+    pub descriptor_weights: Vec<f64>,
+    pub matching: Vec<MatchStep>,
+    pub parametric: ParametricStats,
+    /// Wall time per stage, milliseconds (not deterministic).
+    pub timings_ms: Vec<(String, f64)>,
+    pub warnings: Vec<Warning>,
+}
+
+fn timed<T>(timings: &mut Vec<(String, f64)>, stage: &str, f: impl FnOnce() -> T) -> T {
+    let t0 = Instant::now();
+    let out = f();
+    timings.push((stage.to_string(), t0.elapsed().as_secs_f64() * 1e3));
+    out
+}
+
+/// Transfers the texture of `source` (per-corner UVs + `texture`, optional `mask` of the
+/// texture's size, white = ignore) to `target` (module docs).
+pub fn transfer(
+    source: &TriMesh,
+    texture: &Image,
+    mask: Option<&Image>,
+    target: &TriMesh,
+    options: &TransferOptions,
+    progress: &dyn Progress,
+) -> Result<TransferResult, TransferError> {
+    if options.engine == Engine::Nonparametric {
+        return Err(TransferError::InvalidOption {
+            what: "engine",
+            message: "the non-parametric engine (image analogies) is not implemented in this build; use --engine parametric".into(),
+        });
+    }
+    if !(256..=8_000_000).contains(&options.samples) {
+        return Err(TransferError::InvalidOption {
+            what: "samples",
+            message: format!("must be in 256..=8000000, got {}", options.samples),
+        });
+    }
+    if !(1..=6).contains(&options.levels) {
+        return Err(TransferError::InvalidOption {
+            what: "levels",
+            message: format!("must be in 1..=6, got {}", options.levels),
+        });
+    }
+    if source.uvs.is_none() {
+        return Err(TransferError::SourceNotTextured { what: "has no texture coordinates".into() });
+    }
+    if let Some(m) = mask
+        && (m.width != texture.width || m.height != texture.height)
+    {
+        return Err(TransferError::MaskSize {
+            mask_w: m.width,
+            mask_h: m.height,
+            tex_w: texture.width,
+            tex_h: texture.height,
+        });
+    }
+    if source.n_triangles() == 0 {
+        return Err(TransferError::EmptyMesh { which: "source" });
+    }
+    if target.n_triangles() == 0 {
+        return Err(TransferError::EmptyMesh { which: "target" });
+    }
+    let seed = options.seed;
+    let mut warnings = Vec::new();
+    let mut t = Vec::new();
+    let sp = timed(&mut t, "source_samples", || {
+        SamplePyramid::build(
+            source,
+            options.samples,
+            options.levels,
+            fieldtex_core::rng::stream_seed(seed, "transfer-source", 0),
+            "source",
+            progress,
+            &mut warnings,
+        )
+    })?;
+    let tp = timed(&mut t, "target_samples", || {
+        SamplePyramid::build(
+            target,
+            options.samples,
+            options.levels,
+            fieldtex_core::rng::stream_seed(seed, "transfer-target", 0),
+            "target",
+            progress,
+            &mut warnings,
+        )
+    })?;
+    let (source_colors, source_valid) = timed(&mut t, "source_colors", || {
+        source_sample_colors(source, texture, mask, &sp.levels[0])
+    })?;
+    let usable = source_valid.iter().filter(|&&v| v).count();
+    if usable < 16 {
+        return Err(TransferError::TooFewSamples { found: usable, needed: 16 });
+    }
+    let xs = timed(&mut t, "source_descriptors", || {
+        compute_descriptors(
+            source,
+            &sp.levels[0],
+            &options.descriptors,
+            fieldtex_core::rng::stream_seed(seed, "transfer-source", 1),
+            "source",
+            progress,
+            &mut warnings,
+        )
+    })?;
+    let xt = timed(&mut t, "target_descriptors", || {
+        compute_descriptors(
+            target,
+            &tp.levels[0],
+            &options.descriptors,
+            fieldtex_core::rng::stream_seed(seed, "transfer-target", 1),
+            "target",
+            progress,
+            &mut warnings,
+        )
+    })?;
+    let g = timed(&mut t, "guidance", || {
+        build_guidance(&xs, &source_colors, &source_valid, &xt, options.reduction)
+    })?;
+    let mut gt = g.target.clone();
+    let matching = timed(&mut t, "feature_matching", || {
+        match_features(&mut gt, &g.source, &sp, &tp, options.matching, seed)
+    })?;
+    progress.stage("synthesis", 1);
+    let (target_colors, parametric) = timed(&mut t, "synthesis", || {
+        parametric_synthesis(
+            &ParametricInput {
+                source: &sp,
+                source_guidance: &g.source,
+                source_colors: &source_colors,
+                source_valid: &source_valid,
+                target: &tp,
+                target_guidance: &gt,
+            },
+            &options.parametric,
+            seed,
+        )
+    })?;
+    progress.advance(1);
+    progress.finish_stage();
+    let SamplePyramid { levels, .. } = sp;
+    let source_samples = levels.into_iter().next().expect("level 0");
+    let target_samples = tp.levels.into_iter().next().expect("level 0");
+    Ok(TransferResult {
+        source_samples,
+        source_colors,
+        source_valid,
+        target_samples,
+        target_colors,
+        source_descriptors: xs,
+        target_descriptors: xt,
+        source_guidance: g.source,
+        target_guidance: gt,
+        strengths: g.strengths,
+        directions: g.directions,
+        descriptor_weights: g.descriptor_weights,
+        matching,
+        parametric,
+        timings_ms: t,
+        warnings,
+    })
+}
+
+/// Interpolates per-sample values (`#samples × dim`) at surface points
+/// `(triangle, barycentric)` of `mesh` (the mesh the samples were taken on, possibly with
+/// other UVs), Gaussian σ = 0.6 × the sample spacing (see [`Interpolator`]).
+pub fn values_at_surface_points(
+    mesh: &TriMesh,
+    samples: &SampleSet,
+    values: &[f64],
+    dim: usize,
+    points: &[(u32, [f64; 3])],
+) -> Vec<f64> {
+    let (vn, _) = fieldtex_mesh::vertex_normals(mesh, fieldtex_mesh::NormalWeighting::default());
+    let mut pos: Vec<V3> = Vec::with_capacity(points.len());
+    let mut nrm: Vec<V3> = Vec::with_capacity(points.len());
+    for &(f, b) in points {
+        let tri = mesh.triangles[f as usize];
+        let mut p = [0.0; 3];
+        let mut n = [0.0; 3];
+        for k in 0..3 {
+            p = vec3::add(p, vec3::scale(mesh.positions[tri[k] as usize], b[k]));
+            n = vec3::add(n, vec3::scale(vn[tri[k] as usize], b[k]));
+        }
+        pos.push(p);
+        nrm.push(vec3::normalize(n).unwrap_or([0.0, 0.0, 1.0]));
+    }
+    Interpolator::gaussian(&samples.positions, &samples.normals, &pos, &nrm, 0.6 * samples.spacing)
+        .apply(values, dim)
+}

@@ -1,0 +1,149 @@
+//! End-to-end tests of the transfer crate on procedural meshes (no files).
+
+use fieldtex_core::{Image, NoProgress};
+use fieldtex_mesh::{CornerUvs, TriMesh, primitives};
+use fieldtex_transfer::{
+    DescriptorOptions, MatchMode, ParametricOptions, TransferError, TransferOptions, transfer,
+};
+
+/// `mesh` with a texture holding one texel per triangle, coloured by `f(centroid)`,
+/// and UVs that put all corners of a triangle at its texel's centre.
+fn textured(mesh: &TriMesh, f: impl Fn([f64; 3]) -> [f32; 3]) -> (TriMesh, Image) {
+    let nf = mesh.n_triangles();
+    let w = (nf as f64).sqrt().ceil() as usize;
+    let h = nf.div_ceil(w);
+    let mut img = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
+    let mut values = Vec::with_capacity(nf);
+    for t in 0..nf {
+        let [a, b, c] = mesh.triangle_positions(t);
+        let p =
+            [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0];
+        let col = f(p);
+        let (x, y) = (t % w, t / w);
+        img.set(x, y, [col[0], col[1], col[2], 1.0]);
+        values.push([(x as f64 + 0.5) / w as f64, 1.0 - (y as f64 + 0.5) / h as f64]);
+    }
+    let mut m = mesh.clone();
+    m.uvs = Some(CornerUvs { values, indices: (0..nf as u32).map(|t| [t, t, t]).collect() });
+    (m, img)
+}
+
+fn small_options() -> TransferOptions {
+    TransferOptions {
+        samples: 6000,
+        levels: 3,
+        descriptors: DescriptorOptions { directions: 24, samples: 3000, ..Default::default() },
+        parametric: ParametricOptions { clusters: 12, ..Default::default() },
+        ..Default::default()
+    }
+}
+
+fn pearson(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma).powi(2);
+        sbb += (y - mb).powi(2);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+/// Upward-facing parts are light, downward-facing dark: a function of the normal only.
+fn up_shade(n_y: f64) -> f32 {
+    (0.5 + 0.4 * n_y) as f32
+}
+
+#[test]
+fn colour_that_follows_the_normal_transfers_to_another_shape() {
+    // Source: a sphere (centroid direction = normal); target: a torus lying in x-z.
+    let sphere = primitives::icosphere(4);
+    let (src, tex) = textured(&sphere, |p| {
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        let v = up_shade(p[1] / r);
+        [v, 0.8 * v, 0.6 * v]
+    });
+    let torus = primitives::torus(1.0, 0.35, 64, 24);
+    // Torus primitives lie in the x-y plane; turn it so y is up.
+    let mut tgt = torus.clone();
+    for p in &mut tgt.positions {
+        *p = [p[0], p[2], -p[1]];
+    }
+    let opts = small_options();
+    let r = transfer(&src, &tex, None, &tgt, &opts, &NoProgress).unwrap();
+    assert!(r.strengths[0] > 0.9, "canonical correlations {:?}", r.strengths);
+    let truth: Vec<f64> = r.target_samples.normals.iter().map(|n| up_shade(n[1]) as f64).collect();
+    let got: Vec<f64> = r.target_colors.chunks_exact(3).map(|c| c[0]).collect();
+    let corr = pearson(&truth, &got);
+    assert!(corr > 0.8, "Pearson r {corr}");
+    // On the source sphere height = (n_y + 1) / 2, so the two collinear descriptors
+    // share the weight; together they carry almost all of it.
+    let w = &r.descriptor_weights;
+    assert!(w[0] + w[2] > 0.8, "weights {w:?}");
+}
+
+/// Constrained Heeger–Bergen with one cluster is plain H&B: the output's colour
+/// histogram equals the source's (grey colours, so the decorrelated channel is RGB).
+#[test]
+fn heeger_bergen_histograms_equal_with_one_cluster() {
+    let sphere = primitives::icosphere(4);
+    let (src, tex) = textured(&sphere, |p| {
+        let v = (0.3 + 0.2 * (5.0 * p[0]).sin() + 0.15 * p[1] * p[1]) as f32;
+        [v, v, v]
+    });
+    let mut opts = small_options();
+    opts.parametric.clusters = 1;
+    opts.matching = MatchMode::None;
+    let tgt = primitives::torus(1.0, 0.4, 48, 20);
+    let r = transfer(&src, &tex, None, &tgt, &opts, &NoProgress).unwrap();
+    let q = |v: Vec<f64>| fieldtex_linalg::stats::QuantileFunction::from_samples(&v, 32).unwrap();
+    let qs = q(r.source_colors.chunks_exact(3).map(|c| c[0]).collect());
+    let qt = q(r.target_colors.chunks_exact(3).map(|c| c[0]).collect());
+    for (a, b) in qs.values.iter().zip(&qt.values) {
+        assert!((a - b).abs() < 0.01, "source quantile {a} vs target {b}");
+    }
+}
+
+#[test]
+fn same_output_for_one_and_two_threads() {
+    let sphere = primitives::icosphere(3);
+    let (src, tex) =
+        textured(&sphere, |p| [(0.5 + 0.3 * p[1]) as f32, 0.4, (0.5 - 0.2 * p[0]) as f32]);
+    let tgt = primitives::torus(1.0, 0.3, 40, 16);
+    let mut opts = small_options();
+    opts.samples = 3000;
+    let run = |t: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(|| transfer(&src, &tex, None, &tgt, &opts, &NoProgress).unwrap())
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a.target_colors, b.target_colors);
+    assert_eq!(a.target_guidance, b.target_guidance);
+    assert_eq!(a.source_descriptors, b.source_descriptors);
+}
+
+#[test]
+fn bad_inputs_are_clear_errors() {
+    let sphere = primitives::icosphere(2);
+    let (src, tex) = textured(&sphere, |_| [0.5; 3]);
+    let opts = small_options();
+    let mut no_uv = src.clone();
+    no_uv.uvs = None;
+    let e = transfer(&no_uv, &tex, None, &sphere, &opts, &NoProgress).unwrap_err();
+    assert!(matches!(e, TransferError::SourceNotTextured { .. }), "{e}");
+    assert!(e.is_bad_input());
+    let empty = TriMesh::new(sphere.positions.clone(), Vec::new());
+    let e = transfer(&src, &tex, None, &empty, &opts, &NoProgress).unwrap_err();
+    assert!(matches!(e, TransferError::EmptyMesh { which: "target" }), "{e}");
+    let mask = Image::new(tex.width + 1, tex.height, [0.0; 4]);
+    let e = transfer(&src, &tex, Some(&mask), &sphere, &opts, &NoProgress).unwrap_err();
+    assert!(matches!(e, TransferError::MaskSize { .. }), "{e}");
+    // A mask that hides everything leaves too few samples.
+    let all = Image::new(tex.width, tex.height, [1.0; 4]);
+    let e = transfer(&src, &tex, Some(&all), &sphere, &opts, &NoProgress).unwrap_err();
+    assert!(matches!(e, TransferError::TooFewSamples { .. }), "{e}");
+}
