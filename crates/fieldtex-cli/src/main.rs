@@ -3,6 +3,7 @@
 //! input or usage).
 
 mod progress_bar;
+mod solid_command;
 
 use clap::{Args, Parser, Subcommand};
 use fieldtex::Error;
@@ -197,6 +198,9 @@ enum Command {
         #[arg(long, value_parser = parse_view)]
         view: Option<(f64, f64)>,
     },
+    /// Sketch-guided solid texturing (paper E): model.glb, preview.png, report.json,
+    /// cut-N.glb/png, volume.nrrd.
+    Solid(solid_command::SolidArgs),
     /// Quality metrics of a synthesised image against its exemplar (DESIGN.md §6).
     Eval {
         /// The synthesised image.
@@ -394,6 +398,12 @@ fn run(cli: Cli) -> Result<(), Error> {
                 seed: g.seed,
             };
             let report = fieldtex::align(&out, &opts, &progress)?;
+            print_warnings(&report.warnings, g.quiet);
+            say(&format!("wrote {}/{{model.glb,preview.png,report.json}}", out.display()));
+        }
+        Command::Solid(a) => {
+            let out = solid_command::out_dir(&a);
+            let report = solid_command::run_solid(a, g.seed, &progress)?;
             print_warnings(&report.warnings, g.quiet);
             say(&format!("wrote {}/{{model.glb,preview.png,report.json}}", out.display()));
         }

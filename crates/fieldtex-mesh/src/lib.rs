@@ -21,7 +21,10 @@ pub mod cotan_laplacian;
 pub mod heat_geodesic;
 pub mod mass_matrix;
 pub mod normals;
+pub mod plane_cut;
+pub mod point_inside;
 pub mod poisson_disk_sampling;
+pub mod polygon_triangulation;
 pub mod principal_curvature;
 
 // Inspection and repair.
@@ -66,6 +69,9 @@ mod repair_tests;
 #[cfg(test)]
 mod test_fixtures;
 pub use bvh::{Bvh, ClosestPoint, Hit, Ray};
+pub use plane_cut::{PlaneCut, cut_with_plane};
+pub use point_inside::points_inside;
 pub use poisson_disk_sampling::{
     PoissonDiskOptions, PoissonDiskSamples, SurfaceSample, poisson_disk_sampling,
 };
+pub use polygon_triangulation::triangulate_polygons;

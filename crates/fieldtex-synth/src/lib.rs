@@ -106,6 +106,7 @@ pub mod gaussian_stack;
 pub mod k_coherence;
 mod level_tables;
 pub mod parallel_synthesis;
+pub mod solid;
 pub mod synthesis_options;
 
 pub use color_lookup::{ColorFilter, color_lookup};

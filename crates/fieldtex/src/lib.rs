@@ -16,6 +16,7 @@
 //! | [`field_file`] | `fieldtex field` (paper A §4) |
 //! | [`orient`] | `fieldtex orient` (paper D) |
 //! | [`align`] | `fieldtex align` (paper A) |
+//! | [`solid`] | `fieldtex solid` (paper E) |
 
 mod error;
 mod outputs;
@@ -34,6 +35,7 @@ pub use pipelines::field::{FieldCommandOptions, FieldSummary, field_file};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
 pub use pipelines::orient::{DesignedSingularity, FieldSource, OrientOptions, orient};
 pub use pipelines::render::{RenderCommandOptions, render_file};
+pub use pipelines::solid::{SolidGrid, SolidOptions, solid};
 pub use report::Report;
 
 /// The algorithm crates, re-exported for library users.
