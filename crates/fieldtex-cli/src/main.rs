@@ -5,6 +5,7 @@
 mod conformal_command;
 mod progress_bar;
 mod transfer_command;
+mod solid_command;
 
 use clap::{Args, Parser, Subcommand};
 use fieldtex::Error;
@@ -230,6 +231,9 @@ enum Command {
     },
     /// Texture transfer by geometry correlation (paper B).
     Transfer(transfer_command::TransferArgs),
+    /// Sketch-guided solid texturing (paper E): model.glb, preview.png, report.json,
+    /// cut-N.glb/png, volume.nrrd.
+    Solid(solid_command::SolidArgs),
     /// Quality metrics of a synthesised image against its exemplar (DESIGN.md §6).
     Eval {
         /// The synthesised image.
@@ -457,6 +461,12 @@ fn run(cli: Cli) -> Result<(), Error> {
         }
         Command::Conformal(args) => conformal_command::run(args, g.seed, g.quiet, &progress)?,
         Command::Transfer(args) => transfer_command::run(args, &g, &progress)?,
+        Command::Solid(a) => {
+            let out = solid_command::out_dir(&a);
+            let report = solid_command::run_solid(a, g.seed, &progress)?;
+            print_warnings(&report.warnings, g.quiet);
+            say(&format!("wrote {}/{{model.glb,preview.png,report.json}}", out.display()));
+        }
         Command::Render { model, out, size, view } => {
             let opts = fieldtex::RenderCommandOptions { size, view };
             fieldtex::render_file(&model, &out, &opts)?;

@@ -58,13 +58,16 @@ pub mod domain;
 pub mod error;
 pub mod field_design;
 pub mod field_design_options;
+pub mod frame_field_3d;
 pub mod natural_boundary;
 pub mod normal_equations;
 pub mod orientation_field;
 pub mod presets;
+pub mod quaternion;
 pub mod reference_frames;
 pub mod singular_model_field;
 pub mod singularity_index;
+pub mod sketch;
 pub mod stroke_constraints;
 
 pub use dec::Dec;
@@ -75,7 +78,9 @@ pub use error::FieldsError;
 pub use field_design::{
     Domain, FieldDesign, FieldDesignOptions, SingularityId, SingularityModel, SolvedField, StrokeId,
 };
+pub use frame_field_3d::{FrameCurve, FrameField3d, FrameFieldOptions, FrameGrid};
 pub use singularity_index::DetectedSingularity;
+pub use sketch::Sketch;
 
 // Paper A §4: curve-constrained harmonic diffusion, greedy curve orientation, metrics.
 pub mod greedy_curve_orientation;

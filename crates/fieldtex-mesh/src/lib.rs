@@ -22,7 +22,10 @@ pub mod directional_occlusion;
 pub mod heat_geodesic;
 pub mod mass_matrix;
 pub mod normals;
+pub mod plane_cut;
+pub mod point_inside;
 pub mod poisson_disk_sampling;
+pub mod polygon_triangulation;
 pub mod principal_curvature;
 pub mod solid_angle_curvature;
 pub mod sphere_directions;
@@ -74,3 +77,6 @@ pub use poisson_disk_sampling::{
     PoissonDiskOptions, PoissonDiskSamples, SurfaceSample, poisson_disk_sampling,
 };
 pub use solid_angle_curvature::{OrientedPoint, SolidAngleOptions, solid_angle_curvature};
+pub use plane_cut::{PlaneCut, cut_with_plane};
+pub use point_inside::points_inside;
+pub use polygon_triangulation::triangulate_polygons;

@@ -44,6 +44,7 @@ pub mod image_quilting;
 pub mod k_coherence;
 mod level_tables;
 pub mod parallel_synthesis;
+pub mod solid;
 pub mod synthesis_options;
 
 pub use color_lookup::{ColorFilter, color_lookup};

@@ -17,6 +17,7 @@
 //! | [`orient`] | `fieldtex orient` (paper D) |
 //! | [`align`] | `fieldtex align` (paper A) |
 //! | [`transfer_files`] | `fieldtex transfer` (paper B) |
+//! | [`solid`] | `fieldtex solid` (paper E) |
 
 mod error;
 mod outputs;
@@ -39,6 +40,7 @@ pub use pipelines::render::{RenderCommandOptions, render_file};
 pub use pipelines::transfer as pipelines_transfer;
 pub use pipelines::transfer::{TransferCommandOptions, transfer_files};
 pub use pipelines::transfer_fidelity::transfer_fidelity_files;
+pub use pipelines::solid::{SolidGrid, SolidOptions, solid};
 pub use report::Report;
 
 /// The algorithm crates, re-exported for library users.

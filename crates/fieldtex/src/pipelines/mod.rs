@@ -10,6 +10,7 @@ pub mod inspect;
 pub mod orient;
 pub(crate) mod orient_patch;
 pub mod render;
+pub mod solid;
 pub(crate) mod synthesis;
 pub mod transfer;
 pub mod transfer_fidelity;
@@ -25,6 +26,22 @@ pub(crate) fn write_model(dir: &Path, mesh: &TriMesh, texture: Option<&Image>) -
         &dir.join("model.glb"),
         mesh,
         texture,
+        &fieldtex_io::GlbOptions::default(),
+    )?;
+    Ok(())
+}
+
+/// Writes `name` (a `.glb`) into `dir` with `texture`.
+pub(crate) fn write_model_named(
+    dir: &Path,
+    name: &str,
+    mesh: &TriMesh,
+    texture: &Image,
+) -> Result<()> {
+    fieldtex_io::write_glb(
+        &dir.join(name),
+        mesh,
+        Some(texture),
         &fieldtex_io::GlbOptions::default(),
     )?;
     Ok(())

@@ -1,0 +1,116 @@
+//! `fieldtex solid`: flags → [`fieldtex::SolidOptions`].
+
+use clap::Args;
+use fieldtex::Error;
+use std::path::PathBuf;
+
+/// Sketch-guided solid texturing (paper E): a 3-D frame field from sketched curves,
+/// solid texture synthesised from 2-D exemplars on demand.
+#[derive(Args, Debug)]
+pub struct SolidArgs {
+    /// Input mesh (.obj, .ply, .stl, .glb/.gltf).
+    #[arg(long)]
+    mesh: PathBuf,
+    /// Sketch curves as JSON (schema in docs/solid.md); without it the field is constant.
+    #[arg(long)]
+    sketch: Option<PathBuf>,
+    /// Exemplar for the three planes (xy, yz, zx of the local frame).
+    #[arg(long)]
+    exemplar: Option<PathBuf>,
+    /// Exemplar of the local xy plane (overrides --exemplar there).
+    #[arg(long)]
+    exemplar_xy: Option<PathBuf>,
+    /// Exemplar of the local yz plane.
+    #[arg(long)]
+    exemplar_yz: Option<PathBuf>,
+    /// Exemplar of the local zx plane.
+    #[arg(long)]
+    exemplar_zx: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long)]
+    out: PathBuf,
+    /// Voxels along the bounding box's longest side (cubic voxels).
+    #[arg(long, default_value_t = 256)]
+    resolution: usize,
+    /// Cut plane X,Y,Z,NX,NY,NZ (repeatable): writes cut-N.glb and cut-N.png.
+    #[arg(long = "cut", value_parser = parse_cut)]
+    cuts: Vec<[f64; 6]>,
+    /// Also write the whole grid as volume.nrrd.
+    #[arg(long)]
+    volume: bool,
+    /// Also write frames.ply (the coarse frame field).
+    #[arg(long)]
+    keep: bool,
+    /// Atlas size of the textured meshes, texels.
+    #[arg(long, default_value_t = 1024)]
+    atlas_size: usize,
+    /// Frame-field cells along the bounding box's shortest side.
+    #[arg(long, default_value_t = 24)]
+    field_cells: usize,
+    /// Correction passes per level (half primary grid, half dual grid).
+    #[arg(long, default_value_t = 2)]
+    passes: usize,
+    /// Block side M of the dual-grid correction.
+    #[arg(long, default_value_t = 12)]
+    block: usize,
+    /// Synthesis levels.
+    #[arg(long, default_value_t = 5)]
+    levels: usize,
+    /// Second exemplar for the interior (not implemented yet: refused).
+    #[arg(long)]
+    interior: Option<PathBuf>,
+}
+
+fn parse_cut(s: &str) -> Result<[f64; 6], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().map_err(|e| format!("{t:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    if v.len() != 6 || v.iter().any(|x| !x.is_finite()) {
+        return Err(format!("expected X,Y,Z,NX,NY,NZ (six finite numbers), got {s:?}"));
+    }
+    if v[3] == 0.0 && v[4] == 0.0 && v[5] == 0.0 {
+        return Err("the cut normal NX,NY,NZ must not be zero".into());
+    }
+    Ok([v[0], v[1], v[2], v[3], v[4], v[5]])
+}
+
+/// Runs the command; returns the output directory for the summary line.
+pub fn run_solid(
+    a: SolidArgs,
+    seed: u64,
+    progress: &dyn fieldtex::Progress,
+) -> Result<fieldtex::Report, Error> {
+    if let Some(p) = &a.interior {
+        return Err(Error::bad_input(
+            Some(p),
+            "--interior (two-region solids) is not implemented yet",
+        ));
+    }
+    let mut opts = fieldtex::SolidOptions {
+        mesh: a.mesh,
+        sketch: a.sketch,
+        exemplar: a.exemplar,
+        exemplar_xy: a.exemplar_xy,
+        exemplar_yz: a.exemplar_yz,
+        exemplar_zx: a.exemplar_zx,
+        resolution: a.resolution,
+        cuts: a.cuts,
+        volume: a.volume,
+        keep: a.keep,
+        atlas_size: a.atlas_size,
+        field_cells: a.field_cells,
+        seed,
+        ..Default::default()
+    };
+    opts.synthesis.passes = a.passes;
+    opts.synthesis.block = a.block;
+    opts.synthesis.seed = seed;
+    opts.analysis.levels = a.levels;
+    fieldtex::solid(&a.out, &opts, progress)
+}
+
+/// The output directory of `a` (read before `run_solid` consumes the arguments).
+pub fn out_dir(a: &SolidArgs) -> PathBuf {
+    a.out.clone()
+}

@@ -1,0 +1,188 @@
+//! End-to-end tests of `fieldtex solid`: outputs, the cut image against the volume
+//! slice, closed cut meshes, determinism across thread counts, and clear errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_fieldtex")
+}
+
+fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fieldtex-cli-solid").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(bin()).args(args).output().expect("spawn fieldtex")
+}
+
+const SKETCH: &str = r#"{"curves": [
+  {"points": [[1.25, 0, 0.2], [0.9, 0.9, 0.2], [0, 1.25, 0.2], [-0.9, 0.9, 0.2]], "axis": "x"},
+  {"points": [[-1.0, -0.5, 0.0], [1.0, -0.5, 0.0]], "plane": {"point": [0, 0, 0], "normal": [0, 0, 1]}, "axis": "y"}
+]}"#;
+
+/// Runs the torus at a small resolution with a z cut through the voxel centres of
+/// slice `k`; returns the output directory.
+fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
+    let sketch = dir.join("sketch.json");
+    std::fs::write(&sketch, SKETCH).unwrap();
+    // The grid: longest side 2.5 (x, y), 40 voxels, spacing 0.0625; z extent 0.5
+    // → 8 voxels, origin z = −0.21875.
+    let z = -0.21875 + 0.0625 * k as f64;
+    let cut = format!("0,0,{z},0,0,1");
+    let out = dir.join("out");
+    run(&[
+        "solid",
+        "--mesh",
+        shared().join("meshes/torus.obj").to_str().unwrap(),
+        "--sketch",
+        sketch.to_str().unwrap(),
+        "--exemplar",
+        shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--resolution",
+        "40",
+        "--atlas-size",
+        "128",
+        "--levels",
+        "3",
+        "--cut",
+        &cut,
+        "--volume",
+        "--keep",
+        "--threads",
+        threads,
+        "--quiet",
+    ])
+}
+
+fn weld_closed(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
+    use std::collections::HashMap;
+    let mut ids: HashMap<[u64; 3], u32> = HashMap::new();
+    let map: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            let key = p.map(f64::to_bits);
+            let n = ids.len() as u32;
+            *ids.entry(key).or_insert(n)
+        })
+        .collect();
+    let mut half: HashMap<(u32, u32), usize> = HashMap::new();
+    for t in triangles {
+        let t = t.map(|v| map[v as usize]);
+        for e in 0..3 {
+            *half.entry((t[e], t[(e + 1) % 3])).or_default() += 1;
+        }
+    }
+    half.iter().all(|(&(a, b), &c)| c == 1 && half.get(&(b, a)) == Some(&1))
+}
+
+#[test]
+fn solid_outputs_cut_slice_and_determinism() {
+    let d1 = tmp("torus-1");
+    let o = torus_run(&d1, "1", 4);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = d1.join("out");
+    for f in [
+        "model.glb",
+        "preview.png",
+        "report.json",
+        "cut-1.glb",
+        "cut-1.png",
+        "volume.nrrd",
+        "frames.ply",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let err = report["metrics"]["frame_field"]["alignment_error_max_deg"].as_f64().unwrap();
+    assert!(err <= 5.0, "frame-field alignment error {err}°");
+    assert_eq!(report["metrics"]["cuts"][0]["grid_slice"], true);
+    // The cut image equals the volume's slice where opaque.
+    let vol = fieldtex::crates::io::decode_nrrd_rgb(
+        &std::fs::read(out.join("volume.nrrd")).unwrap(),
+        "volume",
+    )
+    .unwrap();
+    let [nx, ny, nz] = vol.sizes;
+    assert_eq!((nx, ny, nz), (40, 40, 8));
+    let img = fieldtex::crates::io::read_image(&out.join("cut-1.png")).unwrap();
+    assert_eq!((img.width, img.height), (nx, ny));
+    let (mut opaque, mut transparent) = (0, 0);
+    for y in 0..ny {
+        for x in 0..nx {
+            let p = img.get(x, y).map(|v| (v * 255.0).round() as u8);
+            if p[3] == 0 {
+                transparent += 1;
+                continue;
+            }
+            opaque += 1;
+            let i = 3 * (x + nx * (y + ny * 4));
+            assert_eq!(&p[..3], &vol.data[i..i + 3], "pixel ({x}, {y})");
+        }
+    }
+    assert!(opaque > 100 && transparent > 100, "opaque {opaque}, transparent {transparent}");
+    // The cut mesh of the closed torus is closed.
+    let cut = fieldtex::crates::io::read_mesh(&out.join("cut-1.glb")).unwrap().mesh;
+    assert!(weld_closed(&cut.positions, &cut.triangles), "cut-1.glb is not closed");
+    // Two threads: the same bytes.
+    let d2 = tmp("torus-2");
+    let o = torus_run(&d2, "2", 4);
+    assert!(o.status.success());
+    for f in ["model.glb", "cut-1.png", "volume.nrrd", "frames.ply"] {
+        assert_eq!(
+            std::fs::read(out.join(f)).unwrap(),
+            std::fs::read(d2.join("out").join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+}
+
+#[test]
+fn bad_sketches_name_the_curve_and_point() {
+    let d = tmp("bad");
+    let sketch = d.join("s.json");
+    std::fs::write(
+        &sketch,
+        r#"{"curves": [{"points": [[0,0,0],[1,0,0]]}, {"points": [[0,0,0]]}]}"#,
+    )
+    .unwrap();
+    let o = run(&[
+        "solid",
+        "--mesh",
+        shared().join("meshes/torus.obj").to_str().unwrap(),
+        "--sketch",
+        sketch.to_str().unwrap(),
+        "--exemplar",
+        shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap(),
+        "--out",
+        d.join("out").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("curve 1") && e.contains("s.json"), "{e}");
+    std::fs::write(&sketch, r#"{"curves": [{"points": [[0,0,0],[1,0,"x"]]}]}"#).unwrap();
+    let o = run(&[
+        "solid",
+        "--mesh",
+        shared().join("meshes/torus.obj").to_str().unwrap(),
+        "--sketch",
+        sketch.to_str().unwrap(),
+        "--exemplar",
+        shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap(),
+        "--out",
+        d.join("out").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}

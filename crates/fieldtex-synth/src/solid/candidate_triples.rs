@@ -1,0 +1,147 @@
+//! Candidate triples with crossbar consistency (Dong, Lefebvre, Tong & Drettakis 2008,
+//! §4; paper E §2).
+//!
+//! A *coordinate triple* `(p₀, p₁, p₂)` names one pixel in each plane exemplar. Around
+//! a voxel the three `N × N` exemplar neighbourhoods meet pairwise along three sticks
+//! ("crossbars") of `N` samples, `h` apart: with the plane conventions of
+//! [`super::solid_exemplar`], exemplar `j`'s *column* through `p_j` (its second
+//! coordinate, local axis `j + 1`) must agree with exemplar `j + 1`'s *row* through
+//! `p_{j+1}` (its first coordinate, the same local axis). The crossbar error of a triple
+//! is the sum over `j` of the squared RGB differences of those stick pairs.
+//!
+//! For each pixel `p` of plane `i` the table keeps the `N_T` triples with `pᵢ = p` of
+//! least crossbar error, best first. Search (a substitute for Dong 2008's full search,
+//! named in the pipeline notes): the `K₁ = 8` best partners in plane `i + 1` (by the
+//! stick shared with `p`) and in plane `i + 2` are found by brute force over a regular
+//! sub-grid *pool* of about [`super::SolidAnalysisOptions::pool`] pixels, then all
+//! `K₁²` pairs are scored with their third stick. Dong's extra test that a triple be
+//! consistent with a neighbouring pixel's triple is not applied.
+
+use super::solid_exemplar::{PlaneExemplar, SolidAnalysisOptions};
+use rayon::prelude::*;
+
+const K1: usize = 8;
+
+/// Exemplar pixel coordinates, one per plane (xy, yz, zx).
+pub type Triple = [[i32; 2]; 3];
+
+/// Candidate triples of one plane at one level: `n_t` per pixel, best first.
+#[derive(Clone, Debug)]
+pub struct CandidateTriples {
+    /// Plane whose pixels index the table.
+    pub plane: usize,
+    pub width: usize,
+    pub height: usize,
+    pub n_t: usize,
+    /// `width × height × n_t` triples (pixel-major).
+    pub triples: Vec<Triple>,
+}
+
+impl CandidateTriples {
+    /// The `k`-th candidate of pixel `(x, y)` (wrapped).
+    #[inline]
+    pub fn get(&self, x: i32, y: i32, k: usize) -> &Triple {
+        let xi = x.rem_euclid(self.width as i32) as usize;
+        let yi = y.rem_euclid(self.height as i32) as usize;
+        &self.triples[(yi * self.width + xi) * self.n_t + k]
+    }
+}
+
+/// Row and column sticks of every pixel (`N × 3` floats each).
+struct Sticks {
+    rows: Vec<f32>,
+    cols: Vec<f32>,
+    len: usize,
+}
+
+fn sticks(colors: &[[f32; 3]], w: usize, hgt: usize, h: usize, n: usize) -> Sticks {
+    let len = 3 * n;
+    let half = (n / 2) as i64;
+    let mut rows = vec![0.0f32; w * hgt * len];
+    let mut cols = vec![0.0f32; w * hgt * len];
+    rows.par_chunks_mut(len).zip(cols.par_chunks_mut(len)).enumerate().for_each(|(p, (r, c))| {
+        let (x, y) = ((p % w) as i64, (p / w) as i64);
+        for (k, t) in (-half..=half).enumerate() {
+            let xx = (x + t * h as i64).rem_euclid(w as i64) as usize;
+            let yy = (y + t * h as i64).rem_euclid(hgt as i64) as usize;
+            r[3 * k..3 * k + 3].copy_from_slice(&colors[y as usize * w + xx]);
+            c[3 * k..3 * k + 3].copy_from_slice(&colors[yy * w + x as usize]);
+        }
+    });
+    Sticks { rows, cols, len }
+}
+
+#[inline]
+fn dist2(a: &[f32], b: &[f32]) -> f32 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
+fn pool(w: usize, hgt: usize, size: usize) -> Vec<usize> {
+    let stride = ((w * hgt) as f64 / size.max(1) as f64).sqrt().ceil().max(1.0) as usize;
+    let mut out = Vec::new();
+    for y in (0..hgt).step_by(stride) {
+        for x in (0..w).step_by(stride) {
+            out.push(y * w + x);
+        }
+    }
+    out
+}
+
+/// The `K₁` pool pixels whose `stick(q)` is nearest `query` (ties to the lower index).
+fn nearest(query: &[f32], sticks: &[f32], len: usize, pool: &[usize]) -> Vec<(f32, usize)> {
+    let mut best: Vec<(f32, usize)> = Vec::with_capacity(K1 + 1);
+    for &q in pool {
+        let d = dist2(query, &sticks[q * len..(q + 1) * len]);
+        if best.len() < K1 || d < best[best.len() - 1].0 {
+            let at = best.partition_point(|b| b.0 <= d);
+            best.insert(at, (d, q));
+            best.truncate(K1);
+        }
+    }
+    best
+}
+
+/// The candidate-triple table of plane `plane` at the level of spacing `h` (module
+/// docs). `levels[j]` is plane `j`'s exemplar and its stack colours at this level.
+pub fn candidate_triples(
+    levels: [(&PlaneExemplar, &[[f32; 3]]); 3],
+    plane: usize,
+    h: usize,
+    options: &SolidAnalysisOptions,
+) -> CandidateTriples {
+    let n = options.neighbourhood;
+    let st: Vec<Sticks> =
+        levels.iter().map(|(e, colors)| sticks(colors, e.width, e.height, h, n)).collect();
+    let (i, j, k) = (plane, (plane + 1) % 3, (plane + 2) % 3);
+    let (ei, ej, ek) = (levels[i].0, levels[j].0, levels[k].0);
+    let pool_j = pool(ej.width, ej.height, options.pool);
+    let pool_k = pool(ek.width, ek.height, options.pool);
+    let len = st[0].len;
+    let n_t = options.triples;
+    let coord = |e: &PlaneExemplar, p: usize| [(p % e.width) as i32, (p / e.width) as i32];
+    let mut triples = vec![[[0i32; 2]; 3]; ei.width * ei.height * n_t];
+    triples.par_chunks_mut(n_t).enumerate().for_each(|(p, out)| {
+        // Column of plane i ↔ row of plane j; row of plane i ↔ column of plane k;
+        // column of plane j ↔ row of plane k.
+        let qs = nearest(&st[i].cols[p * len..(p + 1) * len], &st[j].rows, len, &pool_j);
+        let rs = nearest(&st[i].rows[p * len..(p + 1) * len], &st[k].cols, len, &pool_k);
+        let mut scored: Vec<(f32, usize, usize)> = Vec::with_capacity(qs.len() * rs.len());
+        for &(eq, q) in &qs {
+            for &(er, r) in &rs {
+                let e3 =
+                    dist2(&st[j].cols[q * len..(q + 1) * len], &st[k].rows[r * len..(r + 1) * len]);
+                scored.push((eq + er + e3, q, r));
+            }
+        }
+        scored.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+        for (slot, s) in out.iter_mut().enumerate() {
+            let (_, q, r) = scored[slot.min(scored.len() - 1)];
+            let mut t = [[0i32; 2]; 3];
+            t[i] = coord(ei, p);
+            t[j] = coord(ej, q);
+            t[k] = coord(ek, r);
+            *s = t;
+        }
+    });
+    CandidateTriples { plane, width: ei.width, height: ei.height, n_t, triples }
+}

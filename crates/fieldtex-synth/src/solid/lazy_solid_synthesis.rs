@@ -1,0 +1,628 @@
+//! Field-aligned lazy solid synthesis with dual-grid correction (paper E §4–5, on
+//! Dong, Lefebvre, Tong & Drettakis 2008 and Lefebvre & Hoppe 2005).
+//!
+//! Every voxel of every level holds a coordinate [`Triple`]. Levels run coarse to fine
+//! over the [`super::voxel_lattice`]:
+//!
+//! 1. **Initialisation** (coarsest level, §4.1): candidate slabs tiled over space and
+//!    warped by the field in subparts of `K³` voxels: voxel `v` in subpart `s` (centre
+//!    `o`) reads the slab at `w = [Rᵥᵀ (v − o)]`; slab layer `m = ⌊w_z / N⌋` of subpart
+//!    `s` is the xy exemplar shifted by a seeded offset, thickened along z by the
+//!    z-sticks of each pixel's best candidate triple.
+//! 2. **Upsampling** (eq. 3–4): `T(v) = T(v_p) + R_pᵀ (h_c δ)` with `δ = v − 2 v_p` and
+//!    the 3-vector added to the triple as `(xy + (d_x, d_y), yz + (d_y, d_z), zx + (d_z, d_x))`.
+//! 3. **Correction** (§4.3): three `N × N` neighbourhoods in the planes of the voxel's
+//!    frame (`v + R (s, t, 0)` etc., nearest voxel; the paper's trilinear sampling on
+//!    coarse levels is not implemented), projected by each plane's PCA; the candidates
+//!    are the `k` best triples of the pixels predicted by the in-plane neighbours
+//!    (`[T_P(v + d) − h P_P(d)]`, `d` in the 3 × 3 in-plane offsets, the paper's reduced
+//!    set) plus the current triple; the one of least summed squared appearance
+//!    distance wins (earliest on ties). `s³ = 8` subpasses by voxel parity, each
+//!    reading the state before it.
+//! 4. **Dual-grid correction** (§5.3, history windows): a level's first `⌈P/2⌉` passes
+//!    run inside primary blocks of side `M` — neighbours outside the block are read at
+//!    version 0 (the upsampled value) — and the last `⌊P/2⌋` inside the dual blocks
+//!    (shifted by `M/2`), whose outside neighbours are read at the primary grid's final
+//!    version. A block's result is therefore a pure function of its version-0 region
+//!    (block + halo `r = ⌈N_h √2⌉`), and that region of the parent level's finals.
+//!
+//! **On demand and deterministic** (§5): a requested voxel set needs the dual blocks
+//! holding it, the primary blocks under those blocks' halos, the parent level's dual
+//! blocks under the primary blocks' halos, and so on to the coarsest level. Only those
+//! blocks are computed (in parallel, each block sequentially), and cached
+//! ([`SolidSynthesizer`] keeps them), so a voxel's triple is bit-identical whether it
+//! is computed alone, in a cut, in a shell or in the whole volume, for any thread count.
+//!
+//! This is the 3-D lattice form of the parallel (Lefebvre & Hoppe) engine: the same
+//! upsample/correct structure and exemplar stack as [`crate::parallel_synthesis`], with
+//! the 2-D grid replaced by the arithmetic voxel lattice, the Jacobian by the frame,
+//! and whole-level tabulation replaced by evaluation of a requested subset from its
+//! dependency (block) set.
+
+use super::candidate_triples::Triple;
+use super::solid_exemplar::SolidExemplar;
+use super::voxel_lattice::{
+    FrameSource, VoxelLattice, dual_block, dual_origin, floor_div, primary_block, primary_origin,
+};
+use crate::SynthError;
+use fieldtex_core::Progress;
+use rayon::prelude::*;
+use std::collections::{BTreeSet, HashMap};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Options of [`SolidSynthesizer`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SolidSynthesisOptions {
+    /// Block side `M` of the (dual-)grid correction. Default 12 (paper: 10–15).
+    pub block: usize,
+    /// Correction passes per level below the coarsest (`⌈P/2⌉` primary, `⌊P/2⌋` dual).
+    /// Default 2 (the paper's "2 (primary and dual) passes").
+    pub passes: usize,
+    /// Correction passes at the coarsest level. Default 4 (paper: 3–5).
+    pub coarse_passes: usize,
+    /// `s³ = 8` parity subpasses per pass (default true).
+    pub subpasses: bool,
+    /// Candidate triples taken per predicted pixel in the correction (`k`). Default 2.
+    pub k: usize,
+    /// Initialisation subpart side `K`, coarsest-level voxels. Default 64 (the paper's).
+    pub subpart: usize,
+    pub seed: u64,
+}
+
+impl Default for SolidSynthesisOptions {
+    fn default() -> Self {
+        Self { block: 12, passes: 2, coarse_passes: 4, subpasses: true, k: 2, subpart: 64, seed: 1 }
+    }
+}
+
+/// Work done for one level by one request.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LevelStats {
+    pub level: usize,
+    /// Blocks computed (not found in the cache).
+    pub primary_blocks: usize,
+    pub dual_blocks: usize,
+    /// Voxels corrected (each once per pass) and candidate evaluations.
+    pub corrections: u64,
+    pub candidate_evaluations: u64,
+    /// Distinct voxels whose final value this request computed (dual blocks × M³).
+    pub voxels: u64,
+    #[serde(skip)]
+    pub seconds: f64,
+}
+
+type BlockMap = HashMap<[i32; 3], Arc<Vec<Triple>>>;
+
+#[derive(Default)]
+struct LevelCache {
+    primary: BlockMap,
+    dual: BlockMap,
+}
+
+/// Lazy, cached solid synthesis over a [`VoxelLattice`] (module docs).
+pub struct SolidSynthesizer<'a> {
+    exemplar: &'a SolidExemplar,
+    lattice: VoxelLattice,
+    frames: &'a dyn FrameSource,
+    options: SolidSynthesisOptions,
+    cache: Vec<LevelCache>,
+}
+
+struct Counts {
+    corrections: u64,
+    evaluations: u64,
+}
+
+impl<'a> SolidSynthesizer<'a> {
+    /// A synthesizer with an empty cache.
+    pub fn new(
+        exemplar: &'a SolidExemplar,
+        lattice: VoxelLattice,
+        frames: &'a dyn FrameSource,
+        options: SolidSynthesisOptions,
+    ) -> Result<Self, SynthError> {
+        let bad = |name: &'static str, value: usize, reason: &'static str| {
+            Err(SynthError::InvalidOption { name, value: value as f64, reason })
+        };
+        if !(4..=64).contains(&options.block) {
+            return bad("SolidSynthesisOptions::block", options.block, "must be between 4 and 64");
+        }
+        if options.passes > 16 || options.coarse_passes > 32 {
+            return bad("SolidSynthesisOptions::passes", options.passes, "at most 16 (32 coarse)");
+        }
+        if options.k == 0 || options.k > exemplar.options.triples {
+            return bad("SolidSynthesisOptions::k", options.k, "between 1 and the analysis's N_T");
+        }
+        if options.subpart == 0 {
+            return bad("SolidSynthesisOptions::subpart", 0, "must be positive");
+        }
+        if !(lattice.spacing.is_finite() && lattice.spacing > 0.0)
+            || lattice.origin.iter().any(|v| !v.is_finite())
+        {
+            return Err(SynthError::InvalidDomain {
+                reason: "the voxel lattice needs a finite origin and a spacing > 0".into(),
+            });
+        }
+        let levels = exemplar.options.levels;
+        Ok(Self {
+            exemplar,
+            lattice,
+            frames,
+            options,
+            cache: (0..levels).map(|_| LevelCache::default()).collect(),
+        })
+    }
+
+    /// The lattice placement.
+    pub fn lattice(&self) -> VoxelLattice {
+        self.lattice
+    }
+
+    /// Voxels whose final value is cached, per level (dual blocks × M³).
+    pub fn cached_voxels(&self) -> Vec<u64> {
+        let m3 = (self.options.block as u64).pow(3);
+        self.cache.iter().map(|l| l.dual.len() as u64 * m3).collect()
+    }
+
+    fn halo(&self) -> i32 {
+        let half = (self.exemplar.options.neighbourhood / 2) as f64;
+        ((half * std::f64::consts::SQRT_2).ceil() as i32).max(1)
+    }
+
+    /// Final (finest-level) triples of `voxels`, computing only their dependency set
+    /// (module docs). Returns per-level statistics of the work done.
+    pub fn triples(
+        &mut self,
+        voxels: &[[i32; 3]],
+        progress: &dyn Progress,
+    ) -> (Vec<Triple>, Vec<LevelStats>) {
+        let levels = self.cache.len();
+        let m = self.options.block as i32;
+        let r = self.halo();
+        // Backward: blocks needed per level, skipping cached ones and their dependencies.
+        let mut need_dual: Vec<BTreeSet<[i32; 3]>> = vec![BTreeSet::new(); levels];
+        let mut need_primary: Vec<BTreeSet<[i32; 3]>> = vec![BTreeSet::new(); levels];
+        for v in voxels {
+            let b = dual_block(*v, m);
+            if !self.cache[0].dual.contains_key(&b) {
+                need_dual[0].insert(b);
+            }
+        }
+        for c in 0..levels {
+            let mut prim = BTreeSet::new();
+            for b in &need_dual[c] {
+                let o = dual_origin(*b, m);
+                let lo: [i32; 3] = std::array::from_fn(|a| o[a] - r);
+                let hi: [i32; 3] = std::array::from_fn(|a| o[a] + m + r - 1);
+                for_box(primary_block(lo, m), primary_block(hi, m), |pb| {
+                    if !self.cache[c].primary.contains_key(&pb) {
+                        prim.insert(pb);
+                    }
+                });
+            }
+            if c + 1 < levels {
+                let mut up = BTreeSet::new();
+                for b in &prim {
+                    let o = primary_origin(*b, m);
+                    let lo: [i32; 3] = std::array::from_fn(|a| floor_div(o[a] - r, 2));
+                    let hi: [i32; 3] = std::array::from_fn(|a| floor_div(o[a] + m + r - 1, 2));
+                    for_box(dual_block(lo, m), dual_block(hi, m), |db| {
+                        if !self.cache[c + 1].dual.contains_key(&db) {
+                            up.insert(db);
+                        }
+                    });
+                }
+                need_dual[c + 1] = up;
+            }
+            need_primary[c] = prim;
+        }
+        // Forward: coarse to fine.
+        let mut stats = vec![LevelStats::default(); levels];
+        for c in (0..levels).rev() {
+            let t0 = Instant::now();
+            let prim: Vec<[i32; 3]> = need_primary[c].iter().copied().collect();
+            let dual: Vec<[i32; 3]> = need_dual[c].iter().copied().collect();
+            progress.stage(&format!("solid level {c}"), (prim.len() + dual.len()) as u64);
+            let this = &*self;
+            let computed: Vec<(Vec<Triple>, Counts)> = prim
+                .par_iter()
+                .map(|b| {
+                    let out = this.primary_block(c, *b);
+                    progress.advance(1);
+                    out
+                })
+                .collect();
+            let mut st = LevelStats {
+                level: c,
+                primary_blocks: prim.len(),
+                dual_blocks: dual.len(),
+                ..Default::default()
+            };
+            for (b, (t, n)) in prim.iter().zip(computed) {
+                st.corrections += n.corrections;
+                st.candidate_evaluations += n.evaluations;
+                self.cache[c].primary.insert(*b, Arc::new(t));
+            }
+            let this = &*self;
+            let computed: Vec<(Vec<Triple>, Counts)> = dual
+                .par_iter()
+                .map(|b| {
+                    let out = this.dual_block(c, *b);
+                    progress.advance(1);
+                    out
+                })
+                .collect();
+            for (b, (t, n)) in dual.iter().zip(computed) {
+                st.corrections += n.corrections;
+                st.candidate_evaluations += n.evaluations;
+                self.cache[c].dual.insert(*b, Arc::new(t));
+            }
+            st.voxels = dual.len() as u64 * (m as u64).pow(3);
+            st.seconds = t0.elapsed().as_secs_f64();
+            progress.finish_stage();
+            stats[c] = st;
+        }
+        let out = voxels.iter().map(|v| self.final_at(0, *v)).collect();
+        (out, stats)
+    }
+
+    /// Colours (RGB, sRGB-encoded as the exemplars) of `voxels`: the mean of the three
+    /// finest exemplar colours at each final triple.
+    pub fn colors(
+        &mut self,
+        voxels: &[[i32; 3]],
+        progress: &dyn Progress,
+    ) -> (Vec<[f32; 3]>, Vec<LevelStats>) {
+        let (t, stats) = self.triples(voxels, progress);
+        (t.iter().map(|t| self.triple_color(0, t)).collect(), stats)
+    }
+
+    /// Mean of the three level-`c` exemplar colours at `t`.
+    #[inline]
+    pub fn triple_color(&self, c: usize, t: &Triple) -> [f32; 3] {
+        let mut acc = [0.0f32; 3];
+        for p in 0..3 {
+            let col = self.exemplar.color(p, c, t[p][0], t[p][1]);
+            for ch in 0..3 {
+                acc[ch] += col[ch];
+            }
+        }
+        acc.map(|v| v / 3.0)
+    }
+
+    fn final_at(&self, c: usize, v: [i32; 3]) -> Triple {
+        let m = self.options.block as i32;
+        let b = dual_block(v, m);
+        let o = dual_origin(b, m);
+        let block = self.cache[c].dual.get(&b).expect("dual block computed by the dependency pass");
+        block[local_index(v, o, m)]
+    }
+
+    fn frame_f32(&self, c: usize, v: [i32; 3]) -> [f32; 9] {
+        self.frames.frame(self.lattice.centre(c, v)).map(|x| x as f32)
+    }
+
+    fn wrap(&self, mut t: Triple) -> Triple {
+        for p in 0..3 {
+            let e = &self.exemplar.planes[p];
+            t[p][0] = t[p][0].rem_euclid(e.width as i32);
+            t[p][1] = t[p][1].rem_euclid(e.height as i32);
+        }
+        t
+    }
+
+    /// Version 0 of voxel `v` at level `c`: initialisation or upsampling.
+    fn version0(
+        &self,
+        c: usize,
+        v: [i32; 3],
+        parent_cache: Option<(&[i32; 3], &Arc<Vec<Triple>>)>,
+    ) -> Triple {
+        let levels = self.cache.len();
+        let n = self.exemplar.options.neighbourhood as i32;
+        let h = 1i32 << c;
+        if c + 1 == levels {
+            // Candidate slabs warped by the field in subparts (§4.1).
+            let k = self.options.subpart as i32;
+            let s: [i32; 3] = std::array::from_fn(|a| floor_div(v[a], k));
+            let o: [f64; 3] = std::array::from_fn(|a| (s[a] * k) as f64 + 0.5 * (k - 1) as f64);
+            let rm = self.frames.frame(self.lattice.centre(c, v));
+            let d: [f64; 3] = std::array::from_fn(|a| v[a] as f64 - o[a]);
+            // Local coordinates Rᵀ d.
+            let w: [i32; 3] = std::array::from_fn(|col| {
+                (rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2]).round() as i32
+            });
+            let layer = floor_div(w[2], n);
+            let t = w[2] - layer * n - n / 2;
+            let key = fieldtex_core::rng::mix64(
+                (s[0] as u32 as u64) ^ ((s[1] as u32 as u64) << 21) ^ ((s[2] as u32 as u64) << 42),
+            ) ^ (layer as u32 as u64);
+            let e0 = &self.exemplar.planes[0];
+            let ox = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-slab-x", key)
+                * e0.width as f64) as i32;
+            let oy = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-slab-y", key)
+                * e0.height as f64) as i32;
+            let table = &self.exemplar.triples[c][0];
+            let mut tr = *table.get(w[0] * h + ox, w[1] * h + oy, 0);
+            tr[1][1] += t * h;
+            tr[2][0] += t * h;
+            return self.wrap(tr);
+        }
+        let m = self.options.block as i32;
+        let pv: [i32; 3] = std::array::from_fn(|a| floor_div(v[a], 2));
+        let pb = dual_block(pv, m);
+        let po = dual_origin(pb, m);
+        let parent = match parent_cache {
+            Some((b, blk)) if *b == pb => blk[local_index(pv, po, m)],
+            _ => self.final_at(c + 1, pv),
+        };
+        let rm = self.frames.frame(self.lattice.centre(c + 1, pv));
+        let delta: [f64; 3] = std::array::from_fn(|a| (h * (v[a] - 2 * pv[a])) as f64);
+        let d: [f64; 3] = std::array::from_fn(|col| {
+            rm[col] * delta[0] + rm[3 + col] * delta[1] + rm[6 + col] * delta[2]
+        });
+        let di: [i32; 3] = d.map(|x| x.round() as i32);
+        let mut tr = parent;
+        tr[0][0] += di[0];
+        tr[0][1] += di[1];
+        tr[1][0] += di[1];
+        tr[1][1] += di[2];
+        tr[2][0] += di[2];
+        tr[2][1] += di[0];
+        self.wrap(tr)
+    }
+
+    fn primary_block(&self, c: usize, b: [i32; 3]) -> (Vec<Triple>, Counts) {
+        let m = self.options.block as i32;
+        let r = self.halo();
+        let s = m + 2 * r;
+        let o = primary_origin(b, m);
+        let origin: [i32; 3] = std::array::from_fn(|a| o[a] - r);
+        let mut region = Vec::with_capacity((s * s * s) as usize);
+        let mut last: Option<([i32; 3], Arc<Vec<Triple>>)> = None;
+        for z in 0..s {
+            for y in 0..s {
+                for x in 0..s {
+                    let v = [origin[0] + x, origin[1] + y, origin[2] + z];
+                    if c + 1 < self.cache.len() {
+                        let pb = dual_block(std::array::from_fn(|a| floor_div(v[a], 2)), m);
+                        if last.as_ref().is_none_or(|(lb, _)| *lb != pb) {
+                            last = self.cache[c + 1].dual.get(&pb).map(|blk| (pb, blk.clone()));
+                        }
+                    }
+                    region.push(self.version0(c, v, last.as_ref().map(|(b, k)| (b, k))));
+                }
+            }
+        }
+        let passes = self.primary_passes(c);
+        self.correct(c, origin, s, r, m, &mut region, passes)
+    }
+
+    fn dual_block(&self, c: usize, b: [i32; 3]) -> (Vec<Triple>, Counts) {
+        let m = self.options.block as i32;
+        let r = self.halo();
+        let s = m + 2 * r;
+        let o = dual_origin(b, m);
+        let origin: [i32; 3] = std::array::from_fn(|a| o[a] - r);
+        let mut region = Vec::with_capacity((s * s * s) as usize);
+        let mut last: Option<([i32; 3], Arc<Vec<Triple>>)> = None;
+        for z in 0..s {
+            for y in 0..s {
+                for x in 0..s {
+                    let v = [origin[0] + x, origin[1] + y, origin[2] + z];
+                    let pb = primary_block(v, m);
+                    if last.as_ref().is_none_or(|(lb, _)| *lb != pb) {
+                        let blk =
+                            self.cache[c].primary.get(&pb).expect("primary block computed first");
+                        last = Some((pb, blk.clone()));
+                    }
+                    let (_, blk) = last.as_ref().expect("set above");
+                    region.push(blk[local_index(v, primary_origin(pb, m), m)]);
+                }
+            }
+        }
+        let passes = self.dual_passes(c);
+        self.correct(c, origin, s, r, m, &mut region, passes)
+    }
+
+    fn level_passes(&self, c: usize) -> usize {
+        if c + 1 == self.cache.len() { self.options.coarse_passes } else { self.options.passes }
+    }
+
+    fn primary_passes(&self, c: usize) -> usize {
+        self.level_passes(c).div_ceil(2)
+    }
+
+    fn dual_passes(&self, c: usize) -> usize {
+        self.level_passes(c) / 2
+    }
+
+    /// Corrects the block voxels `[r, r + m)³` of the `s³` region starting at voxel
+    /// `origin` for `passes` passes; returns the block (`m³`, x fastest).
+    #[allow(clippy::too_many_arguments)]
+    fn correct(
+        &self,
+        c: usize,
+        origin: [i32; 3],
+        s: i32,
+        r: i32,
+        m: i32,
+        region: &mut [Triple],
+        passes: usize,
+    ) -> (Vec<Triple>, Counts) {
+        let mut counts = Counts { corrections: 0, evaluations: 0 };
+        let idx = |x: i32, y: i32, z: i32| ((z * s + y) * s + x) as usize;
+        if passes > 0 {
+            let mut colors: Vec<[f32; 3]> =
+                region.iter().map(|t| self.triple_color(c, t)).collect();
+            let mut frames = Vec::with_capacity((m * m * m) as usize);
+            for z in 0..m {
+                for y in 0..m {
+                    for x in 0..m {
+                        let v = [origin[0] + r + x, origin[1] + r + y, origin[2] + r + z];
+                        frames.push(self.frame_f32(c, v));
+                    }
+                }
+            }
+            let mut scratch = Scratch::new(self.exemplar);
+            let subpasses = if self.options.subpasses { 8 } else { 1 };
+            let mut updates: Vec<(usize, Triple)> = Vec::new();
+            for _ in 0..passes {
+                for sub in 0..subpasses {
+                    updates.clear();
+                    for z in 0..m {
+                        for y in 0..m {
+                            for x in 0..m {
+                                let g = [origin[0] + r + x, origin[1] + r + y, origin[2] + r + z];
+                                let class = (g[0] & 1) | ((g[1] & 1) << 1) | ((g[2] & 1) << 2);
+                                if subpasses == 8 && class != sub {
+                                    continue;
+                                }
+                                let f = &frames[((z * m + y) * m + x) as usize];
+                                let at = [x + r, y + r, z + r];
+                                let (best, evals) =
+                                    self.best_candidate(c, region, &colors, s, at, f, &mut scratch);
+                                counts.corrections += 1;
+                                counts.evaluations += evals;
+                                let i = idx(at[0], at[1], at[2]);
+                                if best != region[i] {
+                                    updates.push((i, best));
+                                }
+                            }
+                        }
+                    }
+                    for &(i, t) in &updates {
+                        region[i] = t;
+                        colors[i] = self.triple_color(c, &t);
+                    }
+                }
+            }
+        }
+        let mut out = Vec::with_capacity((m * m * m) as usize);
+        for z in 0..m {
+            for y in 0..m {
+                for x in 0..m {
+                    out.push(region[idx(x + r, y + r, z + r)]);
+                }
+            }
+        }
+        (out, counts)
+    }
+
+    /// The best candidate for the voxel at region position `at` (§4.3).
+    #[allow(clippy::too_many_arguments)]
+    fn best_candidate(
+        &self,
+        c: usize,
+        region: &[Triple],
+        colors: &[[f32; 3]],
+        s: i32,
+        at: [i32; 3],
+        f: &[f32; 9],
+        scratch: &mut Scratch,
+    ) -> (Triple, u64) {
+        let n = self.exemplar.options.neighbourhood as i32;
+        let half = n / 2;
+        let h = 1i32 << c;
+        let idx = |p: [i32; 3]| ((p[2] * s + p[1]) * s + p[0]) as usize;
+        let current = region[idx(at)];
+        scratch.candidates.clear();
+        scratch.candidates.push(current);
+        for p in 0..3 {
+            let (a1, a2) = (p, (p + 1) % 3);
+            let u = [f[a1], f[3 + a1], f[6 + a1]];
+            let w = [f[a2], f[3 + a2], f[6 + a2]];
+            let lvl = &self.exemplar.planes[p].levels[c];
+            let mut k = 0;
+            for t in -half..=half {
+                for ss in -half..=half {
+                    let (sf, tf) = (ss as f32, t as f32);
+                    let q: [i32; 3] =
+                        std::array::from_fn(|a| at[a] + (sf * u[a] + tf * w[a]).round() as i32);
+                    scratch.buf[k..k + 3].copy_from_slice(&colors[idx(q)]);
+                    k += 3;
+                }
+            }
+            let dims = lvl.dims();
+            let dim = scratch.buf.len();
+            for j in 0..dims {
+                let row = &lvl.basis[j * dim..(j + 1) * dim];
+                let mut acc = 0.0f32;
+                for (a, b) in row.iter().zip(&scratch.buf) {
+                    acc += a * b;
+                }
+                scratch.proj[p][j] = acc - lvl.bias[j];
+            }
+            let table = &self.exemplar.triples[c][p];
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if dx == 0 && dy == 0 {
+                        // The voxel's own coordinate: its table entries.
+                        let pix = current[p];
+                        for kk in 0..self.options.k {
+                            scratch.candidates.push(*table.get(pix[0], pix[1], kk));
+                        }
+                        continue;
+                    }
+                    let (xf, yf) = (dx as f32, dy as f32);
+                    let q: [i32; 3] =
+                        std::array::from_fn(|a| at[a] + (xf * u[a] + yf * w[a]).round() as i32);
+                    let nb = region[idx(q)];
+                    let pred = [nb[p][0] - h * dx, nb[p][1] - h * dy];
+                    for kk in 0..self.options.k {
+                        scratch.candidates.push(*table.get(pred[0], pred[1], kk));
+                    }
+                }
+            }
+        }
+        let mut best = (f32::INFINITY, current);
+        for cand in &scratch.candidates {
+            let mut cost = 0.0f32;
+            for p in 0..3 {
+                let e = &self.exemplar.planes[p];
+                let lvl = &e.levels[c];
+                let dims = lvl.dims();
+                let pix = cand[p][1] as usize * e.width + cand[p][0] as usize;
+                let a = &lvl.appearance[pix * dims..(pix + 1) * dims];
+                for j in 0..dims {
+                    let d = a[j] - scratch.proj[p][j];
+                    cost += d * d;
+                }
+            }
+            if cost < best.0 {
+                best = (cost, *cand);
+            }
+        }
+        (best.1, scratch.candidates.len() as u64)
+    }
+}
+
+/// Per-block scratch buffers.
+struct Scratch {
+    buf: Vec<f32>,
+    proj: [[f32; 32]; 3],
+    candidates: Vec<Triple>,
+}
+
+impl Scratch {
+    fn new(e: &SolidExemplar) -> Self {
+        let n = e.options.neighbourhood;
+        Self { buf: vec![0.0; n * n * 3], proj: [[0.0; 32]; 3], candidates: Vec::with_capacity(64) }
+    }
+}
+
+#[inline]
+fn local_index(v: [i32; 3], o: [i32; 3], m: i32) -> usize {
+    (((v[2] - o[2]) * m + (v[1] - o[1])) * m + (v[0] - o[0])) as usize
+}
+
+fn for_box(lo: [i32; 3], hi: [i32; 3], mut f: impl FnMut([i32; 3])) {
+    for z in lo[2]..=hi[2] {
+        for y in lo[1]..=hi[1] {
+            for x in lo[0]..=hi[0] {
+                f([x, y, z]);
+            }
+        }
+    }
+}

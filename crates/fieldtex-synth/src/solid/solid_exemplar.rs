@@ -1,0 +1,286 @@
+//! Exemplar analysis for solid synthesis from 2-D exemplars (Kopf et al. 2007; Dong,
+//! Lefebvre, Tong & Drettakis 2008; paper E §4).
+//!
+//! Three exemplars `I_xy`, `I_yz`, `I_zx` (plane `P` = 0, 1, 2) may be the same image.
+//! Exemplar `P`'s first pixel coordinate runs along local axis `P` and its second along
+//! local axis `(P + 1) % 3` (xy: x, y; yz: y, z; zx: z, x), x right and y down in the
+//! image, toroidal borders. For every plane and synthesis level `c` (spacing `h = 2^c`):
+//!
+//! - the Gaussian stack level `c` ([`crate::gaussian_stack`], the one home of the stack);
+//! - a PCA basis ([`fieldtex_linalg::Pca`]) of the `N × N` RGB neighbourhoods sampled
+//!   `h` apart, and every pixel's projected neighbourhood (the appearance the correction
+//!   compares against; paper E §4.3 "PCA projection … about 20 dimensions per plane",
+//!   here [`SolidAnalysisOptions::pca_dims`], default 8);
+//! - the candidate triples ([`super::candidate_triples`]).
+//!
+//! Identical exemplars share one analysis: the triple search is symmetric under the
+//! cyclic exchange of the planes, so one table serves all three.
+
+use super::candidate_triples::{CandidateTriples, candidate_triples};
+use crate::SynthError;
+use crate::gaussian_stack::next_stack_level;
+use fieldtex_core::{Image, Progress};
+use fieldtex_linalg::Pca;
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Options of [`SolidExemplar::new`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SolidAnalysisOptions {
+    /// Synthesis levels `L` (stack levels `0..L`, coarsest spacing `2^(L−1)`). Default 5.
+    pub levels: usize,
+    /// Neighbourhood side `N` (odd). Default 5 (the paper uses 7 and 9).
+    pub neighbourhood: usize,
+    /// PCA dimensions per plane. Default 8.
+    pub pca_dims: usize,
+    /// Candidate triples kept per pixel, `N_T`. Default 12 (the paper's value).
+    pub triples: usize,
+    /// Pool pixels the crossbar search examines per query (a regular sub-grid of the
+    /// exemplar). Default 1024.
+    pub pool: usize,
+    /// Largest exemplar side accepted. Default 512.
+    pub max_size: usize,
+}
+
+impl Default for SolidAnalysisOptions {
+    fn default() -> Self {
+        Self { levels: 5, neighbourhood: 5, pca_dims: 8, triples: 12, pool: 1024, max_size: 512 }
+    }
+}
+
+/// One plane's exemplar at one level.
+#[derive(Clone, Debug)]
+pub struct PlaneLevel {
+    /// Stack colours, `W × H` RGB (sRGB-encoded, as stored).
+    pub colors: Vec<[f32; 3]>,
+    /// PCA basis of `N × N × 3` neighbourhoods.
+    pub pca: Pca,
+    /// Projected neighbourhood per pixel, `W × H × pca_dims`.
+    pub appearance: Vec<f32>,
+    /// The PCA components as `f32`, `pca_dims × (N² · 3)` row-major, and
+    /// `bias[j] = components[j] · mean`: the projection is `basis x − bias`.
+    pub basis: Vec<f32>,
+    pub bias: Vec<f32>,
+}
+
+impl PlaneLevel {
+    /// PCA dimensions.
+    pub fn dims(&self) -> usize {
+        self.bias.len()
+    }
+}
+
+/// One exemplar image analysed at every level.
+#[derive(Clone, Debug)]
+pub struct PlaneExemplar {
+    pub width: usize,
+    pub height: usize,
+    pub levels: Vec<PlaneLevel>,
+}
+
+/// The analysis of the three plane exemplars (module docs).
+#[derive(Clone, Debug)]
+pub struct SolidExemplar {
+    pub options: SolidAnalysisOptions,
+    /// Plane exemplars (xy, yz, zx); identical images share one `Arc`.
+    pub planes: [Arc<PlaneExemplar>; 3],
+    /// Candidate triples per level (`triples[c]`), for the three planes.
+    pub triples: Vec<[Arc<CandidateTriples>; 3]>,
+    /// Wall time, milliseconds.
+    pub elapsed_ms: f64,
+}
+
+impl SolidExemplar {
+    /// Analyses `exemplars` (xy, yz, zx).
+    pub fn new(
+        exemplars: [&Image; 3],
+        options: &SolidAnalysisOptions,
+        progress: &dyn Progress,
+    ) -> Result<Self, SynthError> {
+        let t0 = std::time::Instant::now();
+        if options.neighbourhood < 3
+            || options.neighbourhood.is_multiple_of(2)
+            || options.neighbourhood > 15
+        {
+            return Err(SynthError::InvalidOption {
+                name: "SolidAnalysisOptions::neighbourhood",
+                value: options.neighbourhood as f64,
+                reason: "must be odd, between 3 and 15",
+            });
+        }
+        if !(1..=8).contains(&options.levels) {
+            return Err(SynthError::InvalidOption {
+                name: "SolidAnalysisOptions::levels",
+                value: options.levels as f64,
+                reason: "must be between 1 and 8",
+            });
+        }
+        if options.pca_dims == 0
+            || options.pca_dims > 32
+            || options.triples == 0
+            || options.triples > 32
+        {
+            return Err(SynthError::InvalidOption {
+                name: "SolidAnalysisOptions::pca_dims/triples",
+                value: options.pca_dims.max(options.triples) as f64,
+                reason: "pca_dims and triples must be between 1 and 32",
+            });
+        }
+        let same = |a: &Image, b: &Image| std::ptr::eq(a, b) || a == b;
+        progress.stage("solid exemplar analysis", 3 * options.levels as u64);
+        let mut planes: Vec<Arc<PlaneExemplar>> = Vec::with_capacity(3);
+        for p in 0..3 {
+            if let Some(q) = (0..p).find(|&q| same(exemplars[q], exemplars[p])) {
+                let shared = planes[q].clone();
+                planes.push(shared);
+                continue;
+            }
+            planes.push(Arc::new(analyse_plane(exemplars[p], options)?));
+        }
+        let planes: [Arc<PlaneExemplar>; 3] =
+            [planes[0].clone(), planes[1].clone(), planes[2].clone()];
+        let all_same = Arc::ptr_eq(&planes[0], &planes[1]) && Arc::ptr_eq(&planes[1], &planes[2]);
+        let mut triples = Vec::with_capacity(options.levels);
+        for c in 0..options.levels {
+            let h = 1usize << c;
+            let levels: [(&PlaneExemplar, &[[f32; 3]]); 3] =
+                std::array::from_fn(|p| (&*planes[p], &planes[p].levels[c].colors[..]));
+            let t0 = Arc::new(candidate_triples(levels, 0, h, options));
+            progress.advance(1);
+            let row = if all_same {
+                // Cyclic symmetry: plane p's table is plane 0's with the coordinates
+                // turned by p places.
+                let turned = |shift: usize| {
+                    let mut t = (*t0).clone();
+                    t.plane = shift;
+                    for tr in &mut t.triples {
+                        let old = *tr;
+                        for q in 0..3 {
+                            tr[(q + shift) % 3] = old[q];
+                        }
+                    }
+                    Arc::new(t)
+                };
+                let (t1, t2) = (turned(1), turned(2));
+                [t0, t1, t2]
+            } else {
+                let t1 = Arc::new(candidate_triples(levels, 1, h, options));
+                let t2 = Arc::new(candidate_triples(levels, 2, h, options));
+                [t0, t1, t2]
+            };
+            progress.advance(2);
+            triples.push(row);
+        }
+        progress.finish_stage();
+        Ok(Self {
+            options: options.clone(),
+            planes,
+            triples,
+            elapsed_ms: t0.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// Finest colour (RGB) of plane `p` at pixel `(x, y)` (wrapped).
+    #[inline]
+    pub fn color(&self, p: usize, c: usize, x: i32, y: i32) -> [f32; 3] {
+        let e = &self.planes[p];
+        let xi = x.rem_euclid(e.width as i32) as usize;
+        let yi = y.rem_euclid(e.height as i32) as usize;
+        e.levels[c].colors[yi * e.width + xi]
+    }
+}
+
+fn analyse_plane(
+    image: &Image,
+    options: &SolidAnalysisOptions,
+) -> Result<PlaneExemplar, SynthError> {
+    let (w, h) = (image.width, image.height);
+    if image.pixels.len() != w * h {
+        return Err(SynthError::ExemplarBufferSize {
+            width: w,
+            height: h,
+            found: image.pixels.len(),
+        });
+    }
+    let min = options.neighbourhood * 2;
+    if w < min || h < min {
+        return Err(SynthError::ExemplarTooSmall { width: w, height: h, min });
+    }
+    if w > options.max_size || h > options.max_size {
+        return Err(SynthError::ExemplarTooLarge { width: w, height: h, max: options.max_size });
+    }
+    for (index, p) in image.pixels.iter().enumerate() {
+        if let Some(&value) = p.iter().take(3).find(|v| !v.is_finite()) {
+            return Err(SynthError::NonFiniteExemplar { index, x: index % w, y: index / w, value });
+        }
+    }
+    let mut colors: Vec<[f32; 3]> = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    let mut levels = Vec::with_capacity(options.levels);
+    for c in 0..options.levels {
+        if c > 0 {
+            colors = next_stack_level(&colors, w, h, c);
+        }
+        let (pca, appearance) = neighbourhood_pca(&colors, w, h, 1 << c, options, c)?;
+        let basis: Vec<f32> = pca.components.iter().flatten().map(|&v| v as f32).collect();
+        let bias: Vec<f32> = pca
+            .components
+            .iter()
+            .map(|comp| comp.iter().zip(&pca.mean).map(|(a, b)| a * b).sum::<f64>() as f32)
+            .collect();
+        levels.push(PlaneLevel { colors: colors.clone(), pca, appearance, basis, bias });
+    }
+    Ok(PlaneExemplar { width: w, height: h, levels })
+}
+
+/// The `N × N × 3` neighbourhood of `(x, y)` sampled `h` apart into `out`; the first
+/// pixel coordinate varies fastest (`out[3 (N t + s) + ch]` for offsets `(s, t)`).
+#[allow(clippy::too_many_arguments)]
+pub fn exemplar_neighbourhood(
+    colors: &[[f32; 3]],
+    w: usize,
+    hgt: usize,
+    h: usize,
+    n: usize,
+    x: usize,
+    y: usize,
+    out: &mut [f32],
+) {
+    let half = (n / 2) as i64;
+    let mut k = 0;
+    for t in -half..=half {
+        let yy = (y as i64 + t * h as i64).rem_euclid(hgt as i64) as usize;
+        for s in -half..=half {
+            let xx = (x as i64 + s * h as i64).rem_euclid(w as i64) as usize;
+            out[k..k + 3].copy_from_slice(&colors[yy * w + xx]);
+            k += 3;
+        }
+    }
+}
+
+fn neighbourhood_pca(
+    colors: &[[f32; 3]],
+    w: usize,
+    hgt: usize,
+    h: usize,
+    options: &SolidAnalysisOptions,
+    level: usize,
+) -> Result<(Pca, Vec<f32>), SynthError> {
+    let n = options.neighbourhood;
+    let dim = n * n * 3;
+    let count = w * hgt;
+    let stride = count.div_ceil(8192).max(1);
+    let picks: Vec<usize> = (0..count).step_by(stride).collect();
+    let mut samples = vec![0.0f32; picks.len() * dim];
+    samples.par_chunks_mut(dim).zip(&picks).for_each(|(row, &p)| {
+        exemplar_neighbourhood(colors, w, hgt, h, n, p % w, p / w, row);
+    });
+    let k = options.pca_dims.min(dim);
+    let pca = Pca::fit(&samples, dim, k).map_err(|source| SynthError::Pca { level, source })?;
+    let mut appearance = vec![0.0f32; count * k];
+    appearance.par_chunks_mut(k).enumerate().for_each(|(p, out)| {
+        let mut buf = vec![0.0f32; dim];
+        exemplar_neighbourhood(colors, w, hgt, h, n, p % w, p / w, &mut buf);
+        pca.project(&buf, out);
+    });
+    Ok((pca, appearance))
+}

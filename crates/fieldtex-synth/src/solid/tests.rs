@@ -1,0 +1,135 @@
+//! On-demand determinism of the solid engine: a voxel's value does not depend on what
+//! else was requested, nor on the thread count.
+
+use super::*;
+use fieldtex_core::{Image, NoProgress};
+
+/// A 32 × 32 exemplar of noisy diagonal stripes (structured, so corrections matter).
+fn exemplar() -> Image {
+    let mut im = Image::new(32, 32, [0.0, 0.0, 0.0, 1.0]);
+    for y in 0..32 {
+        for x in 0..32 {
+            let s = ((x + 2 * y) % 8) as f32 / 8.0;
+            let n = fieldtex_core::rng::hash_unit(7, "test-exemplar", (y * 32 + x) as u64) as f32;
+            im.set(x, y, [0.2 + 0.6 * s, 0.3 + 0.2 * n, 0.8 - 0.5 * s, 1.0]);
+        }
+    }
+    im
+}
+
+/// A bent field: rotation about z by an angle growing along x.
+struct Bent;
+
+impl FrameSource for Bent {
+    fn frame(&self, p: [f64; 3]) -> [f64; 9] {
+        let a = 0.08 * p[0] + 0.03 * p[2];
+        let (s, c) = a.sin_cos();
+        [c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0]
+    }
+}
+
+fn options() -> (SolidAnalysisOptions, SolidSynthesisOptions) {
+    let a = SolidAnalysisOptions { levels: 3, pool: 256, ..Default::default() };
+    let s = SolidSynthesisOptions { block: 6, passes: 2, coarse_passes: 2, ..Default::default() };
+    (a, s)
+}
+
+fn all_voxels(n: i32) -> Vec<[i32; 3]> {
+    let mut v = Vec::new();
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                v.push([x - 3, y + 1, z - 7]);
+            }
+        }
+    }
+    v
+}
+
+#[test]
+fn voxels_are_identical_alone_in_subsets_and_in_the_full_volume() {
+    let img = exemplar();
+    let (ao, so) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let full_set = all_voxels(14);
+    let mut full = SolidSynthesizer::new(&ex, lattice, &Bent, so.clone()).unwrap();
+    let (full_t, stats) = full.triples(&full_set, &NoProgress);
+    assert!(stats.iter().all(|s| s.corrections > 0));
+    // The corrections changed something: not every voxel equals its version 0.
+    let distinct: std::collections::BTreeSet<_> = full_t.iter().map(|t| t[0]).collect();
+    assert!(distinct.len() > 20, "only {} distinct xy coordinates", distinct.len());
+    // Random subsets, each in a fresh synthesizer, and single voxels alone.
+    for trial in 0..3u64 {
+        let picks: Vec<usize> = (0..25)
+            .map(|i| {
+                (fieldtex_core::rng::hash_unit(trial, "subset", i) * full_set.len() as f64) as usize
+            })
+            .collect();
+        let subset: Vec<[i32; 3]> = picks.iter().map(|&i| full_set[i]).collect();
+        let mut fresh = SolidSynthesizer::new(&ex, lattice, &Bent, so.clone()).unwrap();
+        let (t, _) = fresh.triples(&subset, &NoProgress);
+        for (k, &i) in picks.iter().enumerate() {
+            assert_eq!(t[k], full_t[i], "voxel {:?} differs in a subset", full_set[i]);
+        }
+    }
+    let mut alone = SolidSynthesizer::new(&ex, lattice, &Bent, so.clone()).unwrap();
+    let (t, stats_alone) = alone.triples(&[full_set[777]], &NoProgress);
+    assert_eq!(t[0], full_t[777]);
+    // Alone, far fewer finest voxels were computed than for the whole volume.
+    assert!(stats_alone[0].voxels < stats[0].voxels);
+}
+
+#[test]
+fn one_and_two_threads_give_the_same_voxels() {
+    let img = exemplar();
+    let (ao, so) = options();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+            let lattice = VoxelLattice { origin: [0.5, 0.0, -2.0], spacing: 0.7 };
+            let mut s = SolidSynthesizer::new(&ex, lattice, &Bent, so.clone()).unwrap();
+            s.colors(&all_voxels(10), &NoProgress).0
+        })
+    };
+    let a = run(1);
+    let b = run(2);
+    assert!(a.iter().zip(&b).all(|(x, y)| x.map(f32::to_bits) == y.map(f32::to_bits)));
+}
+
+#[test]
+fn candidate_triples_agree_along_their_crossbars() {
+    let img = exemplar();
+    let (ao, _) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    let table = &ex.triples[0][0];
+    // The best triple's crossbar error is no larger than a random triple's on average.
+    let n = ao.neighbourhood as i32;
+    let err = |t: &Triple| {
+        let mut e = 0.0f32;
+        for j in 0..3 {
+            let k = (j + 1) % 3;
+            for s in -(n / 2)..=n / 2 {
+                let a = ex.color(j, 0, t[j][0], t[j][1] + s);
+                let b = ex.color(k, 0, t[k][0] + s, t[k][1]);
+                e += (0..3).map(|ch| (a[ch] - b[ch]).powi(2)).sum::<f32>();
+            }
+        }
+        e
+    };
+    let (mut best, mut random) = (0.0, 0.0);
+    for p in 0..64i32 {
+        let t = *table.get(p % 32, p / 2, 0);
+        assert_eq!(t[0], [p % 32, (p / 2) % 32]);
+        best += err(&t);
+        let q = |i: u64| {
+            (fieldtex_core::rng::hash_unit(3, "rand-triple", p as u64 * 8 + i) * 32.0) as i32
+        };
+        random += err(&[t[0], [q(0), q(1)], [q(2), q(3)]]);
+    }
+    assert!(best < 0.5 * random, "best {best} vs random {random}");
+    // The turned tables index their own plane.
+    assert_eq!(ex.triples[0][1].get(5, 9, 0)[1], [5, 9]);
+    assert_eq!(ex.triples[0][2].get(5, 9, 0)[2], [5, 9]);
+}

@@ -1,0 +1,666 @@
+//! `fieldtex solid`: sketch-guided solid texturing (paper E, Zhang et al. 2010).
+//!
+//! Steps: read and repair the mesh; read the sketch (`fieldtex_fields::sketch`) and
+//! place its curves; the 3-D frame field on a coarse grid over the bounding box
+//! ([`fieldtex_fields::FrameField3d`], each curve added as an edit of the kept factor);
+//! the exemplar analysis and the lazy solid synthesizer
+//! ([`fieldtex_synth::solid`]) over a voxel lattice whose longest side has
+//! `resolution` voxels; the surface shell: an atlas of the mesh, each covered texel
+//! coloured by trilinear interpolation of the eight voxels around its surface point
+//! (only those voxels and their dependency set are synthesised); optional cuts (the
+//! mesh part on the negative side, capped, textured from the same solid, and the cap's
+//! image), the whole volume as NRRD, and the frame field as PLY.
+//!
+//! Cut images: for an axis-aligned plane through a plane of voxel centres the image is
+//! that slice of the grid, one pixel per voxel (of the two other axes the earlier of
+//! x, y, z along columns, the later along rows), alpha 0 where the voxel centre is
+//! outside the mesh; other planes are sampled at voxel spacing (nearest voxel) over the
+//! mesh's extent in the plane.
+
+use crate::outputs::{prepare_out_dir, write_report};
+use crate::pipelines::align::{atlas_carriers, carrier_texture};
+use crate::pipelines::atlas::atlas_options;
+use crate::{Error, Progress, Report, Result};
+use fieldtex_core::{Image, Warning};
+use fieldtex_fields::{FrameField3d, FrameFieldOptions, FrameGrid, Sketch, quaternion};
+use fieldtex_mesh::{Bvh, TriMesh};
+use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
+use fieldtex_synth::solid::{
+    FrameSource, LevelStats, SolidAnalysisOptions, SolidExemplar, SolidSynthesisOptions,
+    SolidSynthesizer, VoxelLattice,
+};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Options of [`solid`].
+#[derive(Debug, Clone, Serialize)]
+pub struct SolidOptions {
+    pub mesh: PathBuf,
+    /// Sketch JSON; `None` = a constant (identity) field, the unguided baseline.
+    pub sketch: Option<PathBuf>,
+    /// Exemplar for all three planes unless a plane has its own.
+    pub exemplar: Option<PathBuf>,
+    pub exemplar_xy: Option<PathBuf>,
+    pub exemplar_yz: Option<PathBuf>,
+    pub exemplar_zx: Option<PathBuf>,
+    /// Voxels along the bounding box's longest side. Default 256.
+    pub resolution: usize,
+    /// Cut planes `[x, y, z, nx, ny, nz]`.
+    pub cuts: Vec<[f64; 6]>,
+    /// Write `volume.nrrd` (the whole grid).
+    pub volume: bool,
+    /// Write `frames.ply`.
+    pub keep: bool,
+    /// Atlas size of `model.glb` and the cut meshes, texels. Default 1024.
+    pub atlas_size: usize,
+    /// Frame-field cells along the bounding box's shortest side. Default 24.
+    pub field_cells: usize,
+    pub analysis: SolidAnalysisOptions,
+    pub synthesis: SolidSynthesisOptions,
+    pub seed: u64,
+}
+
+impl Default for SolidOptions {
+    fn default() -> Self {
+        Self {
+            mesh: PathBuf::new(),
+            sketch: None,
+            exemplar: None,
+            exemplar_xy: None,
+            exemplar_yz: None,
+            exemplar_zx: None,
+            resolution: 256,
+            cuts: Vec::new(),
+            volume: false,
+            keep: false,
+            atlas_size: 1024,
+            field_cells: 24,
+            analysis: SolidAnalysisOptions::default(),
+            synthesis: SolidSynthesisOptions::default(),
+            seed: 1,
+        }
+    }
+}
+
+/// The voxel grid written out: `sizes` voxels from `origin` (centre of voxel 0).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct SolidGrid {
+    pub origin: [f64; 3],
+    pub spacing: f64,
+    pub sizes: [usize; 3],
+}
+
+impl SolidGrid {
+    fn over_box(min: [f64; 3], max: [f64; 3], resolution: usize) -> Self {
+        let ext: [f64; 3] = std::array::from_fn(|a| max[a] - min[a]);
+        let longest = ext.iter().cloned().fold(0.0, f64::max).max(1e-12);
+        let spacing = longest / resolution as f64;
+        let sizes: [usize; 3] =
+            std::array::from_fn(|a| ((ext[a] / spacing).ceil() as usize).max(1));
+        let origin = std::array::from_fn(|a| {
+            0.5 * (min[a] + max[a]) - 0.5 * (sizes[a] - 1) as f64 * spacing
+        });
+        Self { origin, spacing, sizes }
+    }
+
+    fn len(&self) -> usize {
+        self.sizes.iter().product()
+    }
+}
+
+/// The frame field as the synthesis sees it (rotation matrices).
+struct FieldFrames<'a>(Option<&'a FrameField3d>);
+
+impl FrameSource for FieldFrames<'_> {
+    fn frame(&self, p: [f64; 3]) -> [f64; 9] {
+        match self.0 {
+            Some(f) => quaternion::to_matrix(f.frame_at(p)),
+            None => quaternion::to_matrix(quaternion::IDENTITY),
+        }
+    }
+}
+
+/// Quantises an sRGB colour to bytes exactly as the PNG writer does.
+fn rgb8(c: [f32; 3]) -> [u8; 3] {
+    c.map(|v| if v.is_nan() { 0 } else { (v.clamp(0.0, 1.0) * 255.0).round() as u8 })
+}
+
+/// Running totals of the synthesis work, for the report.
+#[derive(Default, Serialize)]
+struct Work {
+    requested: u64,
+    computed_finest: u64,
+    computed_all_levels: u64,
+    corrections: u64,
+    seconds: f64,
+}
+
+impl Work {
+    fn add(&mut self, requested: usize, stats: &[LevelStats], seconds: f64) {
+        self.requested += requested as u64;
+        self.computed_finest += stats.first().map_or(0, |s| s.voxels);
+        self.computed_all_levels += stats.iter().map(|s| s.voxels).sum::<u64>();
+        self.corrections += stats.iter().map(|s| s.corrections).sum::<u64>();
+        self.seconds += seconds;
+    }
+}
+
+/// Runs `fieldtex solid` into `out_dir` (module docs).
+pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) -> Result<Report> {
+    let aopts = atlas_options(options.atlas_size, 4)?;
+    if !(8..=2048).contains(&options.resolution) {
+        return Err(Error::bad_input(
+            None,
+            format!("--resolution must be in 8..=2048, got {}", options.resolution),
+        ));
+    }
+    let mut report =
+        Report::new("solid", options.seed, serde_json::to_value(options).unwrap_or_default());
+    let (mesh, inputs) = read_inputs(options, &mut report)?;
+    let exemplars = read_exemplars(options)?;
+    prepare_out_dir(out_dir)?;
+    let input_refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    for name in ["model.glb", "preview.png", "report.json", "volume.nrrd", "frames.ply"] {
+        fieldtex_io::ensure_not_input(&out_dir.join(name), &input_refs)?;
+    }
+    let bbox = mesh
+        .bounding_box()
+        .ok_or_else(|| Error::bad_input(Some(&options.mesh), "the mesh has no vertex"))?;
+    // 1. Sketch and frame field (§3).
+    let (field, curves) = report
+        .time("frame_field", || frame_field(&mesh, bbox.min, bbox.max, options, &mut Vec::new()))?;
+    if let Some(f) = &field {
+        let errs = f.constraint_errors_deg();
+        let max = errs.iter().cloned().fold(0.0, f64::max);
+        let mean = errs.iter().sum::<f64>() / errs.len().max(1) as f64;
+        report.metric(
+            "frame_field",
+            serde_json::json!({
+                "grid": f.grid(),
+                "curves": curves.len(),
+                "constrained_nodes": errs.len(),
+                "alignment_error_max_deg": max,
+                "alignment_error_mean_deg": mean,
+            }),
+        );
+        let edit_ms = report.time("frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
+        report.metric("frame_field_edit_ms", edit_ms);
+    }
+    // 2. Exemplar analysis and the synthesizer.
+    let ex = report
+        .time("exemplar_analysis", || {
+            SolidExemplar::new(
+                [&exemplars[0], &exemplars[1], &exemplars[2]],
+                &options.analysis,
+                progress,
+            )
+        })
+        .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
+    let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
+    report.metric("grid", grid);
+    let frames = FieldFrames(field.as_ref());
+    let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
+    let mut synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
+        .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?;
+    // 3. Surface shell → atlas texture → model.glb.
+    let (atlas_mesh, texture, shell) =
+        report.time("shell", || textured_atlas(&mesh, &aopts, &grid, &mut synth, progress))?;
+    report.metric("shell", &shell);
+    report.metric(
+        "shell_voxels_per_second",
+        shell.computed_all_levels as f64 / shell.seconds.max(1e-9),
+    );
+    report.metric("shell_share_of_full_volume", shell.computed_finest as f64 / grid.len() as f64);
+    report.time("write", || super::write_model(out_dir, &atlas_mesh, Some(&texture)))?;
+    let preview = report.time("preview", || preview_with_curves(&atlas_mesh, &texture, &curves));
+    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    // 4. Cuts.
+    let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+    let mut cut_reports = Vec::new();
+    for (i, cut) in options.cuts.iter().enumerate() {
+        let r = report.time(&format!("cut_{}", i + 1), || {
+            write_cut(out_dir, i + 1, *cut, &mesh, &bvh, &aopts, &grid, &mut synth, progress)
+        })?;
+        cut_reports.push(r);
+    }
+    report.metric("cuts", cut_reports);
+    // 5. Volume and frames.
+    if options.volume {
+        let w = report.time("volume", || write_volume(out_dir, &grid, &mut synth, progress))?;
+        report.metric("volume", w);
+    }
+    if options.keep
+        && let Some(f) = &field
+    {
+        write_frames(&out_dir.join("frames.ply"), f)?;
+    }
+    report.metric("cached_voxels_per_level", synth.cached_voxels());
+    report.notes.extend(notes(options));
+    write_report(out_dir, &report)?;
+    Ok(report)
+}
+
+fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, Vec<PathBuf>)> {
+    let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
+    report.warnings.extend(loaded.warnings.iter().cloned());
+    let repaired = report.time("repair", || {
+        fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default())
+    });
+    for c in &repaired.changes {
+        report.warnings.push(Warning::new(
+            format!("repair:{}", c.code),
+            format!("{} ({})", c.message, c.count),
+        ));
+    }
+    report.warnings.extend(repaired.warnings.iter().cloned());
+    if repaired.mesh.triangles.is_empty() {
+        return Err(Error::bad_input(
+            Some(&options.mesh),
+            "no usable triangle is left after repair",
+        ));
+    }
+    let mut inputs = vec![options.mesh.clone()];
+    inputs.extend(options.sketch.iter().cloned());
+    inputs.extend(
+        [&options.exemplar, &options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx]
+            .into_iter()
+            .flatten()
+            .cloned(),
+    );
+    report.input = serde_json::json!({
+        "mesh": options.mesh,
+        "vertices": repaired.mesh.n_vertices(),
+        "triangles": repaired.mesh.n_triangles(),
+    });
+    Ok((repaired.mesh, inputs))
+}
+
+fn read_exemplars(options: &SolidOptions) -> Result<[Image; 3]> {
+    let planes = [&options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx];
+    let mut out = Vec::with_capacity(3);
+    let mut cache: Vec<(PathBuf, Image)> = Vec::new();
+    for (p, own) in planes.iter().enumerate() {
+        let path = own.as_ref().or(options.exemplar.as_ref()).ok_or_else(|| {
+            Error::bad_input(
+                None,
+                format!(
+                    "no exemplar for plane {}: pass --exemplar E (or --exemplar-{})",
+                    ["xy", "yz", "zx"][p],
+                    ["xy", "yz", "zx"][p]
+                ),
+            )
+        })?;
+        if let Some((_, im)) = cache.iter().find(|(q, _)| q == path) {
+            out.push(im.clone());
+            continue;
+        }
+        let im = fieldtex_io::read_image(path)?;
+        cache.push((path.clone(), im.clone()));
+        out.push(im);
+    }
+    Ok([out[0].clone(), out[1].clone(), out[2].clone()])
+}
+
+/// The frame field of the sketch (`None` without a sketch) and the placed curves.
+fn frame_field(
+    mesh: &TriMesh,
+    min: [f64; 3],
+    max: [f64; 3],
+    options: &SolidOptions,
+    _warnings: &mut Vec<Warning>,
+) -> Result<(Option<FrameField3d>, Vec<fieldtex_fields::FrameCurve>)> {
+    let Some(path) = &options.sketch else { return Ok((None, Vec::new())) };
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::bad_input(Some(path), format!("cannot read the sketch: {e}")))?;
+    let sketch: Sketch = serde_json::from_str(&text).map_err(|e| {
+        Error::bad_input(
+            Some(path),
+            format!("the sketch is not valid JSON for the schema in docs/solid.md: {e}"),
+        )
+    })?;
+    let curves =
+        sketch.frame_curves(mesh).map_err(|e| Error::bad_input(Some(path), e.to_string()))?;
+    let grid = FrameGrid::over_box(min, max, options.field_cells)
+        .map_err(|e| Error::bad_input(None, format!("--field-cells: {e}")))?;
+    let mut field = FrameField3d::new(grid, FrameFieldOptions::default())
+        .map_err(|e| Error::Internal(e.to_string()))?;
+    for (i, c) in curves.iter().enumerate() {
+        field.add_curve(c).map_err(|e| Error::bad_input(Some(path), format!("curve {i}: {e}")))?;
+    }
+    Ok((Some(field), curves))
+}
+
+/// Interactive edit timings: the curves added one by one into a fresh field (the first
+/// factors), then the last curve removed and added again (downdate + update + solve).
+fn edit_timing(
+    grid: FrameGrid,
+    curves: &[fieldtex_fields::FrameCurve],
+) -> Result<serde_json::Value> {
+    let mut field = FrameField3d::new(grid, FrameFieldOptions::default())
+        .map_err(|e| Error::Internal(e.to_string()))?;
+    let mut add_ms = Vec::new();
+    let mut last = 0;
+    for c in curves {
+        let t = Instant::now();
+        last = field.add_curve(c).map_err(|e| Error::Internal(e.to_string()))?;
+        add_ms.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let t = Instant::now();
+    field.remove_curve(last).map_err(|e| Error::Internal(e.to_string()))?;
+    let remove_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    if let Some(c) = curves.last() {
+        field.add_curve(c).map_err(|e| Error::Internal(e.to_string()))?;
+    }
+    let readd_ms = t.elapsed().as_secs_f64() * 1e3;
+    Ok(serde_json::json!({"add_ms": add_ms, "remove_ms": remove_ms, "re_add_ms": readd_ms}))
+}
+
+/// Eight voxels and trilinear weights around world point `p`.
+fn trilinear(grid: &SolidGrid, p: [f64; 3]) -> [([i32; 3], f32); 8] {
+    let t: [f64; 3] = std::array::from_fn(|a| (p[a] - grid.origin[a]) / grid.spacing);
+    let b: [i32; 3] = t.map(|x| x.floor() as i32);
+    let f: [f64; 3] = std::array::from_fn(|a| t[a] - b[a] as f64);
+    std::array::from_fn(|c| {
+        let d = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
+        let w: f64 = (0..3).map(|a| if d[a] == 1 { f[a] } else { 1.0 - f[a] }).product();
+        ([b[0] + d[0] as i32, b[1] + d[1] as i32, b[2] + d[2] as i32], w as f32)
+    })
+}
+
+/// Colours of surface points by trilinear interpolation of the solid.
+fn surface_colors(
+    points: &[[f64; 3]],
+    grid: &SolidGrid,
+    synth: &mut SolidSynthesizer<'_>,
+    progress: &dyn Progress,
+    work: &mut Work,
+) -> Vec<[f32; 4]> {
+    let corners: Vec<[([i32; 3], f32); 8]> = points.iter().map(|&p| trilinear(grid, p)).collect();
+    let mut voxels: Vec<[i32; 3]> =
+        corners.iter().flat_map(|c| c.iter().map(|(v, _)| *v)).collect();
+    voxels.sort_unstable();
+    voxels.dedup();
+    let t = Instant::now();
+    let (rgb, stats) = synth.colors(&voxels, progress);
+    work.add(voxels.len(), &stats, t.elapsed().as_secs_f64());
+    corners
+        .iter()
+        .map(|c| {
+            let mut acc = [0.0f32; 3];
+            for (v, w) in c {
+                let i = voxels.binary_search(v).expect("requested above");
+                for ch in 0..3 {
+                    acc[ch] += w * rgb[i][ch];
+                }
+            }
+            [acc[0], acc[1], acc[2], 1.0]
+        })
+        .collect()
+}
+
+/// An atlas of `mesh` whose texels carry the solid's colour at their surface points.
+fn textured_atlas(
+    mesh: &TriMesh,
+    aopts: &fieldtex_param::AtlasOptions,
+    grid: &SolidGrid,
+    synth: &mut SolidSynthesizer<'_>,
+    progress: &dyn Progress,
+) -> Result<(TriMesh, Image, Work)> {
+    let atlas = fieldtex_param::build_atlas(mesh, aopts, progress)
+        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+    let size = aopts.resolution as usize;
+    let map = fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
+        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+    let (covered, _) = atlas_carriers(&map);
+    let points: Vec<[f64; 3]> =
+        covered.iter().filter_map(|&i| map.surface_point(&atlas.mesh, i)).collect();
+    if points.len() != covered.len() {
+        return Err(Error::Internal("a covered texel has no surface point".into()));
+    }
+    let mut work = Work::default();
+    let colors = surface_colors(&points, grid, synth, progress, &mut work);
+    let (texture, _) = carrier_texture(&map, &covered, &colors);
+    Ok((atlas.mesh, texture, work))
+}
+
+fn preview_with_curves(
+    mesh: &TriMesh,
+    texture: &Image,
+    curves: &[fieldtex_fields::FrameCurve],
+) -> Image {
+    let mut scene = Scene::new(mesh).with_texture(texture);
+    for c in curves {
+        scene = scene.with_overlay(Overlay::Polyline(
+            Polyline3::new(c.points.clone()).with_color([0.9, 0.15, 0.1, 1.0]),
+        ));
+    }
+    render(&scene, &RenderOptions { size: 800, ..Default::default() })
+}
+
+/// The axis and voxel index of an axis-aligned plane through voxel centres, if `cut` is one.
+fn grid_slice(grid: &SolidGrid, cut: [f64; 6]) -> Option<(usize, usize)> {
+    let n = [cut[3], cut[4], cut[5]];
+    let axis = (0..3).find(|&a| n[a] != 0.0 && (0..3).all(|b| b == a || n[b] == 0.0))?;
+    let t = (cut[axis] - grid.origin[axis]) / grid.spacing;
+    let k = t.round();
+    ((t - k).abs() < 1e-6 && k >= 0.0 && (k as usize) < grid.sizes[axis])
+        .then_some((axis, k as usize))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_cut(
+    out_dir: &Path,
+    index: usize,
+    cut: [f64; 6],
+    mesh: &TriMesh,
+    bvh: &Bvh,
+    aopts: &fieldtex_param::AtlasOptions,
+    grid: &SolidGrid,
+    synth: &mut SolidSynthesizer<'_>,
+    progress: &dyn Progress,
+) -> Result<serde_json::Value> {
+    let point = [cut[0], cut[1], cut[2]];
+    let normal = [cut[3], cut[4], cut[5]];
+    let pc = fieldtex_mesh::cut_with_plane(mesh, point, normal).ok_or_else(|| {
+        Error::bad_input(None, format!("--cut {index}: the normal must not be zero"))
+    })?;
+    if pc.mesh.triangles.is_empty() {
+        return Err(Error::bad_input(
+            None,
+            format!("--cut {index}: the plane leaves nothing of the mesh on its negative side"),
+        ));
+    }
+    // The cap image: one pixel per voxel of the plane.
+    let scale = mesh.bounding_box().map_or(1.0, |b| b.diagonal());
+    let t0 = Instant::now();
+    let mut work = Work::default();
+    let (image, exact) = match grid_slice(grid, cut) {
+        Some((axis, k)) => {
+            let (a1, a2) = match axis {
+                0 => (1, 2),
+                1 => (0, 2),
+                _ => (0, 1),
+            };
+            let (w, h) = (grid.sizes[a1], grid.sizes[a2]);
+            let mut voxels = Vec::with_capacity(w * h);
+            for row in 0..h {
+                for col in 0..w {
+                    let mut v = [0i32; 3];
+                    v[axis] = k as i32;
+                    v[a1] = col as i32;
+                    v[a2] = row as i32;
+                    voxels.push(v);
+                }
+            }
+            (slice_image(&voxels, w, h, grid, bvh, scale, synth, progress, &mut work), true)
+        }
+        None => {
+            let len =
+                (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
+            let n = normal.map(|x| x / len);
+            let helper = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+            let e1 = unit(cross(helper, n));
+            let e2 = cross(n, e1);
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for p in &pc.mesh.positions {
+                let d = [p[0] - point[0], p[1] - point[1], p[2] - point[2]];
+                let uv = [dot(d, e1), dot(d, e2)];
+                for a in 0..2 {
+                    lo[a] = lo[a].min(uv[a]);
+                    hi[a] = hi[a].max(uv[a]);
+                }
+            }
+            let w = (((hi[0] - lo[0]) / grid.spacing).ceil() as usize).clamp(1, 4096);
+            let h = (((hi[1] - lo[1]) / grid.spacing).ceil() as usize).clamp(1, 4096);
+            let mut voxels = Vec::with_capacity(w * h);
+            for row in 0..h {
+                for col in 0..w {
+                    let (u, v) = (
+                        lo[0] + (col as f64 + 0.5) * grid.spacing,
+                        lo[1] + (row as f64 + 0.5) * grid.spacing,
+                    );
+                    let p: [f64; 3] = std::array::from_fn(|a| point[a] + u * e1[a] + v * e2[a]);
+                    voxels.push(std::array::from_fn(|a| {
+                        ((p[a] - grid.origin[a]) / grid.spacing).round() as i32
+                    }));
+                }
+            }
+            (slice_image(&voxels, w, h, grid, bvh, scale, synth, progress, &mut work), false)
+        }
+    };
+    let image_seconds = t0.elapsed().as_secs_f64();
+    fieldtex_io::write_png(&out_dir.join(format!("cut-{index}.png")), &image)?;
+    // The capped mesh, textured from the same solid.
+    let (atlas_mesh, texture, mesh_work) = textured_atlas(&pc.mesh, aopts, grid, synth, progress)?;
+    super::write_model_named(out_dir, &format!("cut-{index}.glb"), &atlas_mesh, &texture)?;
+    Ok(serde_json::json!({
+        "plane": cut,
+        "grid_slice": exact,
+        "image_size": [image.width, image.height],
+        "image_seconds": image_seconds,
+        "image_voxels_requested": work.requested,
+        "image_voxels_computed_finest": work.computed_finest,
+        "image_voxels_per_second": work.computed_all_levels as f64 / work.seconds.max(1e-9),
+        "cap_loops": pc.loops,
+        "open_chains": pc.open_chains,
+        "forced_clips": pc.forced_clips,
+        "mesh_triangles": pc.mesh.triangles.len(),
+        "cap_triangles": pc.mesh.triangles.len() - pc.cap_start,
+        "mesh_texture": mesh_work,
+    }))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn slice_image(
+    voxels: &[[i32; 3]],
+    w: usize,
+    h: usize,
+    grid: &SolidGrid,
+    bvh: &Bvh,
+    scale: f64,
+    synth: &mut SolidSynthesizer<'_>,
+    progress: &dyn Progress,
+    work: &mut Work,
+) -> Image {
+    let centres: Vec<[f64; 3]> = voxels
+        .iter()
+        .map(|v| std::array::from_fn(|a| grid.origin[a] + v[a] as f64 * grid.spacing))
+        .collect();
+    let inside = fieldtex_mesh::points_inside(bvh, &centres, scale);
+    let wanted: Vec<[i32; 3]> =
+        voxels.iter().zip(&inside).filter(|(_, i)| **i).map(|(v, _)| *v).collect();
+    let t = Instant::now();
+    let (rgb, stats) = synth.colors(&wanted, progress);
+    work.add(wanted.len(), &stats, t.elapsed().as_secs_f64());
+    let mut image = Image::new(w, h, [0.0; 4]);
+    let mut k = 0;
+    for (i, ins) in inside.iter().enumerate() {
+        if *ins {
+            let c = rgb8(rgb[k]);
+            image.pixels[i] = [c[0] as f32 / 255.0, c[1] as f32 / 255.0, c[2] as f32 / 255.0, 1.0];
+            k += 1;
+        }
+    }
+    image
+}
+
+fn write_volume(
+    out_dir: &Path,
+    grid: &SolidGrid,
+    synth: &mut SolidSynthesizer<'_>,
+    progress: &dyn Progress,
+) -> Result<Work> {
+    let [nx, ny, nz] = grid.sizes;
+    let mut data = Vec::with_capacity(3 * grid.len());
+    let mut work = Work::default();
+    // Slab by slab along z keeps the request lists small; the cache makes it one pass.
+    for z in 0..nz {
+        let mut voxels = Vec::with_capacity(nx * ny);
+        for y in 0..ny {
+            for x in 0..nx {
+                voxels.push([x as i32, y as i32, z as i32]);
+            }
+        }
+        let t = Instant::now();
+        let (rgb, stats) = synth.colors(&voxels, progress);
+        work.add(voxels.len(), &stats, t.elapsed().as_secs_f64());
+        data.extend(rgb.iter().flat_map(|c| rgb8(*c)));
+    }
+    let volume = fieldtex_io::RgbVolume {
+        sizes: grid.sizes,
+        origin: grid.origin,
+        spacing: grid.spacing,
+        data,
+    };
+    fieldtex_io::write_nrrd_rgb(&out_dir.join("volume.nrrd"), &volume)?;
+    Ok(work)
+}
+
+fn write_frames(path: &Path, field: &FrameField3d) -> Result<()> {
+    let grid = field.grid();
+    let positions: Vec<[f64; 3]> = (0..grid.len()).map(|i| grid.position(i)).collect();
+    let mut props: Vec<(String, Vec<f32>)> = Vec::new();
+    for (a, name) in ["x", "y", "z"].iter().enumerate() {
+        let axes: Vec<[f64; 3]> =
+            field.frames().iter().map(|q| quaternion::axis_of(*q, a)).collect();
+        for (c, comp) in ["x", "y", "z"].iter().enumerate() {
+            props.push((format!("axis{name}_{comp}"), axes.iter().map(|v| v[c] as f32).collect()));
+        }
+    }
+    let refs: Vec<(&str, &[f32])> = props.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    fieldtex_io::write_point_ply(path, &positions, &refs)?;
+    Ok(())
+}
+
+fn notes(options: &SolidOptions) -> Vec<String> {
+    let mut n = vec![
+        "candidate triples: the partners of each pixel are searched by brute force over a regular sub-grid pool of the other exemplars (SolidAnalysisOptions::pool), not Dong 2008's full search; Dong's neighbour-consistency test is not applied".to_string(),
+        "correction neighbourhoods are sampled at the nearest voxel on every level (the paper uses trilinear sampling and integration along the field on coarse levels)".to_string(),
+        format!(
+            "neighbourhood N = {} on every level and {} PCA dimensions per plane (the paper: N = 7 coarse / 9 fine, about 20 dimensions)",
+            options.analysis.neighbourhood, options.analysis.pca_dims
+        ),
+        "the coarsest level uses the same block (dual-grid) scheme as the others, with more passes, so that every level is lazy; the paper corrects the whole coarsest level without barriers".to_string(),
+        "a voxel's colour is the mean of the three exemplar colours at its coordinate triple; no feature channel (bricks) and no interior regions (--interior) are implemented".to_string(),
+        "the surface texture interpolates the eight voxels around each texel's surface point (trilinear)".to_string(),
+    ];
+    if options.sketch.is_none() {
+        n.push("no sketch: a constant (identity) frame field, the unguided baseline".into());
+    }
+    n
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let l = dot(a, a).sqrt();
+    a.map(|x| x / l)
+}
