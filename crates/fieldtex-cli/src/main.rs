@@ -4,8 +4,8 @@
 
 mod conformal_command;
 mod progress_bar;
-mod transfer_command;
 mod solid_command;
+mod transfer_command;
 
 use clap::{Args, Parser, Subcommand};
 use fieldtex::Error;

@@ -73,10 +73,10 @@ mod repair_tests;
 mod test_fixtures;
 pub use bvh::{Bvh, ClosestPoint, Hit, Ray};
 pub use directional_occlusion::{DirectionalOcclusionOptions, directional_occlusion_sh};
+pub use plane_cut::{PlaneCut, cut_with_plane};
+pub use point_inside::points_inside;
 pub use poisson_disk_sampling::{
     PoissonDiskOptions, PoissonDiskSamples, SurfaceSample, poisson_disk_sampling,
 };
-pub use solid_angle_curvature::{OrientedPoint, SolidAngleOptions, solid_angle_curvature};
-pub use plane_cut::{PlaneCut, cut_with_plane};
-pub use point_inside::points_inside;
 pub use polygon_triangulation::triangulate_polygons;
+pub use solid_angle_curvature::{OrientedPoint, SolidAngleOptions, solid_angle_curvature};

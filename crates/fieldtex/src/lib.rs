@@ -37,10 +37,10 @@ pub use pipelines::field::{FieldCommandOptions, FieldSummary, field_file};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
 pub use pipelines::orient::{DesignedSingularity, FieldSource, OrientOptions, orient};
 pub use pipelines::render::{RenderCommandOptions, render_file};
+pub use pipelines::solid::{SolidGrid, SolidOptions, solid};
 pub use pipelines::transfer as pipelines_transfer;
 pub use pipelines::transfer::{TransferCommandOptions, transfer_files};
 pub use pipelines::transfer_fidelity::transfer_fidelity_files;
-pub use pipelines::solid::{SolidGrid, SolidOptions, solid};
 pub use report::Report;
 
 /// The algorithm crates, re-exported for library users.
