@@ -108,6 +108,18 @@ fn torus_and_tube_end_to_end_deterministic() {
             "{f} differs between 1 and 2 threads"
         );
     }
+    // Valid glTF (Khronos validator, installed by scripts/test).
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
+    assert!(
+        validator.join("node_modules/gltf-validator").is_dir(),
+        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
+    );
+    let v = Command::new("node")
+        .arg(validator.join("validate.js"))
+        .arg(o1.join("model.glb"))
+        .output()
+        .expect("run node");
+    assert!(v.status.success(), "validator: {}", String::from_utf8_lossy(&v.stdout));
     let r = report(&o1);
     let c = &r["metrics"]["components"][0];
     assert_eq!(c["genus"], 1);
