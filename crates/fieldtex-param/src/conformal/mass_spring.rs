@@ -151,6 +151,9 @@ pub fn relax(
     }
     springs.sort_by_key(|a| (a.0, a.1));
     springs.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    if springs.is_empty() {
+        return MassSpringStats { before, after: before, iterations: 0, frozen_moves: 0 };
+    }
     let nv = mesh.n_vertices();
     let mut phi = map.base.clone();
     let corners_of = |phi: &[[f64; 2]], f: usize| -> [[f64; 2]; 3] {
