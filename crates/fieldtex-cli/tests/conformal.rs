@@ -108,6 +108,18 @@ fn torus_and_tube_end_to_end_deterministic() {
             "{f} differs between 1 and 2 threads"
         );
     }
+    // Valid glTF (Khronos validator, installed by scripts/test).
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
+    assert!(
+        validator.join("node_modules/gltf-validator").is_dir(),
+        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
+    );
+    let v = Command::new("node")
+        .arg(validator.join("validate.js"))
+        .arg(o1.join("model.glb"))
+        .output()
+        .expect("run node");
+    assert!(v.status.success(), "validator: {}", String::from_utf8_lossy(&v.stdout));
     let r = report(&o1);
     let c = &r["metrics"]["components"][0];
     assert_eq!(c["genus"], 1);
@@ -174,4 +186,40 @@ fn bad_inputs_exit_2() {
         "--quiet",
     ]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// Zero points on the shared meshes: rocker-arm (genus 1) has none, fertility (genus 4)
+/// has 2g − 2 = 6 (Wang et al. 2005 §3), and neither map flips a triangle.
+#[test]
+fn zero_points_of_shared_meshes() {
+    let ex = shared().join("exemplars/pebbles_Rocks002.png");
+    for (name, genus, zeros) in [("rocker-arm", 1u64, 0u64), ("fertility", 4, 6)] {
+        let d = tmp(name);
+        let mesh = shared().join(format!("meshes/{name}.obj"));
+        let out = run(&[
+            "conformal",
+            "--mesh",
+            mesh.to_str().unwrap(),
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--out",
+            d.to_str().unwrap(),
+            "--size",
+            "256",
+            "--quiet",
+        ]);
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let r = report(&d);
+        let c = &r["metrics"]["components"][0];
+        assert_eq!(c["genus"].as_u64(), Some(genus), "{name}");
+        let z: i64 = c["zero_point_indices"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|z| z["index"].as_i64().unwrap())
+            .sum();
+        assert_eq!(c["zero_points"].as_u64(), Some(zeros), "{name}: {:?}", c["zero_point_indices"]);
+        assert_eq!(z, -(zeros as i64), "{name}: zero-point indices sum to 2 − 2g");
+        assert_eq!(r["metrics"]["distortion_all_faces"]["flipped_triangles"], 0, "{name}");
+    }
 }

@@ -100,3 +100,29 @@ pub fn feature_size_variation(
         triangles: n,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fieldtex_mesh::CornerUvs;
+
+    /// A unit square textured by stripes of period 16 texels over a 256² texture: the
+    /// estimate is within 20 % of the true period (1/16 surface units) with a small CV.
+    #[test]
+    fn stripes_have_their_period() {
+        let mut mesh = fieldtex_mesh::primitives::grid(8, 8, 1.0, 1.0);
+        let values: Vec<[f64; 2]> = mesh.positions.iter().map(|p| [p[0], p[1]]).collect();
+        mesh.uvs = Some(CornerUvs { values, indices: mesh.triangles.clone() });
+        let mut tex = Image::new(256, 256, [0.0; 4]);
+        for y in 0..256 {
+            for x in 0..256 {
+                let v = 0.5 + 0.4 * (x as f32 * std::f32::consts::TAU / 16.0).sin();
+                tex.set(x, y, [v, v, v, 1.0]);
+            }
+        }
+        let s = feature_size_variation(&mesh, &tex, 24).unwrap();
+        assert!(s.triangles > 20);
+        assert!((s.mean_period - 1.0 / 16.0).abs() < 0.2 / 16.0, "{s:?}");
+        assert!(s.cv < 0.1, "{s:?}");
+    }
+}

@@ -169,7 +169,8 @@ pub fn quilt(
             let ok: Vec<usize> = (0..cands.len())
                 .filter(|&k| errors[k] <= best * (1.0 + options.tolerance) + 1e-12)
                 .collect();
-            let (cx, cy) = cands[ok[rng.random_range(0..ok.len())]];
+            let pick = if ok.is_empty() { 0 } else { ok[rng.random_range(0..ok.len())] };
+            let (cx, cy) = cands[pick];
             let patch = |dx: usize, dy: usize| {
                 let p = ex.get((cx + dx).min(ex.width - 1), (cy + dy).min(ex.height - 1));
                 [p[0], p[1], p[2]]

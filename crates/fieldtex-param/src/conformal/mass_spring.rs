@@ -11,7 +11,10 @@
 //! substitute for the unbalanced form). The step is `ε = κ h / max|F|` (`h` the median
 //! parameter edge length): inversely proportional to the largest force as in the
 //! paper. A vertex whose move would flip (or collapse) a triangle keeps its position for
-//! that step, so no triangle ever flips. Lattice translations (the periods) are kept, so
+//! that step, so no triangle ever flips. Each move is also capped at `κ` times the
+//! vertex's shortest parameter edge (our addition, so compressed regions move at their
+//! own scale); when the refusals do not settle within a few
+//! passes the step is dropped and `κ` halved. Lattice translations (the periods) are kept, so
 //! periodic images stay periodic. Sequential and deterministic.
 #![allow(clippy::needless_range_loop)] // index loops over parallel per-face tables
 
@@ -36,7 +39,7 @@ pub struct MassSpringOptions {
 
 impl Default for MassSpringOptions {
     fn default() -> Self {
-        Self { iterations: 400, step: 0.1, max_angle_distortion: 1.25 }
+        Self { iterations: 1500, step: 0.05, max_angle_distortion: 1.25 }
     }
 }
 
@@ -148,6 +151,9 @@ pub fn relax(
     }
     springs.sort_by_key(|a| (a.0, a.1));
     springs.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    if springs.is_empty() {
+        return MassSpringStats { before, after: before, iterations: 0, frozen_moves: 0 };
+    }
     let nv = mesh.n_vertices();
     let mut phi = map.base.clone();
     let corners_of = |phi: &[[f64; 2]], f: usize| -> [[f64; 2]; 3] {
@@ -177,6 +183,7 @@ pub fn relax(
     }
     let area0: Vec<f64> = (0..n_faces).map(|f| signed_area(&corners_of(&phi, f))).collect();
     let mut frozen_moves = 0usize;
+    let mut kappa = options.step;
     let mut iterations = 0;
     let mut checkpoint = (phi.clone(), 0usize);
     let apex_flags: Vec<bool> = map.apex.iter().map(|x| x.is_some()).collect();
@@ -222,11 +229,25 @@ pub fn relax(
         let mid = sorted.len() / 2;
         sorted.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
         let h = sorted[mid];
-        let eps = options.step * h / max_f;
+        let eps = kappa * h / max_f;
+        // Each move is also at most κ times the vertex's shortest parameter edge, so
+        // small (compressed) regions move in proportion to their own size.
+        let mut hv = vec![f64::INFINITY; nv];
+        for (sp, &(i, j, _, _)) in springs.iter().enumerate() {
+            let l = lens[sp].1;
+            hv[i as usize] = hv[i as usize].min(l);
+            hv[j as usize] = hv[j as usize].min(l);
+        }
         let old = phi.clone();
         for v in 0..nv {
             if !phi[v][0].is_nan() && !vertex_faces[v].is_empty() {
-                phi[v] = [phi[v][0] + eps * force[v][0], phi[v][1] + eps * force[v][1]];
+                let mut d = [eps * force[v][0], eps * force[v][1]];
+                let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                let cap = kappa * hv[v];
+                if len > cap && len > 0.0 {
+                    d = [d[0] * cap / len, d[1] * cap / len];
+                }
+                phi[v] = [phi[v][0] + d[0], phi[v][1] + d[1]];
             }
         }
         // Refuse moves that would flip or collapse a triangle (a few passes; then revert).
@@ -264,8 +285,13 @@ pub fn relax(
             pass += 1;
         }
         if !bad.is_empty() {
+            // The refusals did not settle: drop this step and halve the step size.
             phi = old;
-            break;
+            kappa *= 0.5;
+            if kappa < options.step / 64.0 {
+                break;
+            }
+            continue;
         }
         iterations = it + 1;
     }
