@@ -9,7 +9,7 @@
 //! failed ones) fall back to a chart atlas (LSCM charts) synthesised the same way
 //! without partners; the report says so.
 
-use crate::outputs::{prepare_out_dir, write_report};
+use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, Warning, stream_seed};
 use fieldtex_mesh::{CornerUvs, TriMesh};
@@ -99,6 +99,7 @@ pub fn conformal(
     }
     let mut report =
         Report::new("conformal", options.seed, serde_json::to_value(options).unwrap_or_default());
+    begin_command();
     let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
     let exemplar = fieldtex_io::read_image(&options.exemplar)?;
@@ -111,11 +112,11 @@ pub fn conformal(
             ),
         ));
     }
-    let inputs = [options.mesh.as_path(), options.exemplar.as_path()];
-    prepare_out_dir(out_dir)?;
-    for name in ["model.glb", "preview.png", "report.json", "patches.ply", "trajectories.obj"] {
-        fieldtex_io::ensure_not_input(&out_dir.join(name), &inputs)?;
-    }
+    let out = begin_outputs(
+        out_dir,
+        &["model.glb", "preview.png", "report.json", "patches.ply", "trajectories.obj"],
+    )?;
+    let stage = out.staging().to_path_buf();
     let repaired = report.time("repair", || {
         fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default())
     });
@@ -282,10 +283,10 @@ pub fn conformal(
     // 6. One texture: blocks stacked vertically; per-corner UVs.
     let (texture, out_mesh) = report.time("assemble", || assemble(&mesh, &blocks));
     // 7. Outputs.
-    report.time("write", || super::write_model(out_dir, &out_mesh, Some(&texture)))?;
+    report.time("write", || super::write_model(&stage, &out_mesh, Some(&texture)))?;
     let preview =
         report.time("preview", || super::render::preview(&out_mesh, Some(&texture), 800, None));
-    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     // 8. Metrics.
     let comp_json: Vec<serde_json::Value> =
         comps.iter().zip(&images).map(|(c, img)| component_json(c, img.as_ref())).collect();
@@ -314,9 +315,9 @@ pub fn conformal(
     report.metric("texel_density", texel_density(&tau_w));
     add_notes(&mut report, &comps, options);
     if options.keep {
-        report.time("keep", || write_keep(out_dir, &mesh, &comps, &blocks))?;
+        report.time("keep", || write_keep(&stage, &mesh, &comps, &blocks))?;
     }
-    write_report(out_dir, &report)?;
+    commit_outputs(out, &mut report)?;
     Ok(report)
 }
 
