@@ -135,13 +135,16 @@ pub fn demo(out_dir: &Path, options: &DemoOptions, progress: &dyn Progress) -> R
     super::align::align_impl(out_dir, &aopts, Some((&mesh, &exemplar)), Some(&mut add), progress)
 }
 
+/// The orient image, its metrics and its stage timings.
+type OrientBeside = (Image, serde_json::Value, Vec<(String, f64)>);
+
 /// The orient whorl preset on `exemplar`: the image with the designed singularities
 /// marked, and its metrics for the report.
 fn orient_beside(
     options: &DemoOptions,
     exemplar: &Image,
     progress: &dyn Progress,
-) -> Result<(Image, serde_json::Value, Vec<(String, f64)>)> {
+) -> Result<OrientBeside> {
     let n = options.orient_size.clamp(64, 1024);
     let mut oopts = OrientOptions::new(FieldSource::Preset("whorl".into()), PathBuf::new());
     oopts.size = n;
