@@ -16,7 +16,8 @@ bench() {
   local walls=() cpu=""
   for _ in $(seq "$N"); do
     local out
-    out=$( { /usr/bin/time -f "%e %U %S" "$@" >/dev/null 2>/dev/null; } 2>&1 | tail -1)
+    /usr/bin/time -f "%e %U %S" -o "$T/time" "$@" >/dev/null 2>&1
+    out=$(tail -1 "$T/time")
     walls+=("$(echo "$out" | cut -d' ' -f1)")
     cpu=$(echo "$out" | awk '{print $2 + $3}')
   done
