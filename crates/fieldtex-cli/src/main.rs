@@ -145,8 +145,8 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
         /// Ascending strength thresholds (comma-separated), one level of detail each; a
-        /// line's strength is ∫|k| ds along it (unitless). Default: the detector's own
-        /// thresholds, relative to the mesh (see `crest` in report).
+        /// line's strength is ∫|k| ds along it (unitless, scale-invariant). Lines below
+        /// the first are dropped. Default: the detector's own thresholds, 3,9,27.
         #[arg(long, value_delimiter = ',', value_name = "T1,T2,...")]
         levels: Option<Vec<f64>>,
         /// Keep only lines of this level and above.

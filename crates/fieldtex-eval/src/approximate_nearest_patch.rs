@@ -202,16 +202,19 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
     }
 
     /// The approximate nearest squared distance (full dimension) of `query` (`dim`
-    /// values) and its database index; `scratch` holds `dim` values.
-    pub fn nearest(&self, query: &[f32], scratch: &mut [f32]) -> (f32, usize) {
+    /// values) and its database index; `scratch` is reused between queries.
+    pub fn nearest(&self, query: &[f32], scratch: &mut SearchScratch) -> (f32, usize) {
         let k = self.k;
         let mut q = [0f32; 64];
         let q = &mut q[..k.min(64)];
         self.project(query, q);
         let m = self.options.rerank.max(1);
         // Max-heap of the m best (projected distance, point) so far.
-        let mut best: BinaryHeap<(OrdF32, u32)> = BinaryHeap::with_capacity(m + 1);
-        let mut queue: BinaryHeap<std::cmp::Reverse<(OrdF32, u32)>> = BinaryHeap::new();
+        let SearchScratch { best, queue, cands, patch } = scratch;
+        best.clear();
+        queue.clear();
+        cands.clear();
+        patch.resize(query.len(), 0.0);
         queue.push(std::cmp::Reverse((OrdF32(0.0), 0)));
         let mut checks = 0usize;
         while let Some(std::cmp::Reverse((OrdF32(bound), node))) = queue.pop() {
@@ -254,13 +257,12 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
             }
         }
         // Exact re-ranking, in a fixed order (by database index) for determinism.
-        let mut cands: Vec<usize> =
-            best.into_iter().map(|(_, p)| self.order[p as usize] as usize).collect();
+        cands.extend(best.drain().map(|(_, p)| self.order[p as usize] as usize));
         cands.sort_unstable();
         let mut out = (f32::INFINITY, 0usize);
-        for i in cands {
-            self.source.fill(i, scratch);
-            let d: f32 = query.iter().zip(scratch.iter()).map(|(a, b)| (a - b) * (a - b)).sum();
+        for &i in cands.iter() {
+            self.source.fill(i, patch);
+            let d: f32 = query.iter().zip(patch.iter()).map(|(a, b)| (a - b) * (a - b)).sum();
             if d < out.0 {
                 out = (d, i);
             }
@@ -285,6 +287,15 @@ fn dot(a: &[f32], b: &[f32]) -> f32 {
         s += x * y;
     }
     s
+}
+
+/// Buffers of [`PatchIndex::nearest`], reused across the queries of one worker.
+#[derive(Default)]
+pub(crate) struct SearchScratch {
+    best: BinaryHeap<(OrdF32, u32)>,
+    queue: BinaryHeap<std::cmp::Reverse<(OrdF32, u32)>>,
+    cands: Vec<usize>,
+    patch: Vec<f32>,
 }
 
 /// `f32` with a total order (for the heaps).
@@ -318,7 +329,7 @@ mod tests {
             .collect();
         let src = DensePatches { data: &data, dim };
         let idx = PatchIndex::build(&src, &ApproximateSearchOptions::default()).unwrap();
-        let mut scratch = vec![0f32; dim];
+        let mut scratch = SearchScratch::default();
         for i in (0..n).step_by(97) {
             let q = &data[i * dim..(i + 1) * dim];
             let (d, _) = idx.nearest(q, &mut scratch);

@@ -322,7 +322,7 @@ pub fn guided_coherence(
         .map(|&py| {
             let mut q = vec![0f32; dim];
             let mut q_flip = vec![0f32; dim];
-            let mut scratch = vec![0f32; dim];
+            let mut scratch = crate::approximate_nearest_patch::SearchScratch::default();
             let mut dists = Vec::with_capacity(xs.len());
             let (mut border, mut no_dir) = (0, 0);
             let mut hint = 0usize;

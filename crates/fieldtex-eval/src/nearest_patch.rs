@@ -179,7 +179,7 @@ fn approximate_ssd(
         .par_chunks(256)
         .flat_map_iter(|chunk| {
             let mut buf = vec![0f32; dim];
-            let mut scratch = vec![0f32; dim];
+            let mut scratch = crate::approximate_nearest_patch::SearchScratch::default();
             chunk
                 .iter()
                 .map(|&i| {

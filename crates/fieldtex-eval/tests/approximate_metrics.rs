@@ -88,3 +88,23 @@ fn approximate_coherence_and_completeness_stay_within_the_stated_bound() {
     }
     assert!(worst <= 0.05, "approximate metrics {:.1} % from the exact ones", 100.0 * worst);
 }
+
+/// The approximate search gives bit-identical reports on 1 and 2 threads.
+#[test]
+fn approximate_metrics_do_not_depend_on_the_thread_count() {
+    let (ex, w, h) = load("bricks_Bricks012.png");
+    let out = patchwork(&ex, w, h, 96, 5);
+    let o = ImageView::new(&out, 96, 96, 3).unwrap();
+    let e = ImageView::new(&ex, w, h, 3).unwrap();
+    let opts = PatchDistanceOptions::default()
+        .with_wrap_exemplar(true)
+        .with_approximate(Some(ApproximateSearchOptions::default()));
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| coherence_and_completeness(&o, &e, &opts).unwrap())
+    };
+    assert_eq!(run(1), run(2));
+}

@@ -143,7 +143,7 @@ fn empty_and_garbage_files() {
     let e = read_named(&put("garbage.bin", b"\x01\x02 hello")).unwrap_err();
     assert!(matches!(e, IoError::UnknownFormat { .. }), "{e}");
     assert!(matches!(read_mesh(&dir().join("does-not-exist.obj")), Err(IoError::Os { .. })));
-    assert!(matches!(read_mesh(&dir()), Err(IoError::Os { .. })));
+    assert!(matches!(read_mesh(&dir()), Err(IoError::NotRegularFile { .. })));
 }
 
 #[test]

@@ -186,7 +186,7 @@ fn real_scan_patch_with_a_whorl() {
     assert!(!r.metrics["designed_singularities"].as_array().unwrap().is_empty());
     o.patch = Some([tip[0] + 100.0, tip[1], tip[2], 0.5]);
     let e = orient(&dir.join("far"), &o, &NoProgress).unwrap_err();
-    assert!(e.exit_code() == 2 && e.to_string().contains("no triangle lies within"), "{e}");
+    assert!(e.exit_code() == 2 && e.to_string().contains("no triangle centre lies within"), "{e}");
     o.mesh = None;
     let e = orient(&dir.join("no-mesh"), &o, &NoProgress).unwrap_err();
     assert!(e.exit_code() == 2 && e.to_string().contains("--mesh"), "{e}");
