@@ -54,7 +54,7 @@ pub struct SolidOptions {
     pub keep: bool,
     /// Atlas size of `model.glb` and the cut meshes, texels. Default 1024.
     pub atlas_size: usize,
-    /// Frame-field cells along the bounding box's shortest side. Default 24.
+    /// Frame-field cells along the bounding box's shortest side. Default 20 (paper: 20–30).
     pub field_cells: usize,
     pub analysis: SolidAnalysisOptions,
     pub synthesis: SolidSynthesisOptions,
@@ -75,7 +75,7 @@ impl Default for SolidOptions {
             volume: false,
             keep: false,
             atlas_size: 1024,
-            field_cells: 24,
+            field_cells: 20,
             analysis: SolidAnalysisOptions::default(),
             synthesis: SolidSynthesisOptions::default(),
             seed: 1,
@@ -220,7 +220,19 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let mut cut_reports = Vec::new();
     for (i, cut) in options.cuts.iter().enumerate() {
         let r = report.time(&format!("cut_{}", i + 1), || {
-            write_cut(out_dir, i + 1, *cut, &mesh, &bvh, &aopts, &grid, &mut synth, progress)
+            let keep_field = options.keep.then_some(&frames);
+            write_cut(
+                out_dir,
+                i + 1,
+                *cut,
+                &mesh,
+                &bvh,
+                &aopts,
+                &grid,
+                &mut synth,
+                keep_field,
+                progress,
+            )
         })?;
         cut_reports.push(r);
     }
@@ -459,6 +471,7 @@ fn write_cut(
     aopts: &fieldtex_param::AtlasOptions,
     grid: &SolidGrid,
     synth: &mut SolidSynthesizer<'_>,
+    keep_field: Option<&FieldFrames<'_>>,
     progress: &dyn Progress,
 ) -> Result<serde_json::Value> {
     let point = [cut[0], cut[1], cut[2]];
@@ -493,6 +506,24 @@ fn write_cut(
                     v[a2] = row as i32;
                     voxels.push(v);
                 }
+            }
+            if let Some(frames) = keep_field {
+                // The local x axis in the image plane per pixel (`(dx, dy)`, x along
+                // columns, y down the rows), for `fieldtex eval --field`.
+                let mut dirs = Vec::with_capacity(2 * voxels.len());
+                for v in &voxels {
+                    let c: [f64; 3] =
+                        std::array::from_fn(|a| grid.origin[a] + v[a] as f64 * grid.spacing);
+                    let m = frames.frame(c);
+                    let (dx, dy) = (m[3 * a1], m[3 * a2]);
+                    let l = (dx * dx + dy * dy).sqrt().max(1e-12);
+                    dirs.extend([(dx / l) as f32, (dy / l) as f32]);
+                }
+                fieldtex_io::write_npy_f32(
+                    &out_dir.join(format!("cut-{index}-field.npy")),
+                    &[h, w, 2],
+                    &dirs,
+                )?;
             }
             (slice_image(&voxels, w, h, grid, bvh, scale, synth, progress, &mut work), true)
         }
