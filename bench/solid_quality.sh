@@ -47,7 +47,7 @@ for name in "${names[@]}"; do
     sk=(); [ "$tag" = bent ] && sk=(--sketch "$dir/bent-sketch.json")
     out="$dir/$name-$tag"
     target/release/fieldtex solid --mesh "$dir/box.obj" "${sk[@]}" --exemplar "$ex" \
-      --resolution "$res" --atlas-size 256 --cut "0,0,$z,0,0,1" --keep --out "$out" --quiet
+      --resolution "$res" --atlas-size 256 --cut="0,0,$z,0,0,1" --keep --out "$out" --quiet
     field="$out/cut-1-field.npy"
     if [ "$tag" = bent ]; then
       target/release/fieldtex eval "$out/cut-1.png" --exemplar "$ex" --field "$field" --out "$out/eval.json" > /dev/null

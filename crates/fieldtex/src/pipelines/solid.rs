@@ -158,7 +158,11 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let mut report =
         Report::new("solid", options.seed, serde_json::to_value(options).unwrap_or_default());
     let (mesh, inputs) = read_inputs(options, &mut report)?;
-    let exemplars = read_exemplars(options)?;
+    let (exemplars, single) = read_exemplars(options)?;
+    let mut analysis = options.analysis.clone();
+    if single {
+        analysis.plane_weights = [1.0, 1.0, 0.0];
+    }
     prepare_out_dir(out_dir)?;
     let input_refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     for name in ["model.glb", "preview.png", "report.json", "volume.nrrd", "frames.ply"] {
@@ -190,11 +194,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     // 2. Exemplar analysis and the synthesizer.
     let ex = report
         .time("exemplar_analysis", || {
-            SolidExemplar::new(
-                [&exemplars[0], &exemplars[1], &exemplars[2]],
-                &options.analysis,
-                progress,
-            )
+            SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
         })
         .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
     let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
@@ -249,6 +249,11 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     }
     report.metric("cached_voxels_per_level", synth.cached_voxels());
     report.notes.extend(notes(options));
+    if single {
+        report.notes.push(
+            "one --exemplar: the xy plane uses it, the yz plane its transpose (they share the local y axis), and the zx plane has weight 0 in matching and colour (paper E §6.1: drop the third plane when the exemplars cannot all hold in one solid); give --exemplar-xy/-yz/-zx for three weighted planes".into(),
+        );
+    }
     write_report(out_dir, &report)?;
     Ok(report)
 }
@@ -288,7 +293,8 @@ fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, 
     Ok((repaired.mesh, inputs))
 }
 
-fn read_exemplars(options: &SolidOptions) -> Result<[Image; 3]> {
+/// The three plane exemplars, and whether they all came from `--exemplar`.
+fn read_exemplars(options: &SolidOptions) -> Result<([Image; 3], bool)> {
     let planes = [&options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx];
     let mut out = Vec::with_capacity(3);
     let mut cache: Vec<(PathBuf, Image)> = Vec::new();
@@ -311,7 +317,25 @@ fn read_exemplars(options: &SolidOptions) -> Result<[Image; 3]> {
         cache.push((path.clone(), im.clone()));
         out.push(im);
     }
-    Ok([out[0].clone(), out[1].clone(), out[2].clone()])
+    let single = planes.iter().all(|p| p.is_none());
+    if single {
+        // One exemplar for a layered solid (paper E §6.1): the yz plane shares the local
+        // y axis with xy, so it sees the exemplar transposed; the zx plane is dropped
+        // from matching and colour (weight 0).
+        out[1] = transpose(&out[0]);
+    }
+    Ok(([out[0].clone(), out[1].clone(), out[2].clone()], single))
+}
+
+/// The image mirrored about its main diagonal (`(x, y)` → `(y, x)`).
+fn transpose(im: &Image) -> Image {
+    let mut t = Image::new(im.height, im.width, [0.0; 4]);
+    for y in 0..im.height {
+        for x in 0..im.width {
+            t.set(y, x, im.get(x, y));
+        }
+    }
+    t
 }
 
 /// The frame field of the sketch (`None` without a sketch) and the placed curves.
@@ -674,7 +698,7 @@ fn notes(options: &SolidOptions) -> Vec<String> {
             options.analysis.neighbourhood, options.analysis.pca_dims
         ),
         "the coarsest level uses the same block (dual-grid) scheme as the others, with more passes, so that every level is lazy; the paper corrects the whole coarsest level without barriers".to_string(),
-        "a voxel's colour is the mean of the three exemplar colours at its coordinate triple; no feature channel (bricks) and no interior regions (--interior) are implemented".to_string(),
+        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple; no feature channel (bricks) and no interior regions (--interior) are implemented".to_string(),
         "the surface texture interpolates the eight voxels around each texel's surface point (trilinear)".to_string(),
     ];
     if options.sketch.is_none() {
