@@ -134,6 +134,12 @@ fn solid_outputs_cut_slice_and_determinism() {
         }
     }
     assert!(opaque > 100 && transparent > 100, "opaque {opaque}, transparent {transparent}");
+    // The solid is textured, not flat: the red channel varies (woodgrain's own standard
+    // deviation is 7.2; an earlier version that averaged three incompatible planes gave 1.1).
+    let red: Vec<f64> = vol.data.iter().step_by(3).map(|&v| v as f64).collect();
+    let mean = red.iter().sum::<f64>() / red.len() as f64;
+    let std = (red.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / red.len() as f64).sqrt();
+    assert!(std > 2.5, "volume red std {std}");
     // The cut mesh of the closed torus is closed.
     let cut = fieldtex::crates::io::read_mesh(&out.join("cut-1.glb")).unwrap().mesh;
     assert!(weld_closed(&cut.positions, &cut.triangles), "cut-1.glb is not closed");
