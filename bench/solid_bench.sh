@@ -39,7 +39,7 @@ PY
 cut=$(cat /tmp/solid-bench-cut.txt)
 /usr/bin/time -f "cpu_user_s=%U cpu_sys_s=%S wall_s=%e max_rss_kb=%M" \
   target/release/fieldtex solid --mesh "$mesh" "${sketch[@]}" --exemplar "$ex" \
-  --resolution "$res" --cut "$cut" --out "$out" --quiet 2> /tmp/solid-bench-time.txt
+  --resolution "$res" --cut="$cut" --out "$out" --quiet 2> /tmp/solid-bench-time.txt
 python3 - "$out/report.json" "$(cat /tmp/solid-bench-time.txt | tail -1)" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1])); m = r["metrics"]

@@ -45,7 +45,7 @@ pub struct SolidArgs {
     #[arg(long, default_value_t = 1024)]
     atlas_size: usize,
     /// Frame-field cells along the bounding box's shortest side.
-    #[arg(long, default_value_t = 24)]
+    #[arg(long, default_value_t = 20)]
     field_cells: usize,
     /// Correction passes per level (half primary grid, half dual grid).
     #[arg(long, default_value_t = 2)]

@@ -24,19 +24,19 @@ fn run(args: &[&str]) -> Output {
 }
 
 const SKETCH: &str = r#"{"curves": [
-  {"points": [[1.25, 0, 0.2], [0.9, 0.9, 0.2], [0, 1.25, 0.2], [-0.9, 0.9, 0.2]], "axis": "x"},
-  {"points": [[-1.0, -0.5, 0.0], [1.0, -0.5, 0.0]], "plane": {"point": [0, 0, 0], "normal": [0, 0, 1]}, "axis": "y"}
+  {"points": [[1.25, 0.2, 0], [0.9, 0.2, 0.9], [0, 0.2, 1.25], [-0.9, 0.2, 0.9]], "axis": "x"},
+  {"points": [[-1.0, 0.0, -0.5], [1.0, 0.0, -0.5]], "plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}, "axis": "y"}
 ]}"#;
 
-/// Runs the torus at a small resolution with a z cut through the voxel centres of
-/// slice `k`; returns the output directory.
+/// Runs the torus (axis y) at a small resolution with a y cut through the voxel
+/// centres of slice `k`.
 fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
     let sketch = dir.join("sketch.json");
     std::fs::write(&sketch, SKETCH).unwrap();
-    // The grid: longest side 2.5 (x, y), 40 voxels, spacing 0.0625; z extent 0.5
-    // → 8 voxels, origin z = −0.21875.
-    let z = -0.21875 + 0.0625 * k as f64;
-    let cut = format!("0,0,{z},0,0,1");
+    // The grid: longest side 2.5 (x, z), 40 voxels, spacing 0.0625; y extent 0.5
+    // → 8 voxels, origin y = −0.21875.
+    let y = -0.21875 + 0.0625 * k as f64;
+    let cut = format!("0,{y},0,0,1,0");
     let out = dir.join("out");
     run(&[
         "solid",
@@ -54,6 +54,8 @@ fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
         "128",
         "--levels",
         "3",
+        "--block",
+        "6",
         "--cut",
         &cut,
         "--volume",
@@ -114,23 +116,30 @@ fn solid_outputs_cut_slice_and_determinism() {
     )
     .unwrap();
     let [nx, ny, nz] = vol.sizes;
-    assert_eq!((nx, ny, nz), (40, 40, 8));
+    assert_eq!((nx, ny, nz), (40, 8, 40));
     let img = fieldtex::crates::io::read_image(&out.join("cut-1.png")).unwrap();
-    assert_eq!((img.width, img.height), (nx, ny));
+    // Columns run along x, rows along z.
+    assert_eq!((img.width, img.height), (nx, nz));
     let (mut opaque, mut transparent) = (0, 0);
-    for y in 0..ny {
+    for z in 0..nz {
         for x in 0..nx {
-            let p = img.get(x, y).map(|v| (v * 255.0).round() as u8);
+            let p = img.get(x, z).map(|v| (v * 255.0).round() as u8);
             if p[3] == 0 {
                 transparent += 1;
                 continue;
             }
             opaque += 1;
-            let i = 3 * (x + nx * (y + ny * 4));
-            assert_eq!(&p[..3], &vol.data[i..i + 3], "pixel ({x}, {y})");
+            let i = 3 * (x + nx * (4 + ny * z));
+            assert_eq!(&p[..3], &vol.data[i..i + 3], "pixel ({x}, {z})");
         }
     }
     assert!(opaque > 100 && transparent > 100, "opaque {opaque}, transparent {transparent}");
+    // The solid is textured, not flat: the red channel varies (woodgrain's own standard
+    // deviation is 7.2; an earlier version that averaged three incompatible planes gave 1.1).
+    let red: Vec<f64> = vol.data.iter().step_by(3).map(|&v| v as f64).collect();
+    let mean = red.iter().sum::<f64>() / red.len() as f64;
+    let std = (red.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / red.len() as f64).sqrt();
+    assert!(std > 2.5, "volume red std {std}");
     // The cut mesh of the closed torus is closed.
     let cut = fieldtex::crates::io::read_mesh(&out.join("cut-1.glb")).unwrap().mesh;
     assert!(weld_closed(&cut.positions, &cut.triangles), "cut-1.glb is not closed");

@@ -14,7 +14,8 @@
 //! named in the pipeline notes): the `K₁ = 8` best partners in plane `i + 1` (by the
 //! stick shared with `p`) and in plane `i + 2` are found by brute force over a regular
 //! sub-grid *pool* of about [`super::SolidAnalysisOptions::pool`] pixels, then all
-//! `K₁²` pairs are scored with their third stick. Dong's extra test that a triple be
+//! `K₁²` pairs are scored with their third stick; each stick pair's error is weighted
+//! by the product of its planes' [`super::SolidAnalysisOptions::plane_weights`]. Dong's extra test that a triple be
 //! consistent with a neighbouring pixel's triple is not applied.
 
 use super::solid_exemplar::{PlaneExemplar, SolidAnalysisOptions};
@@ -118,6 +119,11 @@ pub fn candidate_triples(
     let pool_k = pool(ek.width, ek.height, options.pool);
     let len = st[0].len;
     let n_t = options.triples;
+    // Stick pairs weighted by the product of their planes' weights (the partner
+    // searches themselves are unweighted, so a zero-weight plane still gets sensible
+    // coordinates).
+    let w = options.plane_weights;
+    let (wij, wik, wjk) = (w[i] * w[j], w[i] * w[k], w[j] * w[k]);
     let coord = |e: &PlaneExemplar, p: usize| [(p % e.width) as i32, (p / e.width) as i32];
     let mut triples = vec![[[0i32; 2]; 3]; ei.width * ei.height * n_t];
     triples.par_chunks_mut(n_t).enumerate().for_each(|(p, out)| {
@@ -130,7 +136,7 @@ pub fn candidate_triples(
             for &(er, r) in &rs {
                 let e3 =
                     dist2(&st[j].cols[q * len..(q + 1) * len], &st[k].rows[r * len..(r + 1) * len]);
-                scored.push((eq + er + e3, q, r));
+                scored.push((wij * eq + wik * er + wjk * e3, q, r));
             }
         }
         scored.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));

@@ -278,17 +278,23 @@ impl<'a> SolidSynthesizer<'a> {
         (t.iter().map(|t| self.triple_color(0, t)).collect(), stats)
     }
 
-    /// Mean of the three level-`c` exemplar colours at `t`.
+    /// Plane-weighted mean of the three level-`c` exemplar colours at `t`
+    /// ([`super::SolidAnalysisOptions::plane_weights`]).
     #[inline]
     pub fn triple_color(&self, c: usize, t: &Triple) -> [f32; 3] {
+        let w = self.exemplar.options.plane_weights;
         let mut acc = [0.0f32; 3];
         for p in 0..3 {
+            if w[p] == 0.0 {
+                continue;
+            }
             let col = self.exemplar.color(p, c, t[p][0], t[p][1]);
             for ch in 0..3 {
-                acc[ch] += col[ch];
+                acc[ch] += w[p] * col[ch];
             }
         }
-        acc.map(|v| v / 3.0)
+        let total = w[0] + w[1] + w[2];
+        acc.map(|v| v / total)
     }
 
     fn final_at(&self, c: usize, v: [i32; 3]) -> Triple {
@@ -529,13 +535,15 @@ impl<'a> SolidSynthesizer<'a> {
         let current = region[idx(at)];
         scratch.candidates.clear();
         scratch.candidates.push(current);
+        let weights = self.exemplar.options.plane_weights;
         for p in 0..3 {
             let (a1, a2) = (p, (p + 1) % 3);
             let u = [f[a1], f[3 + a1], f[6 + a1]];
             let w = [f[a2], f[3 + a2], f[6 + a2]];
             let lvl = &self.exemplar.planes[p].levels[c];
             let mut k = 0;
-            for t in -half..=half {
+            // A zero-weight plane contributes candidates but no neighbourhood.
+            for t in (-half..=half).filter(|_| weights[p] > 0.0) {
                 for ss in -half..=half {
                     let (sf, tf) = (ss as f32, t as f32);
                     let q: [i32; 3] =
@@ -544,7 +552,7 @@ impl<'a> SolidSynthesizer<'a> {
                     k += 3;
                 }
             }
-            let dims = lvl.dims();
+            let dims = if weights[p] > 0.0 { lvl.dims() } else { 0 };
             let dim = scratch.buf.len();
             for j in 0..dims {
                 let row = &lvl.basis[j * dim..(j + 1) * dim];
@@ -580,15 +588,20 @@ impl<'a> SolidSynthesizer<'a> {
         for cand in &scratch.candidates {
             let mut cost = 0.0f32;
             for p in 0..3 {
+                if weights[p] == 0.0 {
+                    continue;
+                }
                 let e = &self.exemplar.planes[p];
                 let lvl = &e.levels[c];
                 let dims = lvl.dims();
                 let pix = cand[p][1] as usize * e.width + cand[p][0] as usize;
                 let a = &lvl.appearance[pix * dims..(pix + 1) * dims];
+                let mut plane_cost = 0.0f32;
                 for j in 0..dims {
                     let d = a[j] - scratch.proj[p][j];
-                    cost += d * d;
+                    plane_cost += d * d;
                 }
+                cost += weights[p] * plane_cost;
             }
             if cost < best.0 {
                 best = (cost, *cand);

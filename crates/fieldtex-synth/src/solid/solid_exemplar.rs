@@ -40,11 +40,24 @@ pub struct SolidAnalysisOptions {
     pub pool: usize,
     /// Largest exemplar side accepted. Default 512.
     pub max_size: usize,
+    /// Weight of each plane (xy, yz, zx) in the crossbar error, the correction's
+    /// neighbourhood distance and the voxel colour. Default `[1, 1, 1]`; paper E §6.1
+    /// suggests dropping or down-weighting the third plane when the exemplars cannot
+    /// all hold in one solid (stripes, wood grain).
+    pub plane_weights: [f32; 3],
 }
 
 impl Default for SolidAnalysisOptions {
     fn default() -> Self {
-        Self { levels: 5, neighbourhood: 5, pca_dims: 8, triples: 12, pool: 1024, max_size: 512 }
+        Self {
+            levels: 5,
+            neighbourhood: 5,
+            pca_dims: 8,
+            triples: 12,
+            pool: 1024,
+            max_size: 512,
+            plane_weights: [1.0; 3],
+        }
     }
 }
 
@@ -126,6 +139,14 @@ impl SolidExemplar {
                 reason: "pca_dims and triples must be between 1 and 32",
             });
         }
+        let w = options.plane_weights;
+        if w.iter().any(|v| !(v.is_finite() && *v >= 0.0)) || w.iter().sum::<f32>() <= 0.0 {
+            return Err(SynthError::InvalidOption {
+                name: "SolidAnalysisOptions::plane_weights",
+                value: w.iter().sum::<f32>() as f64,
+                reason: "weights must be finite, ≥ 0, and not all zero",
+            });
+        }
         let same = |a: &Image, b: &Image| std::ptr::eq(a, b) || a == b;
         progress.stage("solid exemplar analysis", 3 * options.levels as u64);
         let mut planes: Vec<Arc<PlaneExemplar>> = Vec::with_capacity(3);
@@ -139,7 +160,10 @@ impl SolidExemplar {
         }
         let planes: [Arc<PlaneExemplar>; 3] =
             [planes[0].clone(), planes[1].clone(), planes[2].clone()];
-        let all_same = Arc::ptr_eq(&planes[0], &planes[1]) && Arc::ptr_eq(&planes[1], &planes[2]);
+        let all_same = Arc::ptr_eq(&planes[0], &planes[1])
+            && Arc::ptr_eq(&planes[1], &planes[2])
+            && w[0] == w[1]
+            && w[1] == w[2];
         let mut triples = Vec::with_capacity(options.levels);
         for c in 0..options.levels {
             let h = 1usize << c;
@@ -180,7 +204,7 @@ impl SolidExemplar {
         })
     }
 
-    /// Finest colour (RGB) of plane `p` at pixel `(x, y)` (wrapped).
+    /// Level-`c` colour (RGB) of plane `p` at pixel `(x, y)` (wrapped).
     #[inline]
     pub fn color(&self, p: usize, c: usize, x: i32, y: i32) -> [f32; 3] {
         let e = &self.planes[p];

@@ -54,7 +54,7 @@ pub struct SolidOptions {
     pub keep: bool,
     /// Atlas size of `model.glb` and the cut meshes, texels. Default 1024.
     pub atlas_size: usize,
-    /// Frame-field cells along the bounding box's shortest side. Default 24.
+    /// Frame-field cells along the bounding box's shortest side. Default 20 (paper: 20–30).
     pub field_cells: usize,
     pub analysis: SolidAnalysisOptions,
     pub synthesis: SolidSynthesisOptions,
@@ -75,7 +75,7 @@ impl Default for SolidOptions {
             volume: false,
             keep: false,
             atlas_size: 1024,
-            field_cells: 24,
+            field_cells: 20,
             analysis: SolidAnalysisOptions::default(),
             synthesis: SolidSynthesisOptions::default(),
             seed: 1,
@@ -158,7 +158,11 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let mut report =
         Report::new("solid", options.seed, serde_json::to_value(options).unwrap_or_default());
     let (mesh, inputs) = read_inputs(options, &mut report)?;
-    let exemplars = read_exemplars(options)?;
+    let (exemplars, single) = read_exemplars(options)?;
+    let mut analysis = options.analysis.clone();
+    if single {
+        analysis.plane_weights = [1.0, 1.0, 0.0];
+    }
     prepare_out_dir(out_dir)?;
     let input_refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     for name in ["model.glb", "preview.png", "report.json", "volume.nrrd", "frames.ply"] {
@@ -190,11 +194,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     // 2. Exemplar analysis and the synthesizer.
     let ex = report
         .time("exemplar_analysis", || {
-            SolidExemplar::new(
-                [&exemplars[0], &exemplars[1], &exemplars[2]],
-                &options.analysis,
-                progress,
-            )
+            SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
         })
         .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
     let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
@@ -220,7 +220,19 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let mut cut_reports = Vec::new();
     for (i, cut) in options.cuts.iter().enumerate() {
         let r = report.time(&format!("cut_{}", i + 1), || {
-            write_cut(out_dir, i + 1, *cut, &mesh, &bvh, &aopts, &grid, &mut synth, progress)
+            let keep_field = options.keep.then_some(&frames);
+            write_cut(
+                out_dir,
+                i + 1,
+                *cut,
+                &mesh,
+                &bvh,
+                &aopts,
+                &grid,
+                &mut synth,
+                keep_field,
+                progress,
+            )
         })?;
         cut_reports.push(r);
     }
@@ -237,6 +249,11 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     }
     report.metric("cached_voxels_per_level", synth.cached_voxels());
     report.notes.extend(notes(options));
+    if single {
+        report.notes.push(
+            "one --exemplar: the xy plane uses it, the yz plane its transpose (they share the local y axis), and the zx plane has weight 0 in matching and colour (paper E §6.1: drop the third plane when the exemplars cannot all hold in one solid); give --exemplar-xy/-yz/-zx for three weighted planes".into(),
+        );
+    }
     write_report(out_dir, &report)?;
     Ok(report)
 }
@@ -276,7 +293,8 @@ fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, 
     Ok((repaired.mesh, inputs))
 }
 
-fn read_exemplars(options: &SolidOptions) -> Result<[Image; 3]> {
+/// The three plane exemplars, and whether they all came from `--exemplar`.
+fn read_exemplars(options: &SolidOptions) -> Result<([Image; 3], bool)> {
     let planes = [&options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx];
     let mut out = Vec::with_capacity(3);
     let mut cache: Vec<(PathBuf, Image)> = Vec::new();
@@ -299,7 +317,25 @@ fn read_exemplars(options: &SolidOptions) -> Result<[Image; 3]> {
         cache.push((path.clone(), im.clone()));
         out.push(im);
     }
-    Ok([out[0].clone(), out[1].clone(), out[2].clone()])
+    let single = planes.iter().all(|p| p.is_none());
+    if single {
+        // One exemplar for a layered solid (paper E §6.1): the yz plane shares the local
+        // y axis with xy, so it sees the exemplar transposed; the zx plane is dropped
+        // from matching and colour (weight 0).
+        out[1] = transpose(&out[0]);
+    }
+    Ok(([out[0].clone(), out[1].clone(), out[2].clone()], single))
+}
+
+/// The image mirrored about its main diagonal (`(x, y)` → `(y, x)`).
+fn transpose(im: &Image) -> Image {
+    let mut t = Image::new(im.height, im.width, [0.0; 4]);
+    for y in 0..im.height {
+        for x in 0..im.width {
+            t.set(y, x, im.get(x, y));
+        }
+    }
+    t
 }
 
 /// The frame field of the sketch (`None` without a sketch) and the placed curves.
@@ -459,6 +495,7 @@ fn write_cut(
     aopts: &fieldtex_param::AtlasOptions,
     grid: &SolidGrid,
     synth: &mut SolidSynthesizer<'_>,
+    keep_field: Option<&FieldFrames<'_>>,
     progress: &dyn Progress,
 ) -> Result<serde_json::Value> {
     let point = [cut[0], cut[1], cut[2]];
@@ -493,6 +530,24 @@ fn write_cut(
                     v[a2] = row as i32;
                     voxels.push(v);
                 }
+            }
+            if let Some(frames) = keep_field {
+                // The local x axis in the image plane per pixel (`(dx, dy)`, x along
+                // columns, y down the rows), for `fieldtex eval --field`.
+                let mut dirs = Vec::with_capacity(2 * voxels.len());
+                for v in &voxels {
+                    let c: [f64; 3] =
+                        std::array::from_fn(|a| grid.origin[a] + v[a] as f64 * grid.spacing);
+                    let m = frames.frame(c);
+                    let (dx, dy) = (m[3 * a1], m[3 * a2]);
+                    let l = (dx * dx + dy * dy).sqrt().max(1e-12);
+                    dirs.extend([(dx / l) as f32, (dy / l) as f32]);
+                }
+                fieldtex_io::write_npy_f32(
+                    &out_dir.join(format!("cut-{index}-field.npy")),
+                    &[h, w, 2],
+                    &dirs,
+                )?;
             }
             (slice_image(&voxels, w, h, grid, bvh, scale, synth, progress, &mut work), true)
         }
@@ -643,7 +698,7 @@ fn notes(options: &SolidOptions) -> Vec<String> {
             options.analysis.neighbourhood, options.analysis.pca_dims
         ),
         "the coarsest level uses the same block (dual-grid) scheme as the others, with more passes, so that every level is lazy; the paper corrects the whole coarsest level without barriers".to_string(),
-        "a voxel's colour is the mean of the three exemplar colours at its coordinate triple; no feature channel (bricks) and no interior regions (--interior) are implemented".to_string(),
+        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple; no feature channel (bricks) and no interior regions (--interior) are implemented".to_string(),
         "the surface texture interpolates the eight voxels around each texel's surface point (trilinear)".to_string(),
     ];
     if options.sketch.is_none() {
