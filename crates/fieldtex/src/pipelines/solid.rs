@@ -17,7 +17,7 @@
 //! outside the mesh; other planes are sampled at voxel spacing (nearest voxel) over the
 //! mesh's extent in the plane.
 
-use crate::outputs::{prepare_out_dir, write_report};
+use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::align::{atlas_carriers, carrier_texture};
 use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
@@ -157,17 +157,20 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     }
     let mut report =
         Report::new("solid", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let (mesh, inputs) = read_inputs(options, &mut report)?;
+    begin_command();
+    let (mesh, _inputs) = read_inputs(options, &mut report)?;
     let (exemplars, single) = read_exemplars(options)?;
     let mut analysis = options.analysis.clone();
     if single {
         analysis.plane_weights = [1.0, 1.0, 0.0];
     }
-    prepare_out_dir(out_dir)?;
-    let input_refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-    for name in ["model.glb", "preview.png", "report.json", "volume.nrrd", "frames.ply"] {
-        fieldtex_io::ensure_not_input(&out_dir.join(name), &input_refs)?;
-    }
+    let out = begin_outputs(
+        out_dir,
+        &["model.glb", "preview.png", "report.json", "volume.nrrd", "frames.ply"],
+    )?;
+    // Everything below writes into the staging folder, moved into place at the end.
+    let stage = out.staging().to_path_buf();
+    let out_dir = stage.as_path();
     let bbox = mesh
         .bounding_box()
         .ok_or_else(|| Error::bad_input(Some(&options.mesh), "the mesh has no vertex"))?;
@@ -254,7 +257,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
             "one --exemplar: the xy plane uses it, the yz plane its transpose (they share the local y axis), and the zx plane has weight 0 in matching and colour (paper E §6.1: drop the third plane when the exemplars cannot all hold in one solid); give --exemplar-xy/-yz/-zx for three weighted planes".into(),
         );
     }
-    write_report(out_dir, &report)?;
+    commit_outputs(out, &mut report)?;
     Ok(report)
 }
 
