@@ -62,8 +62,22 @@ pub fn sample_surface(
     which: &'static str,
     warnings: &mut Vec<Warning>,
 ) -> Result<SampleSet, TransferError> {
+    sample_surface_with(mesh, Some(count.max(1)), None, seed, which, warnings)
+}
+
+/// [`sample_surface`] with either a target count (the sampler corrects its radius a few
+/// times) or a fixed radius (one pass).
+fn sample_surface_with(
+    mesh: &TriMesh,
+    count: Option<usize>,
+    radius: Option<f64>,
+    seed: u64,
+    which: &'static str,
+    warnings: &mut Vec<Warning>,
+) -> Result<SampleSet, TransferError> {
     let opts = PoissonDiskOptions {
-        target_count: Some(count.max(1)),
+        target_count: count,
+        radius,
         seed,
         candidate_factor: 8.0,
         ..Default::default()
@@ -115,13 +129,30 @@ impl SamplePyramid {
     ) -> Result<Self, TransferError> {
         let levels = levels.max(1);
         progress.stage(&format!("{which} samples"), levels as u64);
-        let mut sets = Vec::with_capacity(levels);
-        for l in 0..levels {
+        // The coarsest level is sampled to a target count (the sampler iterates on its
+        // radius); its density `n r² / A` then gives the radius of every finer level
+        // directly, one pass each (counts within a few percent of the request).
+        let area = fieldtex_mesh::total_area(mesh);
+        let mut sets: Vec<Option<SampleSet>> = vec![None; levels];
+        let mut density: Option<f64> = None;
+        for l in (0..levels).rev() {
             let count = (finest >> (2 * l)).max(64);
             let s = fieldtex_core::rng::stream_seed(seed, "transfer-samples", l as u64);
-            sets.push(sample_surface(mesh, count, s, which, warnings)?);
+            let set = match density {
+                Some(k) if area > 0.0 => {
+                    let r = (k * area / count as f64).sqrt();
+                    sample_surface_with(mesh, None, Some(r), s, which, warnings)?
+                }
+                _ => sample_surface_with(mesh, Some(count), None, s, which, warnings)?,
+            };
+            if density.is_none() && area > 0.0 {
+                density = Some(set.len() as f64 * set.spacing * set.spacing / area);
+            }
+            sets[l] = Some(set);
             progress.advance(1);
         }
+        let sets: Vec<SampleSet> =
+            sets.into_iter().map(|s| s.expect("every level sampled")).collect();
         progress.finish_stage();
         let mut down = Vec::new();
         let mut up = Vec::new();

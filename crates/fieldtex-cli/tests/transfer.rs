@@ -1,0 +1,206 @@
+//! End-to-end tests of `fieldtex transfer` (paper B): outputs, determinism across thread
+//! counts, and clear errors (exit 2) for untextured sources, faceless targets and masks
+//! of the wrong size.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fieldtex-transfer").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs the binary with a wall-clock limit (a hang fails the test).
+fn run(args: &[&str], limit: Duration) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fieldtex"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn fieldtex");
+    let t0 = Instant::now();
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            return child.wait_with_output().expect("output");
+        }
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            panic!("fieldtex {args:?} did not finish within {limit:?} (hang?)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// A small transfer: avocado (textured OBJ) onto the torus.
+fn small(out: &Path, threads: &str, extra: &[&str]) -> Output {
+    let src = shared().join("textured/avocado/avocado.obj");
+    let tgt = shared().join("meshes/torus.obj");
+    let mut args = vec![
+        "transfer".to_string(),
+        "--source".into(),
+        s(&src),
+        "--target".into(),
+        s(&tgt),
+        "--out".into(),
+        s(out),
+        "--samples".into(),
+        "4000".into(),
+        "--descriptor-samples".into(),
+        "1500".into(),
+        "--clusters".into(),
+        "10".into(),
+        "--size".into(),
+        "128".into(),
+        "--threads".into(),
+        threads.into(),
+        "--quiet".into(),
+    ];
+    args.extend(extra.iter().map(|x| x.to_string()));
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    run(&refs, Duration::from_secs(120))
+}
+
+#[test]
+fn transfer_writes_outputs_and_is_identical_for_one_and_two_threads() {
+    let a = tmp("t1");
+    let b = tmp("t2");
+    let oa = small(&a, "1", &["--keep"]);
+    assert!(oa.status.success(), "{}", String::from_utf8_lossy(&oa.stderr));
+    let ob = small(&b, "2", &["--keep"]);
+    assert!(ob.status.success(), "{}", String::from_utf8_lossy(&ob.stderr));
+    for f in ["model.glb", "preview.png", "guidance.ply"] {
+        let x = std::fs::read(a.join(f)).unwrap();
+        let y = std::fs::read(b.join(f)).unwrap();
+        assert!(!x.is_empty());
+        assert!(x == y, "{f} differs between 1 and 2 threads");
+    }
+    // The GLB passes the Khronos validator with 0 errors.
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
+    assert!(
+        validator.join("node_modules/gltf-validator").is_dir(),
+        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
+    );
+    let o = Command::new("node")
+        .arg(validator.join("validate.js"))
+        .arg(a.join("model.glb"))
+        .output()
+        .expect("node runs");
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    assert_eq!(
+        v["issues"]["numErrors"].as_u64(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
+    let g = &report["metrics"]["guidance"];
+    assert_eq!(g["canonical_correlations"].as_array().unwrap().len(), 3);
+    assert_eq!(g["descriptor_weights"].as_object().unwrap().len(), 12);
+    let steps = report["metrics"]["feature_matching"]["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 4, "3 bands and the values");
+    assert!(
+        report["notes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|n| n.as_str().unwrap().contains("non-parametric engine"))
+    );
+}
+
+#[test]
+fn untextured_source_is_a_clear_error() {
+    let out = tmp("untextured");
+    let o = run(
+        &[
+            "transfer",
+            "--source",
+            &s(&shared().join("meshes/torus.obj")),
+            "--target",
+            &s(&shared().join("meshes/torus.obj")),
+            "--out",
+            &s(&out),
+            "--quiet",
+        ],
+        Duration::from_secs(60),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("torus.obj") && e.contains("texture"), "{e}");
+}
+
+#[test]
+fn faceless_target_and_wrong_mask_are_clear_errors() {
+    let dir = tmp("bad");
+    let cloud = dir.join("cloud.obj");
+    std::fs::write(&cloud, "v 0 0 0\nv 1 0 0\nv 0 1 0\n").unwrap();
+    let src = shared().join("textured/avocado/avocado.obj");
+    let o = run(
+        &[
+            "transfer",
+            "--source",
+            &s(&src),
+            "--target",
+            &s(&cloud),
+            "--out",
+            &s(&dir.join("o2")),
+            "--quiet",
+        ],
+        Duration::from_secs(60),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("cloud.obj"), "{e}");
+    // A 3×3 mask cannot match the avocado's texture.
+    let mask = dir.join("mask.png");
+    let img = fieldtex::Image::new(3, 3, [1.0; 4]);
+    fieldtex::crates::io::write_png(&mask, &img).unwrap();
+    let png = mask.clone();
+    let o = run(
+        &[
+            "transfer",
+            "--source",
+            &s(&src),
+            "--target",
+            &s(&shared().join("meshes/torus.obj")),
+            "--mask",
+            &s(&png),
+            "--out",
+            &s(&dir.join("o3")),
+            "--quiet",
+        ],
+        Duration::from_secs(60),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("mask") && e.contains("3×3"), "{e}");
+    // The non-parametric engine is refused, not faked.
+    let o = run(
+        &[
+            "transfer",
+            "--source",
+            &s(&src),
+            "--target",
+            &s(&shared().join("meshes/torus.obj")),
+            "--engine",
+            "nonparametric",
+            "--out",
+            &s(&dir.join("o4")),
+            "--quiet",
+        ],
+        Duration::from_secs(60),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not implemented"));
+}
