@@ -14,7 +14,7 @@
 //!   comes from the same run as every file it lists (see [`fieldtex_io::OutputDir`]).
 
 use crate::{Error, Report, Result};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Creates `dir` (and parents) if needed; a clear error if it is a file. (Pipelines that
 /// write a folder use [`begin_outputs`], which calls it.)
@@ -75,12 +75,4 @@ pub(crate) fn commit_outputs(out: fieldtex_io::OutputDir, report: &mut Report) -
 pub fn write_text(path: &Path, text: &str) -> Result<()> {
     fieldtex_io::atomic_write(path, text.as_bytes())?;
     Ok(())
-}
-
-/// Writes `report.json` into `dir` (for pipelines not yet on [`commit_outputs`]).
-#[allow(dead_code)]
-pub(crate) fn write_report(dir: &Path, report: &Report) -> Result<PathBuf> {
-    let p = dir.join("report.json");
-    write_text(&p, &report.to_json_pretty())?;
-    Ok(p)
 }

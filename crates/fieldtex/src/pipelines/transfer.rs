@@ -9,7 +9,7 @@
 //! target side by side, same view), `report.json` and, with `keep`, `guidance.ply`
 //! (per-vertex descriptors, guidance and colour of the target).
 
-use crate::outputs::{prepare_out_dir, write_report};
+use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::align::{atlas_carriers, carrier_texture};
 use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
@@ -145,10 +145,7 @@ pub fn transfer_files(
         options.transfer.seed,
         serde_json::to_value(options).unwrap_or_default(),
     );
-    let mut inputs = vec![options.source.as_path(), options.target.as_path()];
-    if let Some(m) = &options.mask {
-        inputs.push(m);
-    }
+    begin_command();
     let src = report.time("read_source", || fieldtex_io::read_mesh(&options.source))?;
     report.warnings.extend(src.warnings.iter().cloned());
     let Some(texture) = src.base_color.as_ref() else {
@@ -175,10 +172,10 @@ pub fn transfer_files(
         Some(p) => Some(fieldtex_io::read_image(p)?),
         None => None,
     };
-    prepare_out_dir(out_dir)?;
-    for name in ["model.glb", "preview.png", "report.json", "guidance.ply"] {
-        fieldtex_io::ensure_not_input(&out_dir.join(name), &inputs)?;
-    }
+    let out = begin_outputs(out_dir, &["model.glb", "preview.png", "report.json", "guidance.ply"])?;
+    // Everything below writes into the staging folder, moved into place at the end.
+    let stage = out.staging().to_path_buf();
+    let out_dir = stage.as_path();
     let source_mesh = repaired(&src.mesh, &mut report, "source");
     if source_mesh.uvs.is_none() {
         return Err(Error::bad_input(
@@ -301,7 +298,7 @@ pub fn transfer_files(
             write_guidance_ply(&out_dir.join("guidance.ply"), &target_mesh, &result)
         })?;
     }
-    write_report(out_dir, &report)?;
+    commit_outputs(out, &mut report)?;
     Ok(report)
 }
 
