@@ -236,11 +236,22 @@ enum Command {
     Solid(solid_command::SolidArgs),
     /// Quality metrics of a synthesised image against its exemplar (DESIGN.md §6).
     Eval {
-        /// The synthesised image.
-        image: PathBuf,
+        /// The synthesised image (image metrics, with --exemplar).
+        #[arg(required_unless_present = "mesh")]
+        image: Option<PathBuf>,
         /// The exemplar it was made from.
-        #[arg(long)]
-        exemplar: PathBuf,
+        #[arg(long, required_unless_present = "mesh")]
+        exemplar: Option<PathBuf>,
+        /// A textured mesh (GLB, glTF or OBJ+MTL) to compare with --reference: transfer
+        /// fidelity, the correlation of the two colourings at the same surface points.
+        #[arg(long, requires = "reference", conflicts_with_all = ["image", "exemplar"])]
+        mesh: Option<PathBuf>,
+        /// The reference texturing of the same surface (with --mesh).
+        #[arg(long, requires = "mesh")]
+        reference: Option<PathBuf>,
+        /// Surface samples for --mesh/--reference.
+        #[arg(long, default_value_t = 100_000)]
+        samples: usize,
         /// Guidance field as .npy (H×W×2 float32 unit (dx, dy), x right, y down).
         #[arg(long, conflicts_with = "angle")]
         field: Option<PathBuf>,
@@ -472,7 +483,21 @@ fn run(cli: Cli) -> Result<(), Error> {
             fieldtex::render_file(&model, &out, &opts)?;
             say(&format!("wrote {}", out.display()));
         }
-        Command::Eval { image, exemplar, field, angle, exact_metrics, out } => {
+        Command::Eval { mesh: Some(mesh), reference: Some(reference), samples, out, .. } => {
+            let fidelity = fieldtex::transfer_fidelity_files(&mesh, &reference, samples, g.seed)?;
+            let text = serde_json::to_string_pretty(&fidelity).unwrap_or_default();
+            if let Some(o) = out {
+                fieldtex::write_text(&o, &text)?;
+            }
+            print_stdout(&text);
+        }
+        Command::Eval { image, exemplar, field, angle, exact_metrics, out, .. } => {
+            let (Some(image), Some(exemplar)) = (image, exemplar) else {
+                return Err(Error::bad_input(
+                    None,
+                    "eval needs IMAGE and --exemplar, or --mesh and --reference",
+                ));
+            };
             let guide = match (field, angle) {
                 (Some(f), _) => Some(fieldtex::Guidance::FieldFile(f)),
                 (None, Some(a)) => Some(fieldtex::Guidance::Angle(a)),

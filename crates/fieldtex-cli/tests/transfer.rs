@@ -204,3 +204,21 @@ fn faceless_target_and_wrong_mask_are_clear_errors() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("not implemented"));
 }
+
+/// `eval --mesh A --reference B` scores transfer fidelity: a texturing against itself
+/// correlates perfectly, and `--mesh` without `--reference` is a usage error.
+#[test]
+fn eval_mesh_against_reference_reports_transfer_fidelity() {
+    let blub = shared().join("textured/blub/blub.obj");
+    let b = blub.to_str().unwrap();
+    let out = run(
+        &["eval", "--mesh", b, "--reference", b, "--samples", "4000"],
+        Duration::from_secs(120),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = v["pearson_luma"].as_f64().unwrap();
+    assert!(r > 0.999, "self-fidelity {r}");
+    let bad = run(&["eval", "--mesh", b], Duration::from_secs(60));
+    assert_eq!(bad.status.code(), Some(2));
+}
