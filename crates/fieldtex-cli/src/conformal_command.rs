@@ -7,8 +7,11 @@ use std::path::PathBuf;
 /// Uniform texture synthesis on a global conformal parameterisation (paper C).
 #[derive(Args, Debug)]
 pub struct ConformalArgs {
+    /// Input mesh (.obj, .ply, .stl, .glb/.gltf); repaired first, each component mapped
+    /// on its own.
     #[arg(long)]
     mesh: PathBuf,
+    /// Exemplar image (PNG or JPEG), at least one quilting patch on each side.
     #[arg(long)]
     exemplar: PathBuf,
     /// Output directory (created if missing).
