@@ -67,22 +67,9 @@ pub(crate) fn repaired_atlas(
     report: &mut Report,
     progress: &dyn Progress,
 ) -> Result<Atlas> {
-    let repaired = report
-        .time("repair", || fieldtex_mesh::repair(mesh, &fieldtex_mesh::RepairOptions::default()));
-    for c in &repaired.changes {
-        report
-            .warnings
-            .push(fieldtex_core::Warning::new(format!("repair:{}", c.code), c.message.clone()));
-    }
-    report.warnings.extend(repaired.warnings.iter().cloned());
-    if repaired.mesh.triangles.is_empty() {
-        return Err(Error::bad_input(
-            source,
-            "the mesh has no usable triangle after repair (all were degenerate, non-finite or invalid)",
-        ));
-    }
+    let repaired = super::repair_stage::repair_into_report(mesh, source, None, report)?;
     let atlas =
-        report.time("atlas", || build_atlas(&repaired.mesh, options, progress)).map_err(|e| {
+        report.time("atlas", || build_atlas(&repaired, options, progress)).map_err(|e| {
             let what = source.map(|p| format!("{}: ", p.display())).unwrap_or_default();
             Error::Internal(format!("{what}atlas: {e}"))
         })?;

@@ -11,7 +11,7 @@
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
-use fieldtex_core::{Image, Warning, stream_seed};
+use fieldtex_core::{Image, stream_seed};
 use fieldtex_mesh::{CornerUvs, TriMesh};
 use fieldtex_param::conformal::mass_spring::map_distortion;
 use fieldtex_param::conformal::{
@@ -117,23 +117,12 @@ pub fn conformal(
         &["model.glb", "preview.png", "report.json", "patches.ply", "trajectories.obj"],
     )?;
     let stage = out.staging().to_path_buf();
-    let repaired = report.time("repair", || {
-        fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default())
-    });
-    for c in &repaired.changes {
-        report.warnings.push(Warning::new(
-            format!("repair:{}", c.code),
-            format!("{} ({})", c.message, c.count),
-        ));
-    }
-    report.warnings.extend(repaired.warnings.iter().cloned());
-    let mesh = repaired.mesh;
-    if mesh.triangles.is_empty() {
-        return Err(Error::bad_input(
-            Some(&options.mesh),
-            "the mesh has no usable triangle after repair",
-        ));
-    }
+    let mesh = super::repair_stage::repair_into_report(
+        &loaded.mesh,
+        Some(&options.mesh),
+        None,
+        &mut report,
+    )?;
     report.input = json!({
         "mesh": options.mesh.display().to_string(),
         "exemplar": options.exemplar.display().to_string(),

@@ -53,10 +53,7 @@ pub fn crest_file(
     if let Some(p) = &options.preview {
         crate::outputs::guard_output(p)?;
     }
-    let repaired = fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default());
-    if repaired.mesh.triangles.is_empty() {
-        return Err(Error::bad_input(Some(mesh_path), "no usable triangle is left after repair"));
-    }
+    let repaired = super::repair_stage::repair_mesh(&loaded.mesh, Some(mesh_path), None)?;
     let crest = crest_lines(&repaired.mesh, &copts)
         .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
     let kept: Vec<_> = crest.lines.iter().filter(|l| l.level >= options.min_level).collect();

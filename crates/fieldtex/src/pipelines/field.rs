@@ -68,12 +68,9 @@ pub fn field_file(
     fieldtex_io::ensure_not_input(out, &inputs)?;
     let loaded = fieldtex_io::read_mesh(mesh_path)?;
     let mut warnings = loaded.warnings.clone();
-    let repaired = fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default());
-    warnings.extend(repaired.warnings.iter().cloned());
+    let repaired = super::repair_stage::repair_mesh(&loaded.mesh, Some(mesh_path), None)?;
+    warnings.extend(repaired.warnings);
     let mesh = repaired.mesh;
-    if mesh.triangles.is_empty() {
-        return Err(Error::bad_input(Some(mesh_path), "no usable triangle is left after repair"));
-    }
     let (curves, source) = match &options.curves {
         Some(p) => (fieldtex_io::read_obj_polylines(p)?, p.display().to_string()),
         None => {

@@ -10,6 +10,7 @@ pub mod inspect;
 pub mod orient;
 pub(crate) mod orient_patch;
 pub mod render;
+pub(crate) mod repair_stage;
 pub mod solid;
 pub(crate) mod synthesis;
 pub mod transfer;

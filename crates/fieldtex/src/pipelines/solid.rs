@@ -264,22 +264,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
 fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, Vec<PathBuf>)> {
     let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
-    let repaired = report.time("repair", || {
-        fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default())
-    });
-    for c in &repaired.changes {
-        report.warnings.push(Warning::new(
-            format!("repair:{}", c.code),
-            format!("{} ({})", c.message, c.count),
-        ));
-    }
-    report.warnings.extend(repaired.warnings.iter().cloned());
-    if repaired.mesh.triangles.is_empty() {
-        return Err(Error::bad_input(
-            Some(&options.mesh),
-            "no usable triangle is left after repair",
-        ));
-    }
+    let repaired =
+        super::repair_stage::repair_into_report(&loaded.mesh, Some(&options.mesh), None, report)?;
     let mut inputs = vec![options.mesh.clone()];
     inputs.extend(options.sketch.iter().cloned());
     inputs.extend(
@@ -290,10 +276,10 @@ fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, 
     );
     report.input = serde_json::json!({
         "mesh": options.mesh,
-        "vertices": repaired.mesh.n_vertices(),
-        "triangles": repaired.mesh.n_triangles(),
+        "vertices": repaired.n_vertices(),
+        "triangles": repaired.n_triangles(),
     });
-    Ok((repaired.mesh, inputs))
+    Ok((repaired, inputs))
 }
 
 /// The three plane exemplars, and whether they all came from `--exemplar`.

@@ -13,7 +13,7 @@ use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::align::{atlas_carriers, carrier_texture};
 use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
-use fieldtex_core::{Image, Warning};
+use fieldtex_core::Image;
 use fieldtex_mesh::TriMesh;
 use fieldtex_render::{RenderOptions, Scene, render};
 use fieldtex_transfer::{
@@ -87,18 +87,6 @@ pub fn parse_engine(s: &str) -> Option<Engine> {
         "nonparametric" => Some(Engine::Nonparametric),
         _ => None,
     }
-}
-
-fn repaired(mesh: &TriMesh, report: &mut Report, which: &str) -> TriMesh {
-    let r = fieldtex_mesh::repair(mesh, &fieldtex_mesh::RepairOptions::default());
-    for c in &r.changes {
-        report.warnings.push(Warning::new(
-            format!("repair:{which}:{}", c.code),
-            format!("{which}: {} ({})", c.message, c.count),
-        ));
-    }
-    report.warnings.extend(r.warnings.iter().cloned());
-    r.mesh
 }
 
 fn transfer_error(e: TransferError, options: &TransferCommandOptions) -> Error {
@@ -176,20 +164,24 @@ pub fn transfer_files(
     // Everything below writes into the staging folder, moved into place at the end.
     let stage = out.staging().to_path_buf();
     let out_dir = stage.as_path();
-    let source_mesh = repaired(&src.mesh, &mut report, "source");
+    let source_mesh = super::repair_stage::repair_into_report(
+        &src.mesh,
+        Some(&options.source),
+        Some("source"),
+        &mut report,
+    )?;
     if source_mesh.uvs.is_none() {
         return Err(Error::bad_input(
             Some(&options.source),
             "repair had to drop the source's texture coordinates (see the warnings); fix the UVs of the source",
         ));
     }
-    let target_mesh = repaired(&tgt.mesh, &mut report, "target");
-    if target_mesh.triangles.is_empty() {
-        return Err(Error::bad_input(
-            Some(&options.target),
-            "the target has no usable triangle after repair (all degenerate or invalid)",
-        ));
-    }
+    let target_mesh = super::repair_stage::repair_into_report(
+        &tgt.mesh,
+        Some(&options.target),
+        Some("target"),
+        &mut report,
+    )?;
     report.input = serde_json::json!({
         "source": options.source.display().to_string(),
         "source_vertices": source_mesh.n_vertices(),
