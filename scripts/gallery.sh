@@ -31,7 +31,19 @@ for p in arch tented-arch left-loop right-loop whorl; do
 done
 [ "$only" = orient ] && { echo "gallery (orient) written to docs/gallery/"; exit 0; }
 "$bin" demo --out out/gallery/demo --quiet
-cp out/gallery/demo/preview.png docs/gallery/demo.png
+cp out/gallery/demo/preview.png docs/gallery/demo-cube.png
+cp out/gallery/demo/orient.png docs/gallery/demo-orient-whorl.png
+mesh=../shared/data/meshes
+for m in torus fertility stanford-bunny; do
+  "$bin" conformal --mesh "$mesh/$m.obj" --exemplar "$ex/pebbles_Rocks002.png" --out "out/gallery/conformal-$m" --quiet
+done
+cp out/gallery/conformal-torus/preview.png docs/gallery/conformal-torus.png
+cp out/gallery/conformal-fertility/preview.png docs/gallery/conformal-fertility.png
+cp out/gallery/conformal-stanford-bunny/preview.png docs/gallery/conformal-bunny.png
+"$bin" conformal --mesh "$mesh/stanford-bunny.obj" --exemplar "$ex/pebbles_Rocks002.png" --no-multiscale --out out/gallery/conformal-bunny-nms --quiet
+cp out/gallery/conformal-bunny-nms/preview.png docs/gallery/conformal-bunny-no-multiscale.png
+"$bin" conformal --mesh "$mesh/stanford-bunny.obj" --exemplar "$ex/pebbles_Rocks002.png" --quasi-isometric --out out/gallery/conformal-bunny-qi --quiet
+cp out/gallery/conformal-bunny-qi/preview.png docs/gallery/conformal-bunny-quasi-isometric.png
 "$bin" atlas ../shared/data/meshes/stanford-bunny.obj --out out/gallery/atlas-bunny --quiet
 cp out/gallery/atlas-bunny/preview.png docs/gallery/atlas-bunny.png
 echo "gallery written to docs/gallery/"
