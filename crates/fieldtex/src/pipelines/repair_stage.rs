@@ -32,7 +32,8 @@ pub(crate) fn repair_mesh(
         .map(|c| {
             Warning::new(
                 format!("{code_prefix}{}", c.code),
-                format!("{message_prefix}{} ({})", c.message, c.count),
+                // The message states the count itself.
+                format!("{message_prefix}{}", c.message),
             )
         })
         .collect();

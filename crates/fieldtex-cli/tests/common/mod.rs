@@ -1,0 +1,58 @@
+//! Helpers shared by the CLI's end-to-end tests: the binary, the shared data folder, a
+//! fresh scratch folder per test, and a run with a wall-clock limit (a hang fails the
+//! test instead of stalling the suite).
+
+#![allow(dead_code)] // each test file uses a subset
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// The `fieldtex` binary under test.
+pub fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_fieldtex")
+}
+
+/// `../shared/data` beside the repository (meshes, exemplars, textured meshes).
+pub fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+/// An empty scratch folder `suite/name` under Cargo's per-target temporary folder.
+pub fn tmp_in(suite: &str, name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(suite).join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs the binary with `args`, failing the test when it runs past `limit`.
+pub fn run_limited(args: &[&str], limit: Duration) -> Output {
+    let mut child = Command::new(bin())
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn fieldtex");
+    let t0 = Instant::now();
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            return child.wait_with_output().expect("output");
+        }
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            panic!("fieldtex {args:?} did not finish within {limit:?} (hang?)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// The exit code (−1 when killed by a signal).
+pub fn code(o: &Output) -> i32 {
+    o.status.code().unwrap_or(-1)
+}
+
+/// Standard error as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
