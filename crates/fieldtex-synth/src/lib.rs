@@ -97,10 +97,12 @@
 //!   rayon thread count.
 
 pub mod appearance_space;
+pub mod characteristic_scale;
 pub mod color_lookup;
 pub mod domain;
 mod error;
 pub mod exemplar_analysis;
+pub mod exemplar_policy;
 pub mod flip_combing;
 pub mod gaussian_stack;
 pub mod k_coherence;
@@ -108,8 +110,10 @@ mod level_tables;
 pub mod parallel_synthesis;
 pub mod synthesis_options;
 
+pub use characteristic_scale::{CharacteristicScale, characteristic_scale};
 pub use color_lookup::{ColorFilter, color_lookup};
 pub use domain::{ImageDomain, SynthesisDomain};
 pub use error::SynthError;
 pub use exemplar_analysis::{APPEARANCE_DIMS, AnalysisLevel, AnalysisOptions, ExemplarAnalysis};
+pub use exemplar_policy::{FittedExemplar, MAX_EXEMPLAR_SIDE, fit_exemplar};
 pub use parallel_synthesis::{SynthesisOptions, SynthesisResult, synthesize};

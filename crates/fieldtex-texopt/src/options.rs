@@ -56,6 +56,18 @@ pub struct TexOptOptions {
     /// patch pixels in the blend; `None` for Kwatra 2005's uniform patch weights (blurrier
     /// where overlapping matches disagree). Default `Some(1.5)`.
     pub blend_falloff: Option<f64>,
+    /// Coherence bias `κ` (Ashikhmin 2001): the squared distance of random and PCA
+    /// candidates is multiplied by `1 + κ`, so a sample leaves its own or a
+    /// neighbour-continued patch only for a clearly better one. Without it, thin
+    /// structures (mortar, cracks) that overlapping patches place slightly apart blend
+    /// into faint lines that flat exemplar regions match as well, and fade level by
+    /// level. Default 0.25.
+    pub coherence_bias: f64,
+    /// Crisp final pass: after the last iteration of the finest level each carrier
+    /// takes the colour of the covering patch closest to the blended average instead of
+    /// the average ([`robust_blend`](crate::robust_blend)). Default true; false keeps
+    /// the softer least-squares blend.
+    pub crisp: bool,
     /// Seed of all random streams. Default 0.
     pub seed: u64,
 }
@@ -79,6 +91,8 @@ impl Default for TexOptOptions {
             feature_threshold: 0.5,
             normal_cosine: 0.3,
             blend_falloff: Some(1.5),
+            coherence_bias: 1.0,
+            crisp: true,
             seed: 0,
         }
     }
@@ -159,6 +173,10 @@ impl TexOptOptions {
         {
             return bad("blend_falloff", sigma, "must be positive and finite (or None)");
         }
+        let k = self.coherence_bias;
+        if !(k.is_finite() && k >= 0.0) {
+            return bad("coherence_bias", k, "must be non-negative and finite");
+        }
         let n = self.normal_cosine;
         if !(n.is_finite() && (-1.0..=1.0).contains(&n)) {
             return bad("normal_cosine", n, "must be in [-1, 1]");
@@ -177,4 +195,45 @@ pub struct FeatureAlignment {
     /// `#C`: surface (geodesic) distance from each carrier to the salient curves, in
     /// surface units. `+∞` for carriers the curves cannot reach; NaN is an error.
     pub carrier_curve_distance: Vec<f64>,
+}
+
+/// Coarse-to-fine patch widths for an exemplar whose largest structure is `structure`
+/// pixels and whose shorter side is `min_side` pixels: `w_max, w_max/2, …, 8` with
+/// `w_max` the smallest `8·2^k ≥ structure`, at least 32 (Kwatra et al. 2005's
+/// `32, 16, 8`), at most 256 and at most half the shorter side (so that patches still
+/// have room to move; never below 8 and never above `min_side`). Levels of step
+/// `s = w/8` see the exemplar as its `s`-times reduced pyramid level, so the coarsest
+/// patches span the largest structures.
+pub fn pyramid_patch_sizes(structure: f64, min_side: usize) -> Vec<usize> {
+    let fits = |w: usize| w <= 256 && 2 * w <= min_side;
+    let mut cap = 8;
+    while fits(cap * 2) {
+        cap *= 2;
+    }
+    let cap = if min_side >= 32 { cap.max(32).min(min_side / 8 * 8) } else { 8 };
+    let mut w_max = 32;
+    while (w_max as f64) < structure && w_max * 2 <= cap {
+        w_max *= 2;
+    }
+    let w_max = w_max.min(cap);
+    let mut sizes = vec![w_max];
+    while *sizes.last().unwrap_or(&8) > 8 {
+        let next = sizes.last().unwrap_or(&8) / 2;
+        sizes.push(next.max(8) / 8 * 8);
+    }
+    sizes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pyramid_patch_sizes;
+
+    #[test]
+    fn pyramid_patch_sizes_span_the_structure_within_the_exemplar() {
+        assert_eq!(pyramid_patch_sizes(6.0, 116), vec![32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(75.0, 512), vec![128, 64, 32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(75.0, 200), vec![64, 32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(900.0, 2048), vec![256, 128, 64, 32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(40.0, 40), vec![32, 16, 8]);
+    }
 }

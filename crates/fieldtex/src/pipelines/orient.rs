@@ -38,7 +38,8 @@ pub struct OrientOptions {
     pub size: usize,
     /// Field grid cells per side for presets. Default 128.
     pub grid: usize,
-    /// Exemplar pixels per output pixel. Default 1.
+    /// Pattern size: output pixels per pixel of the exemplar file (2 = the pattern twice
+    /// as large; the same meaning as `align`'s). Default 1.
     pub scale: f64,
     /// The 2-RoSy fix of paper D §4 (off only for the ablation). Default true.
     pub rosy_fix: bool,
@@ -54,6 +55,13 @@ pub struct OrientOptions {
 }
 
 impl OrientOptions {
+    /// Exemplar pixels (of the exemplar as reduced by the exemplar policy, `reduction`
+    /// file pixels each) per output pixel: what the synthesis domain's Jacobians scale
+    /// by.
+    pub(crate) fn exemplar_pixels_per_output_pixel(&self, reduction: usize) -> f64 {
+        1.0 / (self.scale * reduction.max(1) as f64)
+    }
+
     pub fn new(source: FieldSource, exemplar: PathBuf) -> Self {
         Self {
             source,
@@ -178,17 +186,30 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     }
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let exemplar = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
+    report.warnings.extend(fitted.warning.clone());
+    let per_pixel = options.exemplar_pixels_per_output_pixel(fitted.factor);
+    let exemplar = fitted.image;
     report.input = serde_json::json!({
         "exemplar": options.exemplar.display().to_string(),
-        "exemplar_size": [exemplar.width, exemplar.height],
+        "exemplar_size": [exemplar.width * fitted.factor, exemplar.height * fitted.factor],
+        "exemplar_reduction": fitted.factor,
     });
     prepare_out_dir(out_dir)?;
     let (field, designed) = build_field(options, &mut report)?;
     let n = options.size;
-    let synth =
-        super::synthesis::synthesize_image(&exemplar, &field, n, n, options, &mut report, progress)
-            .map_err(|e| e.with_path(&options.exemplar))?;
+    let synth = super::synthesis::synthesize_image(
+        &exemplar,
+        &field,
+        n,
+        n,
+        per_pixel,
+        options,
+        &mut report,
+        progress,
+    )
+    .map_err(|e| e.with_path(&options.exemplar))?;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     fieldtex_io::write_png(&out_dir.join("texture.png"), &synth)?;
     fieldtex_io::write_npy_f32(&out_dir.join("field.npy"), &[n, n, 2], &flat)?;
