@@ -21,6 +21,10 @@ pub struct TexOptOptions {
     pub robust_exponent: f64,
     /// Search/blend iterations per patch size at most. Default 4.
     pub max_iterations: usize,
+    /// Iterations of the levels with `w ≤ 16` at most (they start from upsampled,
+    /// coherent sources and hold most carriers: the cost of `align`). Default 2
+    /// (measured on fandisk, bricks 512², 512² atlas: see docs/real-exemplars.md).
+    pub fine_iterations: usize,
     /// A level stops when at most this fraction of samples changed match. Default 0.01.
     pub converge_fraction: f64,
     /// Random exemplar candidates per sample and iteration (alternately uniform and in a
@@ -80,6 +84,7 @@ impl Default for TexOptOptions {
             sample_spacing_ratio: 0.25,
             robust_exponent: 0.8,
             max_iterations: 4,
+            fine_iterations: 2,
             converge_fraction: 0.01,
             random_candidates: 6,
             coherence_neighbours: 8,
@@ -109,6 +114,10 @@ impl TexOptOptions {
     }
     pub fn with_max_iterations(mut self, n: usize) -> Self {
         self.max_iterations = n;
+        self
+    }
+    pub fn with_fine_iterations(mut self, n: usize) -> Self {
+        self.fine_iterations = n;
         self
     }
     pub fn with_exemplar_angle(mut self, radians: f64) -> Self {

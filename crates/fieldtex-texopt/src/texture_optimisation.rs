@@ -344,8 +344,14 @@ pub fn optimise(
             stats.uncovered_carriers =
                 blend(&ctx, which, &matches, &weights, &mut colors, &mut source, BlendMode::Winner);
         }
-        progress.stage(&format!("texture optimisation {w}×{w}"), options.max_iterations as u64);
-        for iteration in 0..options.max_iterations {
+        // The fine levels start from upsampled, already coherent sources.
+        let iterations = if w <= 16 {
+            options.fine_iterations.clamp(1, options.max_iterations)
+        } else {
+            options.max_iterations
+        };
+        progress.stage(&format!("texture optimisation {w}×{w}"), iterations as u64);
+        for iteration in 0..iterations {
             let found: Vec<Match> = (0..samples.len())
                 .into_par_iter()
                 .with_min_len(64)
@@ -370,7 +376,7 @@ pub fn optimise(
             stats.mean_patch_error.push(err / samples.len().max(1) as f64);
             stats.changed.push(changed);
             stats.iterations += 1;
-            let last = iteration + 1 == options.max_iterations
+            let last = iteration + 1 == iterations
                 || (iteration > 0
                     && changed as f64 <= options.converge_fraction * samples.len() as f64);
             let which = (subset && !last).then_some(ctx.active.as_slice());

@@ -277,6 +277,14 @@ pub fn align(out_dir: &Path, options: &AlignOptions, progress: &dyn Progress) ->
             format!("--scale must be in (0, 64], got {}", options.scale),
         ));
     }
+    if let Some(d) = options.direction
+        && !(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0))
+    {
+        return Err(Error::bad_input(
+            None,
+            format!("--direction must be three finite numbers, not all zero; got {d:?}"),
+        ));
+    }
     let mut inputs = vec![options.mesh.as_path(), options.exemplar.as_path()];
     if let Some(c) = &options.curves {
         inputs.push(c);
