@@ -249,7 +249,9 @@ pub(crate) fn search_sample(
     }
     let mut out = Match { placement: prev[p], distance2: f32::INFINITY, constrained };
     let mut best_score = f32::INFINITY;
-    let penalty = 1.0 + ctx.coherence_bias as f32;
+    // Constrained samples (paper A §5.2) put feature alignment first: no bias (their
+    // candidate list was also filtered, so its first entries are not all coherent).
+    let penalty = if constrained { 1.0 } else { 1.0 + ctx.coherence_bias as f32 };
     for (i, &c) in cand.list[..cand.len].iter().enumerate() {
         let d = lvl.distance2(&x, c.position);
         // Ashikhmin-style coherence bias: a jump to an unrelated exemplar place must be

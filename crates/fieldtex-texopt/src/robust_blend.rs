@@ -44,7 +44,8 @@ pub(crate) enum BlendMode {
     Average,
     /// The crisp final pass: the exemplar pixel (nearest to the coordinate) that one
     /// covering patch assigns, namely the patch whose colour is closest to the weighted
-    /// average (ties: the larger weight), with its exemplar coordinate as source. Every
+    /// average among those with at least half the largest weight (ties: the larger),
+    /// with its exemplar coordinate as source. Every
     /// carrier then shows an exemplar pixel, not a mix.
     Crisp,
     /// The colour of the covering patch with the largest weight (the one whose centre
@@ -162,6 +163,11 @@ fn blend_carrier(
     if mode == BlendMode::Crisp {
         let mut best = (f32::INFINITY, f64::NEG_INFINITY, usize::MAX);
         for (i, (w, z, _)) in cands[..n_cands].iter().enumerate() {
+            // Only patches near their centre here (weight at least half the largest):
+            // their placement is what the search (and §5.2's constraint) decided.
+            if *w < 0.5 * win.0 {
+                continue;
+            }
             let e: f32 = (0..3).map(|k| (z[k] - col[k]) * (z[k] - col[k])).sum();
             if e < best.0 || (e == best.0 && *w > best.1) {
                 best = (e, *w, i);
