@@ -107,7 +107,10 @@ pub fn smoothest_field(mesh: &TriMesh) -> Result<SmoothestField, FieldsError> {
     let system = |shift: f64| -> Result<Cholesky, FieldsError> {
         let mut t = trip.clone();
         for i in 0..nv {
+            // A vertex without edges or area (isolated) is decoupled: 1 on the diagonal,
+            // and its right-hand side is 0.
             let d = diag[i] + shift * mass[i];
+            let d = if d > 0.0 && d.is_finite() { d } else { 1.0 };
             t.push((i, i, d));
             t.push((nv + i, nv + i, d));
         }
