@@ -98,7 +98,9 @@ enum Command {
         /// External field .npy (H×W×2 float32 (dx, dy), x right, y down).
         #[arg(long, group = "source")]
         field: Option<PathBuf>,
-        /// Exemplar image (PNG/JPEG), e.g. stripes; its x axis follows the field.
+        /// Exemplar image: PNG, JPEG, TGA, BMP, TIFF or PNM (8/16-bit, grey/RGB/RGBA);
+        /// above 2048 pixels per side it is reduced (with a warning) and the pattern keeps
+        /// its size.
         #[arg(long)]
         exemplar: PathBuf,
         /// Output size in pixels (square).
@@ -107,7 +109,8 @@ enum Command {
         /// Field grid cells per side (presets).
         #[arg(long, default_value_t = 128)]
         grid: usize,
-        /// Exemplar pixels per output pixel, 1/64 to 16 (below 1 enlarges the pattern).
+        /// Pattern size: output pixels per pixel of the exemplar file (2 = the pattern
+        /// twice as large; the same meaning in align and orient), 1/64 to 16.
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
         /// Disable the 2-RoSy fix of paper D §4 (ablation).
@@ -183,7 +186,9 @@ enum Command {
         /// Mesh file: OBJ, PLY, STL, glTF or GLB.
         #[arg(long)]
         mesh: PathBuf,
-        /// Exemplar image (PNG/JPEG) with clear feature lines (stripes, bricks, weave).
+        /// Exemplar image: PNG, JPEG, TGA, BMP, TIFF or PNM (8/16-bit, grey/RGB/RGBA);
+        /// above 2048 pixels per side it is reduced (with a warning) and the pattern keeps
+        /// its size.
         #[arg(long)]
         exemplar: PathBuf,
         /// OBJ polylines (`l` elements) to align to; default: detected crest lines.
@@ -196,9 +201,15 @@ enum Command {
         /// Atlas texture size in texels (square).
         #[arg(long, default_value_t = 1024)]
         size: usize,
-        /// Size of one exemplar pixel in atlas texels (2 = pattern twice as large).
+        /// Pattern size: output texels per pixel of the exemplar file (2 = the pattern
+        /// twice as large; the same meaning in align and orient).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
+        /// Where no feature curve constrains the field: follow this global direction
+        /// projected onto the surface (default: the smoothest field, along curvature
+        /// where it is clearly anisotropic).
+        #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', allow_negative_numbers = true)]
+        direction: Option<Vec<f64>>,
         /// Ablation: no feature-to-feature alignment (paper A §5.2).
         #[arg(long)]
         no_feature_align: bool,
@@ -447,12 +458,23 @@ fn run(cli: Cli) -> Result<(), Error> {
             exemplar_lines,
             size,
             scale,
+            direction,
             no_feature_align,
             orient,
             keep,
             draw_curves,
             out,
         } => {
+            let direction = match direction.as_deref() {
+                None => None,
+                Some(&[x, y, z]) => Some([x, y, z]),
+                Some(v) => {
+                    return Err(Error::bad_input(
+                        None,
+                        format!("--direction needs three numbers X,Y,Z; got {}", v.len()),
+                    ));
+                }
+            };
             let opts = fieldtex::AlignOptions {
                 mesh,
                 exemplar,
@@ -460,6 +482,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 exemplar_lines,
                 size,
                 scale,
+                direction,
                 feature_align: !no_feature_align,
                 greedy: orient == "greedy",
                 keep,

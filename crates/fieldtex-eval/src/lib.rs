@@ -6,6 +6,7 @@
 //! - [`guided_coherence()`]: coherence with output patches taken in the local frame of a
 //!   direction field (field-guided synthesis);
 //! - [`color_sliced_wasserstein()`]: distance between colour distributions;
+//! - [`contrast_sharpness()`]: luminance contrast and gradient ratios against the exemplar;
 //! - [`orientation_error`]: structure-tensor feature direction vs a guidance field;
 //! - [`singularities()`]: ±1/2 singularities of an orientation map;
 //! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px;
@@ -22,6 +23,7 @@ pub mod approximate_nearest_patch;
 pub mod coherence;
 pub mod color_sliced_wasserstein;
 pub mod completeness;
+pub mod contrast_sharpness;
 mod error;
 pub mod feature_size;
 mod filters;
@@ -41,6 +43,9 @@ pub use color_sliced_wasserstein::{
     SlicedWassersteinOptions, SlicedWassersteinReport, color_sliced_wasserstein,
 };
 pub use completeness::completeness;
+pub use contrast_sharpness::{
+    ContrastSharpnessReport, LuminanceStatistics, contrast_sharpness, luminance_statistics,
+};
 pub use error::EvalError;
 pub use guided_coherence::{GuidedCoherenceOptions, GuidedCoherenceReport, guided_coherence};
 pub use image_view::{FieldView, ImageView, rgb_buffer};

@@ -68,12 +68,18 @@ pub enum OverlapPolicy {
 }
 
 /// Field of a connected component that no curve touches.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub enum UnconstrainedFallback {
-    /// Direction of maximal principal curvature (Rusinkiewicz 2004 estimate; a line
-    /// field, its sign is arbitrary). Default.
+    /// The smoothest line field, aligned to principal curvature only where it is
+    /// clearly anisotropic (Knöppel et al. 2013; [`crate::smoothest_field`]). Default.
     #[default]
+    Smoothest,
+    /// Direction of maximal principal curvature at every vertex (Rusinkiewicz 2004
+    /// estimate; a line field, its sign is arbitrary; swirls on flat parts).
     PrincipalDirection,
+    /// A global direction projected onto each tangent plane (where it is along the
+    /// normal, any tangent).
+    Direction([f64; 3]),
     /// Zero vectors.
     Zero,
 }
@@ -123,7 +129,7 @@ impl Default for CurveFieldOptions {
             sample_spacing: 0.5,
             max_distance: 2.0,
             overlap: OverlapPolicy::KeepFirst,
-            fallback: UnconstrainedFallback::PrincipalDirection,
+            fallback: UnconstrainedFallback::Smoothest,
             refactor_above: 200,
             ordering: FillOrdering::default(),
         }
@@ -148,7 +154,18 @@ impl CurveFieldOptions {
             0.0,
             1e3,
             "a number of mean edge lengths in (0, 1000]",
-        )
+        )?;
+        if let UnconstrainedFallback::Direction(d) = self.fallback {
+            let n = vec3::norm(d);
+            if !(n.is_finite() && n > 0.0) {
+                return Err(FieldsError::InvalidOption {
+                    name: "fallback direction length",
+                    value: n,
+                    expected: "a finite, non-zero direction X,Y,Z",
+                });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -851,6 +868,26 @@ impl<'m> CurveFieldSolver<'m> {
                         }
                     }
                     "the maximal principal curvature direction"
+                }
+                UnconstrainedFallback::Smoothest => {
+                    let smooth = crate::smoothest_field::smoothest_field(self.mesh)?;
+                    for (v, s) in status.iter().enumerate() {
+                        if *s == VertexFieldStatus::Fallback {
+                            vectors[v] = smooth.vectors[v];
+                        }
+                    }
+                    "the smoothest line field, along principal curvature where it is clearly \
+                     anisotropic"
+                }
+                UnconstrainedFallback::Direction(d) => {
+                    for (v, s) in status.iter().enumerate() {
+                        if *s == VertexFieldStatus::Fallback {
+                            let n = self.normals[v];
+                            vectors[v] =
+                                project_unit(d, n).unwrap_or_else(|| vec3::any_orthonormal(n));
+                        }
+                    }
+                    "the given direction projected onto the surface"
                 }
                 UnconstrainedFallback::Zero => "zero vectors",
             };

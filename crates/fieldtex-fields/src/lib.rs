@@ -86,6 +86,7 @@ pub use sketch::Sketch;
 pub mod greedy_curve_orientation;
 pub mod harmonic_diffusion;
 pub mod nested_dissection;
+pub mod smoothest_field;
 pub mod surface_field_metrics;
 pub use greedy_curve_orientation::{
     CurveOrientationOptions, CurveOrientationResult, OrientationMode, OrientationScore,
@@ -95,6 +96,7 @@ pub use harmonic_diffusion::{
     AddReport, CurveConstraints, CurveField, CurveFieldOptions, CurveFieldSolver, OverlapPolicy,
     SolveReport, UnconstrainedFallback, VertexFieldStatus,
 };
+pub use smoothest_field::{SmoothestField, smoothest_field};
 pub use surface_field_metrics::{
     AlignmentError, FieldSingularity, SurfaceFieldMetrics, surface_field_metrics,
 };

@@ -1,5 +1,5 @@
-//! PNG/JPEG reading into the shared [`Image`] (RGBA `f32`, sRGB-encoded, top row first)
-//! and PNG writing.
+//! Image reading (PNG, JPEG, TGA, BMP, TIFF, PNM: the `image` crate's decoders) into the
+//! shared [`Image`] (RGBA `f32`, sRGB-encoded, top row first) and PNG writing.
 //!
 //! Reading accepts 8- and 16-bit gray, gray+alpha, RGB and RGBA PNGs and baseline or
 //! progressive JPEGs; integer samples are divided by their maximum (255 or 65535), gray
@@ -43,7 +43,7 @@ pub fn read_image_bytes(bytes: &[u8], name: &str) -> Result<Image, IoError> {
     if r.format().is_none() {
         return Err(IoError::UnknownFormat {
             file: name.to_string(),
-            detail: "not a PNG or JPEG image".into(),
+            detail: "not a PNG, JPEG, TGA, BMP, TIFF or PNM image".into(),
         });
     }
     let decoder =

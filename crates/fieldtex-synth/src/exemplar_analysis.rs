@@ -41,13 +41,21 @@ pub struct AnalysisOptions {
     /// ([`AnalysisLevel::margin`]), so the exemplar's edges never show as seams.
     pub tileable: bool,
     /// Largest accepted exemplar side; larger exemplars are refused with
-    /// [`SynthError::ExemplarTooLarge`]. Default 1024.
+    /// [`SynthError::ExemplarTooLarge`]. Default
+    /// [`MAX_EXEMPLAR_SIDE`](crate::MAX_EXEMPLAR_SIDE) (pipelines reduce larger ones
+    /// first, [`crate::exemplar_policy`]).
     pub max_size: usize,
 }
 
 impl Default for AnalysisOptions {
     fn default() -> Self {
-        Self { k: 2, coherence_radius: 3, coherence_scan: 256, tileable: false, max_size: 1024 }
+        Self {
+            k: 2,
+            coherence_radius: 3,
+            coherence_scan: 256,
+            tileable: false,
+            max_size: crate::MAX_EXEMPLAR_SIDE,
+        }
     }
 }
 

@@ -32,10 +32,12 @@
 //!   rayon thread count.
 
 pub mod appearance_space;
+pub mod characteristic_scale;
 pub mod color_lookup;
 pub mod domain;
 mod error;
 pub mod exemplar_analysis;
+pub mod exemplar_policy;
 pub mod exemplar_scales;
 pub mod flip_combing;
 pub mod gaussian_stack;
@@ -47,9 +49,11 @@ pub mod parallel_synthesis;
 pub mod solid;
 pub mod synthesis_options;
 
+pub use characteristic_scale::{CharacteristicScale, characteristic_scale};
 pub use color_lookup::{ColorFilter, color_lookup};
 pub use domain::{ImageDomain, SynthesisDomain};
 pub use error::SynthError;
 pub use exemplar_analysis::{APPEARANCE_DIMS, AnalysisLevel, AnalysisOptions, ExemplarAnalysis};
+pub use exemplar_policy::{FittedExemplar, MAX_EXEMPLAR_SIDE, fit_exemplar};
 pub use image_quilting::{QuiltStats, QuiltTarget, QuiltingOptions, quilt};
 pub use parallel_synthesis::{SynthesisOptions, SynthesisResult, synthesize};

@@ -244,7 +244,7 @@ fn bad_exemplars_and_options_are_refused() {
         Err(SynthError::ExemplarTooSmall { width: 7, height: 30, .. })
     ));
     assert!(matches!(
-        ExemplarAnalysis::new(&Image::new(1100, 9, [0.5; 4]), &opts, &NoProgress),
+        ExemplarAnalysis::new(&Image::new(2100, 9, [0.5; 4]), &opts, &NoProgress),
         Err(SynthError::ExemplarTooLarge { .. })
     ));
     let mut nan = blotches(10, 10);

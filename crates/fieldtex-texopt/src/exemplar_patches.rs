@@ -8,11 +8,21 @@
 //! every `w`, then [`Pca`] reduces them for exhaustive search.
 //!
 //! Patch positions are integer *origins* `o` (the pixel of grid point `(0, 0)`); grid
-//! point `(i, j)` is pixel `o + (i·s, j·s)`, and the patch centre is `o + 3.5·s`. With
-//! `toroidal = false` every origin keeps the grid inside the exemplar
-//! (`0 ≤ o ≤ W − 1 − 7s`); with `toroidal = true` every pixel is an origin and lookups
-//! wrap. Coordinates here are pixel-*index* space (pixel `x` at `x`); the public API adds
+//! point `(i, j)` is pixel `o + (i·s, j·s)`, and the patch centre is `o + 3.5·s`.
+//! Origins lie on a lattice of *stride* `t` pixels: `t = max(⌊s/2⌋, t₀, 1)` with `t₀`
+//! the smallest stride that keeps the positions of a large exemplar under
+//! [`MAX_POSITIONS`]. At `w = 8` on exemplars up to 512² every pixel is an origin; a
+//! coarse level is, in effect, a level of the exemplar's pyramid sampled at twice its
+//! resolution (Kwatra et al. 2005 search coarse levels on the subsampled exemplar).
+//! Matches keep a continuous origin offset of up to `±t/2` (coherence), so copying is
+//! not quantised to the lattice. With `toroidal = false` every origin keeps the grid
+//! inside the exemplar (`0 ≤ o ≤ W − 1 − 7s`); with `toroidal = true` lookups wrap.
+//! Coordinates here are pixel-*index* space (pixel `x` at `x`); the public API adds
 //! `0.5` (pixel centres at `x + 0.5`, as `Image::sample_bilinear`).
+//!
+//! Memory: descriptors are not stored; the exact 192-D distance reads the filtered
+//! image (64 pixels), and only the PCA coordinates (`kp` floats) are kept per position.
+//! The PCA basis is fitted on at most [`PCA_FIT_SAMPLES`] evenly spread positions.
 
 use crate::TexOptError;
 use fieldtex_core::Image;
@@ -25,10 +35,16 @@ pub(crate) const GRID: usize = 8;
 pub(crate) const DIM: usize = GRID * GRID * 3;
 /// Patch coordinate of the grid centre.
 pub(crate) const HALF: f64 = (GRID as f64 - 1.0) / 2.0;
+/// Most patch positions per level (bounds the PCA coordinates to `2¹⁸ · kp` floats).
+pub const MAX_POSITIONS: usize = 1 << 18;
+/// Most positions the PCA basis is fitted on.
+pub const PCA_FIT_SAMPLES: usize = 16_384;
 
 /// Exemplar data of one patch size.
 pub(crate) struct ExemplarLevel {
     pub step: usize,
+    /// Lattice spacing of the origins, pixels.
+    pub stride: usize,
     pub width: usize,
     pub height: usize,
     pub toroidal: bool,
@@ -37,8 +53,6 @@ pub(crate) struct ExemplarLevel {
     /// Origins per axis: `nx × ny` positions, index `oy·nx + ox`.
     pub nx: usize,
     pub ny: usize,
-    /// `M × DIM` descriptors.
-    pub descriptors: Vec<f32>,
     /// `M × kp` PCA coefficients, zero-padded to `kp` (a multiple of 8) per row.
     pub coords: Vec<f32>,
     /// Padded row length of `coords`.
@@ -70,16 +84,23 @@ impl ExemplarLevel {
         }
         let image = tent_filter(exemplar, step, toroidal);
         let span = (GRID - 1) * step;
-        let (nx, ny) = if toroidal { (w, h) } else { (w - span, h - span) };
+        let base = (w * h).div_ceil(MAX_POSITIONS).isqrt();
+        let base = if base * base * MAX_POSITIONS < w * h { base + 1 } else { base };
+        let stride = (step / 2).max(base).max(1);
+        let (nx, ny) = if toroidal {
+            (w.div_ceil(stride), h.div_ceil(stride))
+        } else {
+            ((w - 1 - span) / stride + 1, (h - 1 - span) / stride + 1)
+        };
         let mut level = Self {
             step,
+            stride,
             width: w,
             height: h,
             toroidal,
             image,
             nx,
             ny,
-            descriptors: Vec::new(),
             coords: Vec::new(),
             kp: 0,
             basis: Vec::new(),
@@ -89,14 +110,18 @@ impl ExemplarLevel {
             feature_bins: Vec::new(),
         };
         let m = nx * ny;
-        let mut descriptors = vec![0.0f32; m * DIM];
+        // PCA on an evenly spread subset of positions (deterministic).
+        let fit_step = m.div_ceil(PCA_FIT_SAMPLES).max(1);
+        let fit: Vec<u32> = (0..m as u32).step_by(fit_step).collect();
+        let mut descriptors = vec![0.0f32; fit.len() * DIM];
         descriptors
             .par_chunks_mut(DIM)
-            .enumerate()
-            .for_each(|(p, d)| level.descriptor(p as u32, d));
+            .zip(fit.par_iter())
+            .for_each(|(d, &p)| level.descriptor(p, d));
         let k = pca_components.clamp(1, DIM);
         let pca =
             Pca::fit(&descriptors, DIM, k).map_err(|source| TexOptError::Pca { patch, source })?;
+        drop(descriptors);
         let kp = k.div_ceil(8) * 8;
         level.kp = kp;
         level.basis = vec![0.0; kp * DIM];
@@ -107,13 +132,11 @@ impl ExemplarLevel {
         }
         level.mean = pca.mean.iter().map(|&m| m as f32).collect();
         let mut coords = vec![0.0f32; m * kp];
-        descriptors.par_chunks(DIM).zip(coords.par_chunks_mut(kp)).with_min_len(256).for_each(
-            |(d, c)| {
-                let d: &[f32; DIM] = d.try_into().expect("DIM-long chunk");
-                level.project(d, c);
-            },
-        );
-        level.descriptors = descriptors;
+        coords.par_chunks_mut(kp).enumerate().with_min_len(256).for_each(|(p, c)| {
+            let mut d = [0.0f32; DIM];
+            level.descriptor(p as u32, &mut d);
+            level.project(&d, c);
+        });
         level.coords = coords;
         level.pca = pca;
         if let Some(dist) = distance {
@@ -148,20 +171,34 @@ impl ExemplarLevel {
     /// Origin pixel of position `p`.
     #[inline]
     pub fn origin(&self, p: u32) -> [i64; 2] {
-        [(p as usize % self.nx) as i64, (p as usize / self.nx) as i64]
+        let t = self.stride as i64;
+        [(p as usize % self.nx) as i64 * t, (p as usize / self.nx) as i64 * t]
     }
 
     /// The position whose origin is nearest to the continuous origin `(x, y)` (clamped,
     /// or wrapped when toroidal).
     #[inline]
     pub fn position_near(&self, x: f64, y: f64) -> u32 {
-        let (xi, yi) = (x.round() as i64, y.round() as i64);
+        let t = self.stride as f64;
+        let (xi, yi) = ((x / t).round() as i64, (y / t).round() as i64);
         let (xi, yi) = if self.toroidal {
             (xi.rem_euclid(self.nx as i64), yi.rem_euclid(self.ny as i64))
         } else {
             (xi.clamp(0, self.nx as i64 - 1), yi.clamp(0, self.ny as i64 - 1))
         };
         (yi as usize * self.nx + xi as usize) as u32
+    }
+
+    /// The placement of the continuous origin `(x, y)`: the nearest position and the
+    /// remaining offset, clamped to half a stride.
+    #[inline]
+    pub fn placement_near(&self, x: f64, y: f64) -> crate::patch_search::Placement {
+        let position = self.position_near(x, y);
+        let [ox, oy] = self.origin(position);
+        let lim = 0.5 * self.stride as f64;
+        let offset =
+            [(x - ox as f64).clamp(-lim, lim) as f32, (y - oy as f64).clamp(-lim, lim) as f32];
+        crate::patch_search::Placement { position, offset }
     }
 
     #[inline]
@@ -201,18 +238,31 @@ impl ExemplarLevel {
         }
     }
 
-    /// Squared distance between a descriptor and the stored descriptor of `p`.
+    /// Squared distance between a descriptor and the descriptor of `p` (read from the
+    /// filtered image).
     #[inline]
     pub fn distance2(&self, x: &[f32; DIM], p: u32) -> f32 {
-        let d = &self.descriptors[p as usize * DIM..(p as usize + 1) * DIM];
-        let mut s = [0.0f32; 8];
-        for (a, b) in x.chunks_exact(8).zip(d.chunks_exact(8)) {
-            for k in 0..8 {
-                let e = a[k] - b[k];
-                s[k] += e * e;
+        let [ox, oy] = self.origin(p);
+        let s = self.step as i64;
+        let inside =
+            !self.toroidal || (ox + 7 * s < self.width as i64 && oy + 7 * s < self.height as i64);
+        let mut acc = [0.0f32; 3];
+        for j in 0..GRID {
+            let y = oy + j as i64 * s;
+            for i in 0..GRID {
+                let c = if inside {
+                    self.image[y as usize * self.width + (ox + i as i64 * s) as usize]
+                } else {
+                    self.pixel(ox + i as i64 * s, y)
+                };
+                let o = (j * GRID + i) * 3;
+                for k in 0..3 {
+                    let e = x[o + k] - c[k];
+                    acc[k] += e * e;
+                }
             }
         }
-        s.iter().sum()
+        acc[0] + acc[1] + acc[2]
     }
 
     /// Projects a descriptor onto the padded PCA basis: `out[..kp]`.

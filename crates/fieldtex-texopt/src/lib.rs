@@ -53,7 +53,15 @@
 //! - §5.2 uses unsigned distances on both sides: a patch may put the feature line on
 //!   either side of its centre; the principal-feature-line choice is the caller's (it
 //!   builds the distance map).
-//! - The exemplar is used at one scale (`h`); no multi-scale exemplar pyramid.
+//! - Coarse to fine over the exemplar's pyramid: a level of step `s = w/8` reads the
+//!   exemplar through a tent of radius `s` at origins every `max(s/2, 1)` pixels, i.e.
+//!   its `s`-times reduced pyramid level (sampled at twice that level's resolution);
+//!   [`pyramid_patch_sizes`] picks the coarsest `w` so that it spans the exemplar's
+//!   largest structure (the caller estimates it, e.g. `fieldtex_synth::
+//!   characteristic_scale`). The surface side stays at one resolution (carriers), with
+//!   coarse levels iterating on a subset (above).
+//! - Crisp final pass ([`TexOptOptions::crisp`]): each carrier shows one covering
+//!   patch's exemplar colour, the one nearest the blend (see [`robust_blend`]).
 
 mod error;
 mod exemplar_patches;
@@ -66,7 +74,7 @@ pub mod texture_optimisation;
 mod uniform_grid;
 
 pub use error::TexOptError;
-pub use options::{FeatureAlignment, TexOptOptions};
+pub use options::{FeatureAlignment, TexOptOptions, pyramid_patch_sizes};
 pub use sample_set::sample_set;
 pub use surface_domain::{Carrier, SurfaceDomain, vertex_carriers};
 pub use texture_optimisation::{LevelStats, TexOptResult, optimise};

@@ -21,6 +21,10 @@ pub struct TexOptOptions {
     pub robust_exponent: f64,
     /// Search/blend iterations per patch size at most. Default 4.
     pub max_iterations: usize,
+    /// Iterations of the levels with `w ≤ 16` at most (they start from upsampled,
+    /// coherent sources and hold most carriers: the cost of `align`). Default 2
+    /// (measured on fandisk, bricks 512², 512² atlas: see docs/real-exemplars.md).
+    pub fine_iterations: usize,
     /// A level stops when at most this fraction of samples changed match. Default 0.01.
     pub converge_fraction: f64,
     /// Random exemplar candidates per sample and iteration (alternately uniform and in a
@@ -56,6 +60,18 @@ pub struct TexOptOptions {
     /// patch pixels in the blend; `None` for Kwatra 2005's uniform patch weights (blurrier
     /// where overlapping matches disagree). Default `Some(1.5)`.
     pub blend_falloff: Option<f64>,
+    /// Coherence bias `κ` (Ashikhmin 2001): the squared distance of random and PCA
+    /// candidates is multiplied by `1 + κ`, so a sample leaves its own or a
+    /// neighbour-continued patch only for a clearly better one. Without it, thin
+    /// structures (mortar, cracks) that overlapping patches place slightly apart blend
+    /// into faint lines that flat exemplar regions match as well, and fade level by
+    /// level. Default 0.25.
+    pub coherence_bias: f64,
+    /// Crisp final pass: after the last iteration of the finest level each carrier
+    /// takes the colour of the covering patch closest to the blended average instead of
+    /// the average ([`robust_blend`](crate::robust_blend)). Default true; false keeps
+    /// the softer least-squares blend.
+    pub crisp: bool,
     /// Seed of all random streams. Default 0.
     pub seed: u64,
 }
@@ -68,6 +84,7 @@ impl Default for TexOptOptions {
             sample_spacing_ratio: 0.25,
             robust_exponent: 0.8,
             max_iterations: 4,
+            fine_iterations: 2,
             converge_fraction: 0.01,
             random_candidates: 6,
             coherence_neighbours: 8,
@@ -79,6 +96,8 @@ impl Default for TexOptOptions {
             feature_threshold: 0.5,
             normal_cosine: 0.3,
             blend_falloff: Some(1.5),
+            coherence_bias: 1.0,
+            crisp: true,
             seed: 0,
         }
     }
@@ -95,6 +114,10 @@ impl TexOptOptions {
     }
     pub fn with_max_iterations(mut self, n: usize) -> Self {
         self.max_iterations = n;
+        self
+    }
+    pub fn with_fine_iterations(mut self, n: usize) -> Self {
+        self.fine_iterations = n;
         self
     }
     pub fn with_exemplar_angle(mut self, radians: f64) -> Self {
@@ -159,6 +182,10 @@ impl TexOptOptions {
         {
             return bad("blend_falloff", sigma, "must be positive and finite (or None)");
         }
+        let k = self.coherence_bias;
+        if !(k.is_finite() && k >= 0.0) {
+            return bad("coherence_bias", k, "must be non-negative and finite");
+        }
         let n = self.normal_cosine;
         if !(n.is_finite() && (-1.0..=1.0).contains(&n)) {
             return bad("normal_cosine", n, "must be in [-1, 1]");
@@ -177,4 +204,45 @@ pub struct FeatureAlignment {
     /// `#C`: surface (geodesic) distance from each carrier to the salient curves, in
     /// surface units. `+∞` for carriers the curves cannot reach; NaN is an error.
     pub carrier_curve_distance: Vec<f64>,
+}
+
+/// Coarse-to-fine patch widths for an exemplar whose largest structure is `structure`
+/// pixels and whose shorter side is `min_side` pixels: `w_max, w_max/2, …, 8` with
+/// `w_max` the smallest `8·2^k ≥ structure`, at least 32 (Kwatra et al. 2005's
+/// `32, 16, 8`), at most 256 and at most half the shorter side (so that patches still
+/// have room to move; never below 8 and never above `min_side`). Levels of step
+/// `s = w/8` see the exemplar as its `s`-times reduced pyramid level, so the coarsest
+/// patches span the largest structures.
+pub fn pyramid_patch_sizes(structure: f64, min_side: usize) -> Vec<usize> {
+    let fits = |w: usize| w <= 256 && 2 * w <= min_side;
+    let mut cap = 8;
+    while fits(cap * 2) {
+        cap *= 2;
+    }
+    let cap = if min_side >= 32 { cap.max(32).min(min_side / 8 * 8) } else { 8 };
+    let mut w_max = 32;
+    while (w_max as f64) < structure && w_max * 2 <= cap {
+        w_max *= 2;
+    }
+    let w_max = w_max.min(cap);
+    let mut sizes = vec![w_max];
+    while *sizes.last().unwrap_or(&8) > 8 {
+        let next = sizes.last().unwrap_or(&8) / 2;
+        sizes.push(next.max(8) / 8 * 8);
+    }
+    sizes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pyramid_patch_sizes;
+
+    #[test]
+    fn pyramid_patch_sizes_span_the_structure_within_the_exemplar() {
+        assert_eq!(pyramid_patch_sizes(6.0, 116), vec![32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(75.0, 512), vec![128, 64, 32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(75.0, 200), vec![64, 32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(900.0, 2048), vec![256, 128, 64, 32, 16, 8]);
+        assert_eq!(pyramid_patch_sizes(40.0, 40), vec![32, 16, 8]);
+    }
 }

@@ -30,7 +30,8 @@ const MAX_CANDIDATES: usize = 48;
 const MAX_CONSTRAINED_SCAN: usize = 1024;
 
 /// Where a sample's patch sits in the exemplar: an integer position (whose descriptor
-/// is compared) and a sub-pixel offset of the origin in `[−½, ½]²`, inherited from
+/// is compared) and an offset of the origin within half the origin lattice's stride
+/// (`[−½, ½]²` pixels at stride 1), inherited from
 /// coherence so that neighbouring patches copied from one exemplar region agree exactly
 /// (no blur from rounding).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,12 +174,9 @@ pub(crate) fn search_sample(
         let d = sub(f.pos, fq.pos);
         let x = ox as f64 + pq.offset[0] as f64 + dot(d, fq.tx) * s;
         let y = oy as f64 + pq.offset[1] as f64 + dot(d, fq.ty) * s;
-        let c = lvl.position_near(x, y);
-        let [cx, cy] = lvl.origin(c);
-        let offset =
-            [(x - cx as f64).clamp(-0.5, 0.5) as f32, (y - cy as f64).clamp(-0.5, 0.5) as f32];
-        cand.push(Placement { position: c, offset });
+        cand.push(lvl.placement_near(x, y));
     }
+    let n_coherent = cand.len;
     // Random search (PatchMatch style): alternately uniform over the exemplar and in a
     // window around the previous match that halves with each draw.
     let rbase = ((ctx.level_index as u64 * 1024 + iteration as u64) << 36) | ((p as u64) << 4);
@@ -250,9 +248,17 @@ pub(crate) fn search_sample(
         }
     }
     let mut out = Match { placement: prev[p], distance2: f32::INFINITY, constrained };
-    for &c in &cand.list[..cand.len] {
+    let mut best_score = f32::INFINITY;
+    // Constrained samples (paper A §5.2) put feature alignment first: no bias (their
+    // candidate list was also filtered, so its first entries are not all coherent).
+    let penalty = if constrained { 1.0 } else { 1.0 + ctx.coherence_bias as f32 };
+    for (i, &c) in cand.list[..cand.len].iter().enumerate() {
         let d = lvl.distance2(&x, c.position);
-        if d < out.distance2 {
+        // Ashikhmin-style coherence bias: a jump to an unrelated exemplar place must be
+        // clearly better than continuing a neighbour's (or its own) patch.
+        let score = if i < n_coherent.min(cand.len) { d } else { d * penalty };
+        if score < best_score {
+            best_score = score;
             out.distance2 = d;
             out.placement = c;
         }

@@ -17,6 +17,12 @@
 //! (`σ = ∞` gives Kwatra 2005 exactly). The carrier's *source* is the exemplar
 //! coordinate it receives from the patch with the largest weight, so centres win over
 //! borders. Carriers outside every footprint keep their colour and source.
+//!
+//! [`BlendMode::Crisp`] is the final pass of [`optimise`](crate::optimise) (when
+//! [`TexOptOptions::crisp`](crate::TexOptOptions::crisp)): each carrier takes the colour
+//! of the one covering patch that agrees best with the average instead of the average
+//! itself, the usual cure for the softness of least-squares blending (a texel shows an
+//! exemplar pixel; seams between patches stay where the average put its transitions).
 
 use crate::exemplar_patches::{GRID, HALF};
 use crate::texture_optimisation::LevelContext;
@@ -31,6 +37,26 @@ pub fn robust_weight(lambda: f64, d2: f32, exponent: f64) -> f64 {
     lambda * rms.powf(exponent - 2.0)
 }
 
+/// How a carrier's colour is formed from the patches covering it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum BlendMode {
+    /// The robust weighted average (Kwatra et al. 2005 eq. 3).
+    Average,
+    /// The crisp final pass: the exemplar pixel (nearest to the coordinate) that one
+    /// covering patch assigns, namely the patch whose colour is closest to the weighted
+    /// average among those with at least half the largest weight (ties: the larger),
+    /// with its exemplar coordinate as source. Every
+    /// carrier then shows an exemplar pixel, not a mix.
+    Crisp,
+    /// The colour of the covering patch with the largest weight (the one whose centre
+    /// is nearest, at equal IRLS weights): a mosaic of whole patches. Used for the
+    /// random initialisation, where averaging unrelated patches would give flat grey.
+    Winner,
+}
+
+/// Most covering patches considered by the crisp choice (the average uses all).
+const MAX_CRISP_CANDIDATES: usize = 64;
+
 /// Blends the carriers `which` (all when `None`) from the matches; returns the number
 /// of those left uncovered.
 pub(crate) fn blend(
@@ -40,12 +66,13 @@ pub(crate) fn blend(
     weights: &[f64],
     colors: &mut [[f32; 4]],
     source: &mut [[f32; 2]],
+    mode: BlendMode,
 ) -> usize {
     if let Some(list) = which {
         let results: Vec<Option<([f32; 4], [f32; 2])>> = list
             .par_iter()
             .with_min_len(1024)
-            .map(|&c| blend_carrier(ctx, c as usize, matches, weights))
+            .map(|&c| blend_carrier(ctx, c as usize, matches, weights, mode))
             .collect();
         let mut uncovered = 0;
         for (&c, r) in list.iter().zip(results) {
@@ -64,7 +91,7 @@ pub(crate) fn blend(
         .zip(source.par_iter_mut())
         .enumerate()
         .with_min_len(1024)
-        .map(|(c, (col, src))| match blend_carrier(ctx, c, matches, weights) {
+        .map(|(c, (col, src))| match blend_carrier(ctx, c, matches, weights, mode) {
             Some((a, b)) => {
                 *col = a;
                 *src = b;
@@ -81,6 +108,7 @@ fn blend_carrier(
     c: usize,
     matches: &[crate::patch_search::Placement],
     weights: &[f64],
+    mode: BlendMode,
 ) -> Option<([f32; 4], [f32; 2])> {
     let lvl = ctx.level;
     let s = lvl.step as f64;
@@ -90,6 +118,9 @@ fn blend_carrier(
     let mut acc = [0.0f64; 4];
     let mut wsum = 0.0f64;
     let mut win = (f64::NEG_INFINITY, [0.0f64; 2]);
+    let mut cands = [(0.0f64, [0.0f32; 4], [0.0f64; 2]); MAX_CRISP_CANDIDATES];
+    let mut n_cands = 0usize;
+    let mut win_color = [0.0f32; 4];
     ctx.sample_grid.for_each_within(&ctx.sample_positions, pos[c], ctx.radius, |p, _| {
         let p = p as usize;
         let f = &ctx.frames[p];
@@ -115,12 +146,41 @@ fn blend_carrier(
         wsum += w;
         if w > win.0 {
             win = (w, [ex, ey]);
+            win_color = z;
+        }
+        if mode == BlendMode::Crisp && n_cands < MAX_CRISP_CANDIDATES {
+            cands[n_cands] = (w, z, [ex, ey]);
+            n_cands += 1;
         }
     });
     if !(wsum > 0.0 && wsum.is_finite()) {
         return None;
     }
-    let col = [0, 1, 2, 3].map(|k| (acc[k] / wsum) as f32);
+    let mut col = [0, 1, 2, 3].map(|k| (acc[k] / wsum) as f32);
+    if mode == BlendMode::Winner {
+        col = win_color;
+    }
+    if mode == BlendMode::Crisp {
+        let mut best = (f32::INFINITY, f64::NEG_INFINITY, usize::MAX);
+        for (i, (w, z, _)) in cands[..n_cands].iter().enumerate() {
+            // Only patches near their centre here (weight at least half the largest):
+            // their placement is what the search (and §5.2's constraint) decided.
+            if *w < 0.5 * win.0 {
+                continue;
+            }
+            let e: f32 = (0..3).map(|k| (z[k] - col[k]) * (z[k] - col[k])).sum();
+            if e < best.0 || (e == best.0 && *w > best.1) {
+                best = (e, *w, i);
+            }
+        }
+        if best.2 != usize::MAX {
+            // The exemplar pixel under the chosen source (nearest, not bilinear: a
+            // bilinear lookup at half-pixel offsets would halve fine grain).
+            let [ex, ey] = cands[best.2].2;
+            col = lvl.sample(ex.round(), ey.round());
+            win.1 = [ex, ey];
+        }
+    }
     let (w, h) = (lvl.width as f64, lvl.height as f64);
     let wrap = |v: f64, n: f64| if lvl.toroidal { v.rem_euclid(n) } else { v.clamp(0.0, n - 1.0) };
     Some((col, [wrap(win.1[0], w) as f32, wrap(win.1[1], h) as f32]))

@@ -14,7 +14,9 @@
 //!    `max_iterations` or when at most `converge_fraction` of the matches changed.
 //!
 //! Initial colours: at the first level every sample gets a seeded random exemplar
-//! position and the carriers are blended from those (random patches). Later levels
+//! position and each carrier takes the colour of its nearest-centred patch (a mosaic of
+//! random patches: averaging unrelated patches would start from flat grey, which the
+//! search then matches with flat exemplar regions). Later levels
 //! start each sample at the match that reproduces its carrier's current source.
 //!
 //! Energy reported per iteration: `E = Σ_p λ_p e_p^r` with `e_p` the RMS 192-D error
@@ -23,7 +25,7 @@
 
 use crate::exemplar_patches::{ExemplarLevel, GRID};
 use crate::patch_search::{Match, Placement, search_sample};
-use crate::robust_blend::{blend, robust_weight};
+use crate::robust_blend::{BlendMode, blend, robust_weight};
 use crate::{FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, UniformGrid, sample_set};
 use fieldtex_core::rng::stream_seed;
 use fieldtex_core::vec3::{self, V3};
@@ -109,6 +111,8 @@ pub(crate) struct LevelContext<'a> {
     pub seed: u64,
     /// `1/(2σ²)` of the blend falloff (0 for none).
     pub falloff: f64,
+    /// [`TexOptOptions::coherence_bias`].
+    pub coherence_bias: f64,
 }
 
 fn validate_inputs(
@@ -293,6 +297,7 @@ pub fn optimise(
             normal_cosine: options.normal_cosine,
             seed: options.seed,
             falloff: options.blend_falloff.map_or(0.0, |sigma| 0.5 / (sigma * sigma)),
+            coherence_bias: options.coherence_bias,
         };
         let m = level.len() as u64;
         let half = crate::exemplar_patches::HALF * s;
@@ -309,14 +314,7 @@ pub fn optimise(
                 .iter()
                 .map(|&c| {
                     let [x, y] = source[c as usize];
-                    let (x, y) = (x as f64 - half, y as f64 - half);
-                    let position = level.position_near(x, y);
-                    let [ox, oy] = level.origin(position);
-                    let offset = [
-                        (x - ox as f64).clamp(-0.5, 0.5) as f32,
-                        (y - oy as f64).clamp(-0.5, 0.5) as f32,
-                    ];
-                    Placement { position, offset }
+                    level.placement_near(x as f64 - half, y as f64 - half)
                 })
                 .collect()
         };
@@ -332,13 +330,28 @@ pub fn optimise(
             uncovered_carriers: 0,
             seconds: 0.0,
         };
+        if li > 0 {
+            // Upsampling: every carrier shows this level's (sharper) exemplar at the
+            // source the coarser level gave it, so the first search compares sharp
+            // patches with sharp exemplar patches instead of a coarse blur (which flat
+            // exemplar regions match best, washing thin structures out).
+            colors.par_iter_mut().zip(&source).with_min_len(4096).for_each(|(c, s)| {
+                *c = level.sample(s[0] as f64, s[1] as f64);
+            });
+        }
         if li == 0 {
             let which = subset.then_some(ctx.active.as_slice());
             stats.uncovered_carriers =
-                blend(&ctx, which, &matches, &weights, &mut colors, &mut source);
+                blend(&ctx, which, &matches, &weights, &mut colors, &mut source, BlendMode::Winner);
         }
-        progress.stage(&format!("texture optimisation {w}×{w}"), options.max_iterations as u64);
-        for iteration in 0..options.max_iterations {
+        // The fine levels start from upsampled, already coherent sources.
+        let iterations = if w <= 16 {
+            options.fine_iterations.clamp(1, options.max_iterations)
+        } else {
+            options.max_iterations
+        };
+        progress.stage(&format!("texture optimisation {w}×{w}"), iterations as u64);
+        for iteration in 0..iterations {
             let found: Vec<Match> = (0..samples.len())
                 .into_par_iter()
                 .with_min_len(64)
@@ -363,12 +376,15 @@ pub fn optimise(
             stats.mean_patch_error.push(err / samples.len().max(1) as f64);
             stats.changed.push(changed);
             stats.iterations += 1;
-            let last = iteration + 1 == options.max_iterations
+            let last = iteration + 1 == iterations
                 || (iteration > 0
                     && changed as f64 <= options.converge_fraction * samples.len() as f64);
             let which = (subset && !last).then_some(ctx.active.as_slice());
+            let finest = li + 1 == options.patch_sizes.len();
+            let mode =
+                if options.crisp && last && finest { BlendMode::Crisp } else { BlendMode::Average };
             stats.uncovered_carriers =
-                blend(&ctx, which, &matches, &weights, &mut colors, &mut source);
+                blend(&ctx, which, &matches, &weights, &mut colors, &mut source, mode);
             progress.advance(1);
             if last {
                 break;

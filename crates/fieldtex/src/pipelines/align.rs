@@ -10,9 +10,17 @@
 //! gutters dilated. Writes `model.glb`, `preview.png`, `report.json` and, with `keep`,
 //! `curves.obj` and `field.ply`.
 //!
-//! A mesh without crest lines falls back to the fields crate's documented behaviour:
-//! principal curvature directions where no curve constrains the field (a warning says
-//! so); users can pass their own curves.
+//! Where no curve constrains the field (a component without crest lines) it falls back
+//! to the smoothest line field, along principal curvature only where the surface is
+//! clearly anisotropic (Knöppel et al. 2013, `fieldtex_fields::smoothest_field`), or to
+//! a global direction projected onto the surface (`direction`); a warning says so.
+//! Users can pass their own curves.
+//!
+//! Exemplars follow the one policy of `fieldtex_synth::exemplar_policy` (above 2048
+//! pixels per side they are reduced, with a warning, and the pattern keeps its size).
+//! Synthesis runs coarse to fine over the exemplar's pyramid from a patch that spans its
+//! largest structure (`fieldtex_synth::characteristic_scale`,
+//! `fieldtex_texopt::pyramid_patch_sizes`), and ends with the crisp pass.
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::atlas::atlas_options;
@@ -41,9 +49,13 @@ pub struct AlignOptions {
     pub exemplar_lines: Option<PathBuf>,
     /// Atlas resolution in texels. Default 1024.
     pub size: usize,
-    /// Size of one exemplar pixel in atlas texels (2 = the pattern twice as large on the
-    /// surface). Default 1.
+    /// Pattern size: atlas texels per pixel of the exemplar file (2 = the pattern twice
+    /// as large on the surface; `orient` uses the same meaning). Default 1.
     pub scale: f64,
+    /// Where no curve constrains the field: this global direction projected onto the
+    /// surface. Default `None`: the smoothest line field, along principal curvature where
+    /// it is clearly anisotropic (Knöppel et al. 2013, `fieldtex_fields::smoothest_field`).
+    pub direction: Option<[f64; 3]>,
     /// Feature-to-feature alignment (§5.2). Default on; off is the ablation.
     pub feature_align: bool,
     /// `greedy` (default) or `arbitrary` curve orientation.
@@ -64,6 +76,7 @@ impl Default for AlignOptions {
             exemplar_lines: None,
             size: 1024,
             scale: 1.0,
+            direction: None,
             feature_align: true,
             greedy: true,
             keep: false,
@@ -96,8 +109,9 @@ pub(crate) fn salient_curves(
     if curves.is_empty() {
         warnings.push(Warning::new(
             "no-curves",
-            "no feature curve was found or given: the field follows principal curvature \
-             directions where no curve constrains it (pass --curves C.obj to steer it)",
+            "no feature curve was found or given: the field is the smoothest field (along \
+             curvature where it is clearly anisotropic) or --direction where no curve \
+             constrains it (pass --curves C.obj to steer it)",
         ));
     }
     Ok((curves, source))
@@ -188,7 +202,8 @@ fn curve_surface_points(
 }
 
 /// Distance from each carrier to the nearest salient curve, within the band where paper
-/// A §5.2 constrains samples (half the largest patch, plus a margin); `+∞` beyond it.
+/// A §5.2 constrains samples (half the largest patch up to 32 px, plus a margin); `+∞`
+/// beyond it.
 ///
 /// Paper A uses the geodesic distance. Inside the band (at most 16 exemplar pixels) the
 /// 3-D distance to the curve equals it up to `O(κ d²)`, and unlike the heat method
@@ -202,7 +217,9 @@ fn curve_distance_band(
     topts: &TexOptOptions,
 ) -> Vec<f64> {
     use fieldtex_core::vec3::{lerp, norm, sub};
-    let w = topts.patch_sizes.iter().copied().max().unwrap_or(8) as f64;
+    // Coarse pyramid levels (w > 32) span whole structures; the constraint acts near
+    // the curve, within half a 32-px patch (the finest levels' reach).
+    let w = topts.patch_sizes.iter().copied().max().unwrap_or(8).min(32) as f64;
     let band = (0.5 * w + 2.0) * h;
     let step = 0.25 * h;
     let mut pts = Vec::new();
@@ -290,6 +307,14 @@ pub(crate) fn align_impl(
             format!("--scale must be in (0, 64], got {}", options.scale),
         ));
     }
+    if let Some(d) = options.direction
+        && !(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0))
+    {
+        return Err(Error::bad_input(
+            None,
+            format!("--direction must be three finite numbers, not all zero; got {d:?}"),
+        ));
+    }
     let mut inputs = vec![options.mesh.as_path(), options.exemplar.as_path()];
     if let Some(c) = &options.curves {
         inputs.push(c);
@@ -312,6 +337,10 @@ pub(crate) fn align_impl(
         ),
     };
     report.warnings.extend(loaded.warnings.iter().cloned());
+    // One exemplar policy for every pipeline: reduce above the size limit, with a warning.
+    let fitted = fieldtex_synth::fit_exemplar(exemplar, fieldtex_synth::MAX_EXEMPLAR_SIDE);
+    report.warnings.extend(fitted.warning.clone());
+    let (exemplar, reduction) = (fitted.image, fitted.factor);
     let min_side = TexOptOptions::default().patch_sizes.into_iter().max().unwrap_or(8);
     if exemplar.width < min_side || exemplar.height < min_side {
         return Err(Error::bad_input(
@@ -331,26 +360,19 @@ pub(crate) fn align_impl(
     )?;
     let stage = out.staging();
     // 1. Repair once; everything below uses this mesh (the atlas keeps its triangles).
-    let repaired = report.time("repair", || {
-        fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default())
-    });
-    for c in &repaired.changes {
-        report.warnings.push(Warning::new(format!("repair:{}", c.code), c.message.clone()));
-    }
-    report.warnings.extend(repaired.warnings.iter().cloned());
-    let mesh = repaired.mesh;
-    if mesh.triangles.is_empty() {
-        return Err(Error::bad_input(
-            Some(&options.mesh),
-            "no usable triangle is left after repair",
-        ));
-    }
+    let mesh = super::repair_stage::repair_into_report(
+        &loaded.mesh,
+        Some(&options.mesh),
+        None,
+        &mut report,
+    )?;
     report.input = serde_json::json!({
         "mesh": options.mesh.display().to_string(),
         "vertices": mesh.n_vertices(),
         "triangles": mesh.n_triangles(),
         "exemplar": options.exemplar.display().to_string(),
-        "exemplar_size": [exemplar.width, exemplar.height],
+        "exemplar_size": [exemplar.width * reduction, exemplar.height * reduction],
+        "exemplar_reduction": reduction,
     });
     // 2. Salient curves and the oriented field (paper A §3–4).
     let mut warnings = Vec::new();
@@ -363,7 +385,10 @@ pub(crate) fn align_impl(
     } else {
         OrientationMode::Arbitrary { seed: options.seed }
     };
-    let copts = CurveOrientationOptions { mode, ..Default::default() };
+    let mut copts = CurveOrientationOptions { mode, ..Default::default() };
+    if let Some(d) = options.direction {
+        copts.field.fallback = fieldtex_fields::UnconstrainedFallback::Direction(d);
+    }
     let oriented = report
         .time("field", || orient_curves(&mesh, &curves, &copts, progress))
         .map_err(|e| Error::Internal(format!("field: {e}")))?;
@@ -406,8 +431,19 @@ pub(crate) fn align_impl(
         .time("domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
         .map_err(|e| Error::Internal(format!("surface domain: {e}")))?;
     report.warnings.extend(dwarn);
+    // Coarse to fine over the exemplar's pyramid: the coarsest patch spans its largest
+    // structure (autocorrelation estimate).
+    let structure =
+        report.time("exemplar_scale", || fieldtex_synth::characteristic_scale(&exemplar));
+    let patch_sizes =
+        fieldtex_texopt::pyramid_patch_sizes(structure.pixels, exemplar.width.min(exemplar.height));
+    report.metric("exemplar_scale", &structure);
+    // `--scale` counts texels per pixel of the exemplar file; a reduced exemplar's
+    // pixel is `reduction` file pixels.
+    let texels_per_pixel = options.scale * reduction as f64;
     let topts = TexOptOptions {
-        pixel_size: Some(domain.carrier_spacing() * options.scale),
+        patch_sizes,
+        pixel_size: Some(domain.carrier_spacing() * texels_per_pixel),
         feature_align: options.feature_align,
         seed: options.seed,
         ..Default::default()
@@ -538,6 +574,19 @@ pub(crate) fn align_impl(
         }))
     })?;
     report.metric("orientation_error", orientation);
+    // Contrast and crispness of the covered texels against the exemplar.
+    let sharpness = report.time("metrics_contrast", || -> Result<_> {
+        let tbuf = fieldtex_eval::rgb_buffer(&texture);
+        let tview = fieldtex_eval::ImageView::new(&tbuf, size, size, 3).map_err(internal)?;
+        let ebuf = fieldtex_eval::rgb_buffer(&exemplar);
+        let eview = fieldtex_eval::ImageView::new(&ebuf, exemplar.width, exemplar.height, 3)
+            .map_err(internal)?;
+        let mut mask = vec![false; size * size];
+        covered.iter().for_each(|&i| mask[i] = true);
+        fieldtex_eval::contrast_sharpness(&tview, Some(&mask), &eview, texels_per_pixel)
+            .map_err(internal)
+    })?;
+    report.metric("contrast", sharpness);
     // 7. Outputs.
     report.time("write", || super::write_model(stage, &atlas.mesh, Some(&texture)))?;
     let preview = report.time("preview", || {

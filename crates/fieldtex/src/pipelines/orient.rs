@@ -41,7 +41,8 @@ pub struct OrientOptions {
     pub size: usize,
     /// Field grid cells per side for presets. Default 128.
     pub grid: usize,
-    /// Exemplar pixels per output pixel, in [`MIN_SCALE`, 16]. Default 1.
+    /// Pattern size: output pixels per pixel of the exemplar file (2 = the pattern twice
+    /// as large; the same meaning as `align`'s), in [`MIN_SCALE`, 16]. Default 1.
     pub scale: f64,
     /// The 2-RoSy fix of paper D §4 (off only for the ablation). Default true.
     pub rosy_fix: bool,
@@ -60,6 +61,13 @@ pub struct OrientOptions {
 }
 
 impl OrientOptions {
+    /// Exemplar pixels (of the exemplar as reduced by the exemplar policy, `reduction`
+    /// file pixels each) per output pixel: what the synthesis domain's Jacobians scale
+    /// by.
+    pub(crate) fn exemplar_pixels_per_output_pixel(&self, reduction: usize) -> f64 {
+        1.0 / (self.scale * reduction.max(1) as f64)
+    }
+
     pub fn new(source: FieldSource, exemplar: PathBuf) -> Self {
         Self {
             source,
@@ -197,18 +205,31 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     }
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let exemplar = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
+    report.warnings.extend(fitted.warning.clone());
+    let per_pixel = options.exemplar_pixels_per_output_pixel(fitted.factor);
+    let exemplar = fitted.image;
     report.input = serde_json::json!({
         "exemplar": options.exemplar.display().to_string(),
-        "exemplar_size": [exemplar.width, exemplar.height],
+        "exemplar_size": [exemplar.width * fitted.factor, exemplar.height * fitted.factor],
+        "exemplar_reduction": fitted.factor,
     });
     let (field, designed) = build_field(options, &mut report)?;
     let out = begin_outputs(out_dir, &["texture.png", "field.npy", "preview.png", "report.json"])?;
     let stage = out.staging();
     let n = options.size;
-    let synth =
-        super::synthesis::synthesize_image(&exemplar, &field, n, n, options, &mut report, progress)
-            .map_err(|e| e.with_path(&options.exemplar))?;
+    let synth = super::synthesis::synthesize_image(
+        &exemplar,
+        &field,
+        n,
+        n,
+        per_pixel,
+        options,
+        &mut report,
+        progress,
+    )
+    .map_err(|e| e.with_path(&options.exemplar))?;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     fieldtex_io::write_png(&stage.join("texture.png"), &synth)?;
     fieldtex_io::write_npy_f32(&stage.join("field.npy"), &[n, n, 2], &flat)?;
@@ -238,8 +259,11 @@ pub(crate) fn orient_in_memory(
 ) -> Result<Image> {
     let (field, designed) = build_field(options, report)?;
     let n = options.size;
-    let synth =
-        super::synthesis::synthesize_image(exemplar, &field, n, n, options, report, progress)?;
+    // In-memory exemplars (the demo's procedural ones) are never reduced.
+    let per_pixel = options.exemplar_pixels_per_output_pixel(1);
+    let synth = super::synthesis::synthesize_image(
+        exemplar, &field, n, n, per_pixel, options, report, progress,
+    )?;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     report.metric("designed_singularities", &designed);
     if options.metrics {

@@ -32,7 +32,7 @@
 //! 5. **Jacobians.** Per texel `J = (1/s) [dᵀ P; d⊥ᵀ P]` (rows; texel offset → exemplar
 //!    offset), `d` the field's unit direction on the surface, `d⊥ = ±n × d` (sign so
 //!    that `det J > 0`), `s` the surface length per exemplar pixel = mean surface
-//!    length per texel / `--scale`. So the exemplar's x axis follows the field on the
+//!    length per texel × `--scale` (× the exemplar's reduction factor). So the exemplar's x axis follows the field on the
 //!    surface and the pattern has one size on the surface whatever the parameter-space
 //!    stretch. Texels outside the chart copy the Jacobian and field of the nearest
 //!    chart texel (8-connected breadth-first flood, deterministic order).
@@ -91,7 +91,11 @@ pub(crate) fn orient_patch(
     let n = options.size;
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let exemplar = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
+    report.warnings.extend(fitted.warning.clone());
+    let per_texel = options.exemplar_pixels_per_output_pixel(fitted.factor);
+    let exemplar = fitted.image;
     let loaded = report.time("read_mesh", || fieldtex_io::read_mesh(mesh_path))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
     let repaired = fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default());
@@ -139,7 +143,7 @@ pub(crate) fn orient_patch(
         .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
     let (field, designed) = texel_field(options, &patch, &map, &mut report)?;
     let (jac, field, inside) =
-        report.time("jacobians", || jacobians(&patch, &map, &field, options));
+        report.time("jacobians", || jacobians(&patch, &map, &field, per_texel));
     let n_inside = inside.iter().filter(|&&b| b).count();
     if n_inside == 0 {
         return Err(Error::Internal("the patch covers no texel of the texture".into()));

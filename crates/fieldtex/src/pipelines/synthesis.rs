@@ -50,12 +50,15 @@ pub(crate) fn cached_analysis(
     Ok((a, false))
 }
 
-/// Synthesises a `width × height` texture whose exemplar x axis follows `field`.
+/// Synthesises a `width × height` texture whose exemplar x axis follows `field`, at
+/// `per_pixel` exemplar pixels per output pixel.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn synthesize_image(
     exemplar: &Image,
     field: &[[f32; 2]],
     width: usize,
     height: usize,
+    per_pixel: f64,
     options: &OrientOptions,
     report: &mut Report,
     progress: &dyn Progress,
@@ -66,7 +69,7 @@ pub(crate) fn synthesize_image(
         .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
     report.metric("analysis_cached", cached);
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
-    let domain = ImageDomain::from_direction_field(width, height, &flat, options.scale as f32)
+    let domain = ImageDomain::from_direction_field(width, height, &flat, per_pixel as f32)
         .map_err(|e| Error::Internal(format!("synthesis domain: {e}")))?;
     let sopts =
         SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };

@@ -2,7 +2,6 @@
 //! (steps 4 and 5 of [`super`]).
 
 use super::patch_parameterization::Patch;
-use crate::pipelines::orient::OrientOptions;
 use fieldtex_core::vec3::{add, cross, dot, norm, normalize, scale, sub};
 use fieldtex_fields::Symmetry;
 use fieldtex_param::TexelMap;
@@ -75,14 +74,15 @@ pub(super) fn sample_texels(
 }
 
 /// Per-texel Jacobians (module docs, step 5), the field with texels outside the chart
-/// filled from the nearest chart texel, and the chart mask.
+/// filled from the nearest chart texel, and the chart mask. `per_texel`: exemplar
+/// pixels per texel (`1 / (--scale × exemplar reduction)`).
 pub(super) fn jacobians(
     patch: &Patch,
     map: &TexelMap,
     field: &[[f32; 2]],
-    options: &OrientOptions,
+    per_texel: f64,
 ) -> (Vec<[f32; 4]>, Vec<[f32; 2]>, Vec<bool>) {
-    let inv_s = options.scale / patch.length_per_texel;
+    let inv_s = per_texel / patch.length_per_texel;
     let own: Vec<Option<[f32; 4]>> = (0..map.width * map.height)
         .into_par_iter()
         .map(|i| {
@@ -110,7 +110,7 @@ pub(super) fn jacobians(
     let source = nearest_source(map.width, map.height, &inside);
     let mut jac = Vec::with_capacity(own.len());
     let mut out_field = Vec::with_capacity(own.len());
-    let fallback = [options.scale as f32, 0.0, 0.0, options.scale as f32];
+    let fallback = [per_texel as f32, 0.0, 0.0, per_texel as f32];
     for &s in &source {
         if s == u32::MAX {
             jac.push(fallback);
