@@ -3,6 +3,7 @@
 //! input or usage).
 
 mod progress_bar;
+mod studio_command;
 
 use clap::{Args, Parser, Subcommand};
 use fieldtex::Error;
@@ -34,6 +35,8 @@ struct GlobalArgs {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Local web studio: design orientation fields interactively (http://127.0.0.1:7878).
+    Studio(studio_command::StudioArgs),
     /// Run the main job on built-in inputs (no files needed).
     Demo {
         /// Output directory (created if missing).
@@ -266,6 +269,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         }
     };
     match cli.command {
+        Command::Studio(a) => studio_command::run(a, g.seed, g.quiet)?,
         Command::Demo { out, size } => {
             let opts = fieldtex::DemoOptions { seed: g.seed, size, ..Default::default() };
             let report = fieldtex::demo(&out, &opts, &progress)?;
