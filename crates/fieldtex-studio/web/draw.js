@@ -42,6 +42,7 @@ export function drawStreamlines(ctx, field, n, width, height, spacing = 9) {
   ctx.strokeStyle = '#2b3a55';
   ctx.lineWidth = 1;
   const step = Math.min(sx, sy, 2);
+  ctx.beginPath(); // one path for all lines: one stroke call
   for (let j = 0; j * spacing < height; j++) {
     for (let i = 0; i * spacing < width; i++) {
       const x0 = (i + 0.5) * spacing, y0 = (j + 0.5) * spacing;
@@ -71,12 +72,11 @@ export function drawStreamlines(ctx, field, n, width, height, spacing = 9) {
         const i2 = Math.floor(x / cell), j2 = Math.floor(y / cell);
         if (i2 >= 0 && j2 >= 0 && i2 < gw && j2 < gh) occupied[j2 * gw + i2] = 1;
       }
-      ctx.beginPath();
       ctx.moveTo(line[0][0] * k, line[0][1] * k);
       for (const [x, y] of line) ctx.lineTo(x * k, y * k);
-      ctx.stroke();
     }
   }
+  ctx.stroke();
 }
 
 const COLORS = { wedge: '#d62b1a', trisector: '#1a59f2', source: '#e08a00', sink: '#7a3ad6', vortex: '#0a9a6a', saddle: '#444' };
