@@ -171,3 +171,22 @@ pub fn check_file_name(name: &str) -> Result<(), PathError> {
         ))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_plain_paths_only() {
+        let root = Root::new(&std::env::temp_dir(), false).unwrap();
+        assert!(root.join_checked("a/b.png").is_ok());
+        for bad in ["", "../a", "a/../b", "./a", "/etc/passwd", "a\\b", "C:x", "a\0b"] {
+            assert!(root.join_checked(bad).is_err(), "{bad:?}");
+        }
+        assert!(root.dir_for_writing("x").is_err(), "read-only root");
+        assert!(check_file_name("ok-name_1.png").is_ok());
+        for bad in ["", ".x", "a/b", "a b", "é.png"] {
+            assert!(check_file_name(bad).is_err(), "{bad:?}");
+        }
+    }
+}

@@ -321,6 +321,14 @@ fn texture_and_export() {
     let (shape, _) = fieldtex_io::read_npy_f32(&ws.join("out/a/field.npy")).unwrap();
     assert_eq!(shape, vec![32, 32, 2]);
     assert!(ws.join("out/a/texture.png").is_file());
+    // Same design, exemplar and seed: byte-identical texture.
+    let body = format!(r#"{{"dir":"out/b","exemplar":{ex},"size":32}}"#);
+    let r = request(addr, "POST", &format!("/api/export?session={id}"), body.as_bytes());
+    assert_eq!(r.status, 200, "{}", r.error());
+    assert_eq!(
+        std::fs::read(ws.join("out/a/texture.png")).unwrap(),
+        std::fs::read(ws.join("out/b/texture.png")).unwrap()
+    );
     // The exported design loads back as a session.
     let (_, json, _) = new_session(addr, r#"{"design":"out/a/design.toml","view":16}"#);
     assert_eq!(json["singularities"].as_array().unwrap().len(), 2);

@@ -239,7 +239,7 @@ async function synthesise() {
   const abort = new AbortController();
   textureAbort = abort;
   const version = state.version;
-  for (const size of [128, state.width]) {
+  for (const size of [128, Math.min(1024, Math.round(state.width))]) {
     try {
       const t0 = performance.now();
       const resp = await fetch(`/api/texture?session=${encodeURIComponent(state.session)}`, {
