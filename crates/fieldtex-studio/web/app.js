@@ -312,6 +312,9 @@ async function start() {
   for (const p of info.presets) { const o = document.createElement('option'); o.textContent = p; $('preset').appendChild(o); }
   $('exemplar').appendChild(new Option('(none)', ''));
   for (const ex of info.exemplars) addExemplarOption(ex);
+  // Preselect a striped exemplar (or the first one) so the first edit shows a texture.
+  const pick = info.exemplars.find((e) => /fingerprint|stripes/.test(e.path)) || info.exemplars[0];
+  if (pick) $('exemplar').value = JSON.stringify(pick);
   const old = sessionStorage.getItem('fieldtex-session');
   if (old) {
     try {
