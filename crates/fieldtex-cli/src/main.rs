@@ -5,6 +5,7 @@
 mod conformal_command;
 mod progress_bar;
 mod solid_command;
+mod studio_command;
 mod transfer_command;
 
 use clap::{Args, Parser, Subcommand};
@@ -37,6 +38,8 @@ struct GlobalArgs {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Local web studio: design orientation fields interactively (http://127.0.0.1:7878).
+    Studio(studio_command::StudioArgs),
     /// Run the main job on built-in inputs (no files needed): procedural stripes aligned
     /// to the creases of a cube (`align`), and the whorl preset of `orient` beside it.
     Demo {
@@ -345,6 +348,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         }
     };
     match cli.command {
+        Command::Studio(a) => studio_command::run(a, g.seed, g.quiet)?,
         Command::Demo { out, size } => {
             let opts = fieldtex::DemoOptions { seed: g.seed, size, ..Default::default() };
             let report = fieldtex::demo(&out, &opts, &progress)?;

@@ -6,6 +6,7 @@ pub mod crest;
 pub mod demo;
 pub mod eval;
 pub mod field;
+pub mod field_texture;
 pub mod inspect;
 pub mod orient;
 pub(crate) mod orient_patch;
