@@ -33,7 +33,12 @@ pub struct SolidArgs {
     #[arg(long, default_value_t = 256)]
     resolution: usize,
     /// Cut plane X,Y,Z,NX,NY,NZ (repeatable): writes cut-N.glb and cut-N.png.
-    #[arg(long = "cut", value_parser = parse_cut)]
+    #[arg(
+        long = "cut",
+        value_name = "X,Y,Z,NX,NY,NZ",
+        value_parser = parse_cut,
+        allow_hyphen_values = true
+    )]
     cuts: Vec<[f64; 6]>,
     /// Also write the whole grid as volume.nrrd.
     #[arg(long)]

@@ -394,3 +394,24 @@ fn arguments_lacked_help_text_and_defaults() {
     let crest = help(&["crest", "--help"]);
     assert!(crest.contains("Default: the detector's own"), "{crest}");
 }
+
+#[test]
+fn solid_cut_with_a_negative_first_number_was_rejected_by_the_parser() {
+    let d = tmp("solid-cut");
+    let missing = d.join("missing.obj");
+    let o = quick(&[
+        "solid",
+        "--mesh",
+        s(&missing),
+        "--exemplar",
+        s(&d.join("e.png")),
+        "--out",
+        s(&d.join("out")),
+        "--cut",
+        "-0.017,0.11,0,0,0,1",
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    // The plane parses; the error is about the missing mesh, not the argument.
+    assert!(!stderr(&o).contains("unexpected argument"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("missing.obj"), "{}", stderr(&o));
+}
