@@ -117,6 +117,38 @@ pub(crate) fn salient_curves(
     Ok((curves, source))
 }
 
+/// An atlas of a repaired mesh, its `size × size` texel map and the covered texels as
+/// colour carriers: the stage of every pipeline whose colour lives on atlas texels
+/// (align, transfer). Timed as `atlas` and `texel_map`.
+pub(crate) struct CarrierAtlas {
+    pub atlas: fieldtex_param::Atlas,
+    pub map: fieldtex_param::TexelMap,
+    /// Row-major indices of the covered texels, parallel to `carriers`.
+    pub covered: Vec<usize>,
+    pub carriers: Vec<Carrier>,
+}
+
+/// Builds the [`CarrierAtlas`] of `mesh`.
+pub(crate) fn carrier_atlas(
+    mesh: &TriMesh,
+    aopts: &fieldtex_param::AtlasOptions,
+    size: usize,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<CarrierAtlas> {
+    let atlas = report
+        .time("atlas", || fieldtex_param::build_atlas(mesh, aopts, progress))
+        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+    report.warnings.extend(atlas.warnings.iter().cloned());
+    let map = report
+        .time("texel_map", || {
+            fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
+        })
+        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+    let (covered, carriers) = atlas_carriers(&map);
+    Ok(CarrierAtlas { atlas, map, covered, carriers })
+}
+
 /// The covered texels of `map` (row-major indices) and their surface points as colour
 /// carriers, in the same order.
 pub(crate) fn atlas_carriers(map: &fieldtex_param::TexelMap) -> (Vec<usize>, Vec<Carrier>) {
@@ -416,17 +448,9 @@ pub(crate) fn align_impl(
     let normals = oriented.solver.normals().to_vec();
     drop(oriented);
     // 3. Atlas and colour carriers (covered texels).
-    let atlas = report
-        .time("atlas", || fieldtex_param::build_atlas(&mesh, &aopts, progress))
-        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
-    report.warnings.extend(atlas.warnings.iter().cloned());
     let size = options.size;
-    let map = report
-        .time("texel_map", || {
-            fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
-        })
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
-    let (covered, carriers) = atlas_carriers(&map);
+    let CarrierAtlas { atlas, map, covered, carriers } =
+        carrier_atlas(&mesh, &aopts, size, &mut report, progress)?;
     let (domain, dwarn) = report
         .time("domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
         .map_err(|e| Error::Internal(format!("surface domain: {e}")))?;

@@ -10,7 +10,7 @@
 //! (per-vertex descriptors, guidance and colour of the target).
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
-use crate::pipelines::align::{atlas_carriers, carrier_texture};
+use crate::pipelines::align::{CarrierAtlas, carrier_atlas, carrier_texture};
 use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
@@ -204,17 +204,8 @@ pub fn transfer_files(
     report.timings_ms.extend(result.timings_ms.iter().cloned());
     report.warnings.extend(result.warnings.iter().cloned());
     // Atlas of the target and baking.
-    let atlas = report
-        .time("atlas", || fieldtex_param::build_atlas(&target_mesh, &aopts, progress))
-        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
-    report.warnings.extend(atlas.warnings.iter().cloned());
-    let size = options.size;
-    let map = report
-        .time("texel_map", || {
-            fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
-        })
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
-    let (covered, carriers) = atlas_carriers(&map);
+    let CarrierAtlas { atlas, map, covered, carriers } =
+        carrier_atlas(&target_mesh, &aopts, options.size, &mut report, progress)?;
     let texture_out = report.time("bake", || {
         let points: Vec<(u32, [f64; 3])> =
             carriers.iter().map(|c| (c.triangle, c.barycentric)).collect();
