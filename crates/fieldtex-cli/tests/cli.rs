@@ -3,11 +3,11 @@
 //! `atlas`, and the Khronos validator on the GLBs the pipelines write.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use std::time::Duration;
 
 mod common;
-use common::{code, shared, stderr};
+use common::{code, shared, stderr, validator_errors};
 
 fn tmp(name: &str) -> PathBuf {
     common::tmp_in("fieldtex-cli", name)
@@ -211,11 +211,6 @@ fn atlas_works_on_every_shared_mesh() {
 /// The GLBs the pipelines write pass the Khronos validator with 0 errors.
 #[test]
 fn pipeline_glbs_pass_the_khronos_validator() {
-    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
-    assert!(
-        validator.join("node_modules/gltf-validator").is_dir(),
-        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
-    );
     let demo = tmp("validate-demo");
     assert_eq!(
         code(&run(
@@ -234,19 +229,7 @@ fn pipeline_glbs_pass_the_khronos_validator() {
         0
     );
     for glb in [demo.join("model.glb"), atlas.join("model.glb")] {
-        let o = Command::new("node")
-            .arg(validator.join("validate.js"))
-            .arg(&glb)
-            .output()
-            .expect("node runs");
-        let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
-        assert_eq!(
-            report["issues"]["numErrors"].as_u64(),
-            Some(0),
-            "{}: {}",
-            glb.display(),
-            String::from_utf8_lossy(&o.stdout)
-        );
+        assert_eq!(validator_errors(&glb), 0, "{}", glb.display());
     }
 }
 
@@ -476,23 +459,7 @@ fn orient_patch_outputs_determinism_and_valid_glb() {
     // A sanity bound; the 10° target is tested at 160² in crates/fieldtex/tests.
     let err = r["metrics"]["chart_orientation_error"]["mean_error_deg"].as_f64().unwrap();
     assert!(err <= 12.0, "chart orientation error {err}°");
-    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
-    assert!(
-        validator.join("node_modules/gltf-validator").is_dir(),
-        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
-    );
-    let o = Command::new("node")
-        .arg(validator.join("validate.js"))
-        .arg(a.join("model.glb"))
-        .output()
-        .expect("node runs");
-    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
-    assert_eq!(
-        report["issues"]["numErrors"].as_u64(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stdout)
-    );
+    assert_eq!(validator_errors(&a.join("model.glb")), 0);
 }
 
 /// `orient --mesh` refuses meshes that are not one disk (a closed torus, a patch with
@@ -543,18 +510,6 @@ fn orient_patch_refuses_non_disk_meshes() {
         assert!(e.contains("disk") && e.contains(loops), "{e}");
         assert!(!e.contains("panicked"), "{e}");
     }
-}
-
-/// Number of errors the Khronos validator reports for `glb`.
-fn validator_errors(glb: &Path) -> u64 {
-    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
-    assert!(
-        validator.join("node_modules/gltf-validator").is_dir(),
-        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
-    );
-    let o = Command::new("node").arg(validator.join("validate.js")).arg(glb).output().unwrap();
-    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
-    report["issues"]["numErrors"].as_u64().unwrap_or(u64::MAX)
 }
 
 /// `align` on fandisk (crest lines, greedy field, texture optimisation with feature

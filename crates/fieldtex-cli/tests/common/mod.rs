@@ -56,3 +56,20 @@ pub fn code(o: &Output) -> i32 {
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// Number of errors the Khronos glTF validator (installed into `tools/gltf-validator`
+/// by `scripts/test`) reports for `glb`; the validator's report is printed on failure.
+pub fn validator_errors(glb: &Path) -> u64 {
+    let validator = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf-validator");
+    assert!(
+        validator.join("node_modules/gltf-validator").is_dir(),
+        "glTF validator missing: run `npm ci --prefix tools/gltf-validator` (scripts/test does it)"
+    );
+    let o = Command::new("node").arg(validator.join("validate.js")).arg(glb).output().unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    let errors = report["issues"]["numErrors"].as_u64().unwrap_or(u64::MAX);
+    if errors != 0 {
+        eprintln!("{}", String::from_utf8_lossy(&o.stdout));
+    }
+    errors
+}
