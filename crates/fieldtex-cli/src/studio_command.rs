@@ -21,6 +21,12 @@ pub struct StudioArgs {
     /// Extra read-only directory of exemplar images to offer (e.g. ../shared/data/exemplars).
     #[arg(long)]
     exemplars: Option<PathBuf>,
+    /// Extra read-only directory of meshes to offer in the mesh modes (e.g. ../shared/data/meshes).
+    #[arg(long)]
+    meshes: Option<PathBuf>,
+    /// Jobs (align, conformal, transfer, solid) run at once; more wait in a queue.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=2))]
+    max_jobs: u16,
     /// Largest upload in MiB.
     #[arg(long, default_value_t = 16)]
     max_upload_mib: usize,
@@ -40,6 +46,8 @@ pub fn run(args: StudioArgs, seed: u64, quiet: bool) -> Result<(), Error> {
     let mut o = fieldtex_studio::StudioOptions::new(workspace);
     o.port = args.port;
     o.exemplars = args.exemplars;
+    o.meshes = args.meshes;
+    o.max_jobs = usize::from(args.max_jobs);
     o.max_upload_bytes = args.max_upload_mib.saturating_mul(1 << 20);
     o.seed = seed;
     if let Some(h) = args.host {

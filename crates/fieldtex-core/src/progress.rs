@@ -13,6 +13,12 @@ pub trait Progress: Sync {
     fn advance(&self, n: u64);
     /// The current stage is finished.
     fn finish_stage(&self) {}
+    /// Whether the caller asked to stop. Pipelines check it between stages and return
+    /// early (the facade answers `Error::Cancelled`, writing no outputs); the default
+    /// never cancels.
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// A [`Progress`] that ignores everything.

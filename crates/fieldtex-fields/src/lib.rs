@@ -88,6 +88,7 @@ pub mod harmonic_diffusion;
 pub mod nested_dissection;
 pub mod smoothest_field;
 pub mod surface_field_metrics;
+pub mod surface_streamlines;
 pub use greedy_curve_orientation::{
     CurveOrientationOptions, CurveOrientationResult, OrientationMode, OrientationScore,
     OrientationStep, orient_curves, orient_curves_with_signs, orientation_score,

@@ -5,8 +5,10 @@
 
 use crate::StudioOptions;
 use crate::http::{Request, Response, read_request, write_response};
+use crate::jobs::{JobTask, Jobs};
+use crate::mesh_mode::MeshSession;
 use crate::session::{Edit, Session};
-use crate::workspace::{Root, check_file_name, is_image_name};
+use crate::workspace::{Root, check_file_name, is_image_name, is_mesh_name};
 use fieldtex_fields::{DesignFile, SingularityKind, Symmetry};
 use serde::Deserialize;
 use std::collections::{HashMap, VecDeque};
@@ -15,10 +17,49 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-const INDEX_HTML: &str = include_str!("../web/index.html");
-const APP_JS: &str = include_str!("../web/app.js");
-const DRAW_JS: &str = include_str!("../web/draw.js");
-const STYLE_CSS: &str = include_str!("../web/style.css");
+/// The embedded pages: URL path, content type, bytes.
+const ASSETS: &[(&str, &str, &str)] = &[
+    ("/", "text/html; charset=utf-8", include_str!("../web/index.html")),
+    ("/index.html", "text/html; charset=utf-8", include_str!("../web/index.html")),
+    ("/mesh.html", "text/html; charset=utf-8", include_str!("../web/mesh.html")),
+    ("/app.js", "text/javascript; charset=utf-8", include_str!("../web/app.js")),
+    ("/draw.js", "text/javascript; charset=utf-8", include_str!("../web/draw.js")),
+    ("/mesh.js", "text/javascript; charset=utf-8", include_str!("../web/mesh.js")),
+    ("/style.css", "text/css; charset=utf-8", include_str!("../web/style.css")),
+];
+
+/// The three.js modules copied by `scripts/setup-studio` (empty before it ran).
+mod vendor {
+    include!(concat!(env!("OUT_DIR"), "/vendor.rs"));
+}
+
+/// Every API route and its method (anything else on these paths is 405).
+const ROUTES: &[(&str, &str)] = &[
+    ("GET", "/api/info"),
+    ("POST", "/api/session"),
+    ("GET", "/api/state"),
+    ("POST", "/api/edit"),
+    ("POST", "/api/texture"),
+    ("POST", "/api/export"),
+    ("POST", "/api/upload"),
+    ("GET", "/api/file"),
+    ("GET", "/api/meshes"),
+    ("POST", "/api/mesh/open"),
+    ("POST", "/api/mesh/field"),
+    ("POST", "/api/mesh/frames"),
+    ("GET", "/api/jobs"),
+    ("POST", "/api/jobs"),
+    ("GET", "/api/jobs/get"),
+    ("POST", "/api/jobs/cancel"),
+    ("GET", "/api/jobs/events"),
+    ("GET", "/api/jobs/files"),
+];
+
+/// Candidate-triple pool of the studio's solid jobs (module docs of `job_submit`).
+const SOLID_PREVIEW_POOL: usize = 256;
+
+/// Most meshes kept open at once (the oldest is dropped beyond).
+const MAX_MESH_SESSIONS: usize = 8;
 
 type SessionRef = Arc<Mutex<Session>>;
 
@@ -33,6 +74,10 @@ struct Sessions {
 pub struct State {
     workspace: Root,
     exemplars: Option<Root>,
+    meshes: Option<Root>,
+    mesh_sessions: Mutex<VecDeque<(String, Arc<MeshSession>)>>,
+    mesh_counter: std::sync::atomic::AtomicU64,
+    jobs: Arc<Jobs>,
     loopback: bool,
     pub(crate) max_connections: usize,
     max_upload: usize,
@@ -48,9 +93,14 @@ impl State {
     pub fn new(o: &StudioOptions) -> Result<Self, String> {
         let workspace = Root::new(&o.workspace, true)?;
         let exemplars = o.exemplars.as_deref().map(|d| Root::new(d, false)).transpose()?;
+        let meshes = o.meshes.as_deref().map(|d| Root::new(d, false)).transpose()?;
         Ok(Self {
             workspace,
             exemplars,
+            meshes,
+            mesh_sessions: Mutex::new(VecDeque::new()),
+            mesh_counter: std::sync::atomic::AtomicU64::new(0),
+            jobs: Jobs::start(o.max_jobs, 8),
             loopback: crate::is_loopback_host(&o.host),
             max_connections: o.max_connections.max(1),
             max_upload: o.max_upload_bytes,
@@ -68,9 +118,13 @@ impl State {
             "exemplars" => self.exemplars.as_ref().ok_or_else(|| {
                 Response::error(404, "no exemplar directory was given (--exemplars)")
             }),
+            "meshes" => self
+                .meshes
+                .as_ref()
+                .ok_or_else(|| Response::error(404, "no meshes directory was given (--meshes)")),
             _ => Err(Response::error(
                 400,
-                format!("unknown root {name:?}: use \"workspace\" or \"exemplars\""),
+                format!("unknown root {name:?}: use \"workspace\", \"exemplars\" or \"meshes\""),
             )),
         }
     }
@@ -137,6 +191,15 @@ pub fn handle_connection(state: &State, mut stream: TcpStream) {
             drain(&mut stream);
             return;
         }
+        Ok(req) if req.method == "GET" && req.path == "/api/jobs/events" => {
+            match refuse_foreign(state, &req) {
+                Some(r) => r,
+                None => {
+                    job_events(state, &req, &mut stream);
+                    return;
+                }
+            }
+        }
         Ok(req) => match catch_unwind(AssertUnwindSafe(|| guarded(state, &req))) {
             Ok(r) => r,
             Err(_) => Response::error(
@@ -172,29 +235,37 @@ fn host_name(host: &str) -> &str {
     host.rsplit_once(':').map_or(host, |(h, _)| h)
 }
 
-fn guarded(state: &State, req: &Request) -> Response {
+/// The DNS-rebinding and cross-site checks: `Some(403)` for a request to refuse.
+fn refuse_foreign(state: &State, req: &Request) -> Option<Response> {
     let host = req.header("host").unwrap_or("");
     if state.loopback && !crate::is_loopback_host(host_name(host)) {
-        return Response::error(
+        return Some(Response::error(
             403,
             format!("Host {host:?} is not a loopback name; open http://127.0.0.1:PORT/"),
-        );
+        ));
     }
     if let Some(origin) = req.header("origin")
         && origin != format!("http://{host}")
     {
-        return Response::error(403, format!("requests from {origin:?} are refused"));
+        return Some(Response::error(403, format!("requests from {origin:?} are refused")));
     }
-    route(state, req)
+    None
+}
+
+fn guarded(state: &State, req: &Request) -> Response {
+    refuse_foreign(state, req).unwrap_or_else(|| route(state, req))
 }
 
 fn route(state: &State, req: &Request) -> Response {
-    let asset = |ct: &'static str, s: &'static str| Response::new(200, ct, s.as_bytes().to_vec());
+    if req.method == "GET" {
+        if let Some((_, ct, body)) = ASSETS.iter().find(|(p, _, _)| *p == req.path) {
+            return Response::new(200, ct, body.as_bytes().to_vec());
+        }
+        if let Some((_, body)) = vendor::VENDOR.iter().find(|(p, _)| *p == req.path) {
+            return Response::new(200, "text/javascript; charset=utf-8", body.to_vec());
+        }
+    }
     match (req.method.as_str(), req.path.as_str()) {
-        ("GET", "/") | ("GET", "/index.html") => asset("text/html; charset=utf-8", INDEX_HTML),
-        ("GET", "/app.js") => asset("text/javascript; charset=utf-8", APP_JS),
-        ("GET", "/draw.js") => asset("text/javascript; charset=utf-8", DRAW_JS),
-        ("GET", "/style.css") => asset("text/css; charset=utf-8", STYLE_CSS),
         ("GET", "/api/info") => info(state),
         ("POST", "/api/session") => respond(new_session(state, req)),
         ("GET", "/api/state") => respond(get_state(state, req)),
@@ -203,29 +274,39 @@ fn route(state: &State, req: &Request) -> Response {
         ("POST", "/api/export") => respond(export(state, req)),
         ("POST", "/api/upload") => respond(upload(state, req)),
         ("GET", "/api/file") => respond(file(state, req)),
-        (_, p)
-            if p == "/" || p.ends_with(".js") || p.ends_with(".css") || p.starts_with("/api/") =>
-        {
-            if matches!(
-                p,
-                "/" | "/app.js"
-                    | "/draw.js"
-                    | "/style.css"
-                    | "/api/info"
-                    | "/api/session"
-                    | "/api/state"
-                    | "/api/edit"
-                    | "/api/texture"
-                    | "/api/export"
-                    | "/api/upload"
-                    | "/api/file"
-            ) {
-                Response::error(405, format!("{} is not allowed on {p}", req.method))
+        ("GET", "/api/meshes") => meshes(state),
+        ("POST", "/api/mesh/open") => respond(mesh_open(state, req)),
+        ("POST", "/api/mesh/field") => respond(mesh_field(state, req)),
+        ("POST", "/api/mesh/frames") => respond(mesh_frames(state, req)),
+        ("GET", "/api/jobs") => {
+            Response::json(200, &serde_json::json!({ "jobs": state.jobs.list() }))
+        }
+        ("POST", "/api/jobs") => respond(job_submit(state, req)),
+        ("GET", "/api/jobs/get") => {
+            respond(job_get(state, req).map(|j| Response::json(200, &j.json())))
+        }
+        ("POST", "/api/jobs/cancel") => respond(job_get(state, req).map(|j| {
+            j.request_cancel();
+            Response::json(200, &j.json())
+        })),
+        ("GET", "/api/jobs/files") => respond(job_files(state, req)),
+        (m, p) => {
+            let known = ASSETS.iter().any(|(a, _, _)| *a == p)
+                || vendor::VENDOR.iter().any(|(a, _)| *a == p)
+                || ROUTES.iter().any(|(_, r)| *r == p);
+            if known {
+                Response::error(405, format!("{m} is not allowed on {p}"))
+            } else if p.starts_with("/vendor/") {
+                Response::error(
+                    404,
+                    format!(
+                        "{p}: three.js is not embedded in this build; run scripts/setup-studio, then rebuild (cargo build --release -p fieldtex-cli)"
+                    ),
+                )
             } else {
                 Response::error(404, format!("no route {p}"))
             }
         }
-        (_, p) => Response::error(404, format!("no route {p}")),
     }
 }
 
@@ -266,6 +347,8 @@ fn info(state: &State) -> Response {
             "workspace": state.workspace.dir.display().to_string(),
             "max_upload_bytes": state.max_upload,
             "seed": state.seed,
+            "three": vendor::VENDOR_VERSION,
+            "setup_command": "scripts/setup-studio && cargo build --release -p fieldtex-cli",
         }),
     )
 }
@@ -518,19 +601,42 @@ fn export(state: &State, req: &Request) -> Result<Response, Response> {
 fn upload(state: &State, req: &Request) -> Result<Response, Response> {
     let name = req.query("name").ok_or_else(|| bad("give ?name=FILE.png"))?;
     check_file_name(name).map_err(|(c, m)| Response::error(c, m))?;
-    if !is_image_name(name) {
-        return Err(bad(format!("{name:?}: uploads are .png or .jpg exemplars")));
+    let mesh = is_mesh_name(name);
+    if !is_image_name(name) && !mesh {
+        return Err(bad(format!(
+            "{name:?}: uploads are .png/.jpg exemplars or .obj/.ply/.stl/.glb meshes"
+        )));
     }
     if req.body.is_empty() {
         return Err(bad("empty upload"));
     }
-    fieldtex_io::read_image_bytes(&req.body, name)
-        .map_err(|e| bad(format!("{name} is not a readable image: {e}")))?;
-    let p = state
-        .workspace
-        .file_for_writing("uploads", name)
-        .map_err(|(c, m)| Response::error(c, m))?;
-    fieldtex_io::atomic_write(&p, &req.body).map_err(|e| Response::error(500, e.to_string()))?;
+    let path_err = |(c, m): (u16, String)| Response::error(c, m);
+    let p = state.workspace.file_for_writing("uploads", name).map_err(path_err)?;
+    if mesh {
+        // Check the mesh with the same reader the pipelines use, from a hidden file
+        // next to the target, before it takes the name.
+        let dir = state.workspace.dir_for_writing("uploads").map_err(path_err)?;
+        let check = dir.join(format!(".check-{name}"));
+        let io500 = |e: fieldtex_io::IoError| Response::error(500, e.to_string());
+        fieldtex_io::atomic_write(&check, &req.body).map_err(io500)?;
+        let read = fieldtex_io::read_mesh(&check);
+        let ok = read.as_ref().is_ok_and(|m| !m.mesh.triangles.is_empty());
+        let result = if ok {
+            std::fs::rename(&check, &p).map_err(|e| Response::error(500, e.to_string()))
+        } else {
+            Err(bad(match read {
+                Err(e) => format!("{name} is not a readable mesh: {e}"),
+                Ok(_) => format!("{name} has no triangles"),
+            }))
+        };
+        let _ = std::fs::remove_file(&check);
+        result?;
+    } else {
+        fieldtex_io::read_image_bytes(&req.body, name)
+            .map_err(|e| bad(format!("{name} is not a readable image: {e}")))?;
+        fieldtex_io::atomic_write(&p, &req.body)
+            .map_err(|e| Response::error(500, e.to_string()))?;
+    }
     Ok(Response::json(
         200,
         &serde_json::json!({ "root": "workspace", "path": format!("uploads/{name}") }),
@@ -556,4 +662,283 @@ fn file(state: &State, req: &Request) -> Result<Response, Response> {
         _ => "application/octet-stream",
     };
     Ok(Response::new(200, ct, bytes))
+}
+
+/// Meshes (workspace and the meshes root) and GLB outputs (workspace) to open.
+fn meshes(state: &State) -> Response {
+    let mut meshes = Vec::new();
+    if let Some(r) = &state.meshes {
+        for p in r.list_matching(300, is_mesh_name) {
+            meshes.push(serde_json::json!({ "root": "meshes", "path": p }));
+        }
+    }
+    for p in state.workspace.list_matching(300, is_mesh_name) {
+        meshes.push(serde_json::json!({ "root": "workspace", "path": p }));
+    }
+    let glbs: Vec<_> = state
+        .workspace
+        .list_matching(300, |n| n.to_ascii_lowercase().ends_with(".glb"))
+        .into_iter()
+        .map(|p| serde_json::json!({ "root": "workspace", "path": p }))
+        .collect();
+    Response::json(200, &serde_json::json!({ "meshes": meshes, "glbs": glbs }))
+}
+
+/// A mesh file behind a `{root, path}` reference.
+fn mesh_file(state: &State, r: &FileRef) -> Result<std::path::PathBuf, Response> {
+    let root = state.root(&r.root)?;
+    if !is_mesh_name(&r.path) {
+        return Err(bad(format!("{:?} is not a .obj/.ply/.stl/.glb mesh", r.path)));
+    }
+    root.existing_file(&r.path).map_err(|(c, m)| Response::error(c, m))
+}
+
+fn mesh_open(state: &State, req: &Request) -> Result<Response, Response> {
+    let r: FileRef = parse_json(&req.body)?;
+    let path = mesh_file(state, &r)?;
+    let session =
+        MeshSession::open(&path, &r.root, &r.path).map_err(|(c, m)| Response::error(c, m))?;
+    let n = state.mesh_counter.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
+    let id = format!("m{n}");
+    let body = session.encode(&id);
+    let mut g = state.mesh_sessions.lock().unwrap_or_else(|e| e.into_inner());
+    while g.len() >= MAX_MESH_SESSIONS {
+        g.pop_front();
+    }
+    g.push_back((id, Arc::new(session)));
+    Ok(Response::new(200, "application/octet-stream", body))
+}
+
+fn mesh_session(state: &State, req: &Request) -> Result<Arc<MeshSession>, Response> {
+    let id = req.query("mesh").ok_or_else(|| bad("give ?mesh=ID"))?;
+    let g = state.mesh_sessions.lock().unwrap_or_else(|e| e.into_inner());
+    g.iter().find(|(k, _)| k == id).map(|(_, m)| m.clone()).ok_or_else(|| {
+        Response::error(
+            404,
+            format!("no open mesh {id:?} (expired or server restarted): open it again"),
+        )
+    })
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FieldRequest {
+    /// Curves on the surface; `None` = the mesh's crest lines.
+    curves: Option<Vec<Vec<[f64; 3]>>>,
+    /// Streamline seeds (default 300).
+    seeds: Option<usize>,
+}
+
+fn mesh_field(state: &State, req: &Request) -> Result<Response, Response> {
+    let f: FieldRequest = parse_json(&req.body)?;
+    let m = mesh_session(state, req)?;
+    if let Some(c) = &f.curves {
+        crate::mesh_mode::check_curves(c).map_err(bad)?;
+    }
+    let json = m
+        .field_lines(f.curves.as_deref(), f.seeds.unwrap_or(300))
+        .map_err(|(c, e)| Response::error(c, e))?;
+    Ok(Response::json(200, &json))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FramesRequest {
+    sketch: fieldtex_fields::Sketch,
+    samples: Option<usize>,
+}
+
+fn mesh_frames(state: &State, req: &Request) -> Result<Response, Response> {
+    let f: FramesRequest = parse_json(&req.body)?;
+    let m = mesh_session(state, req)?;
+    let json =
+        m.frames(&f.sketch, f.samples.unwrap_or(250)).map_err(|(c, e)| Response::error(c, e))?;
+    Ok(Response::json(200, &json))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JobRequest {
+    kind: String,
+    /// align, conformal, solid: the mesh; transfer: the target.
+    mesh: Option<FileRef>,
+    /// transfer: the textured source mesh.
+    source: Option<FileRef>,
+    exemplar: Option<FileRef>,
+    /// align: curves on the surface (written as `curves.obj`); `None` = crest lines.
+    curves: Option<Vec<Vec<[f64; 3]>>>,
+    /// solid: the sketch JSON (`fieldtex_fields::sketch`), written as `sketch.json`.
+    sketch: Option<serde_json::Value>,
+    /// solid: cut planes `[x, y, z, nx, ny, nz]`.
+    cuts: Option<Vec<[f64; 6]>>,
+    /// solid: voxels along the longest side (8..=512, default 96).
+    resolution: Option<usize>,
+    /// Atlas / texture size (64..=2048, default 512).
+    size: Option<usize>,
+    seed: Option<u64>,
+}
+
+fn job_submit(state: &State, req: &Request) -> Result<Response, Response> {
+    let j: JobRequest = parse_json(&req.body)?;
+    let size = j.size.unwrap_or(512);
+    if !(64..=2048).contains(&size) {
+        return Err(bad(format!("size {size} is outside 64..=2048")));
+    }
+    let seed = j.seed.unwrap_or(state.seed);
+    let need = |r: &Option<FileRef>, what: &str| -> Result<std::path::PathBuf, Response> {
+        let r = r.as_ref().ok_or_else(|| bad(format!("a {} job needs \"{what}\"", j.kind)))?;
+        if what == "exemplar" {
+            let root = state.root(&r.root)?;
+            if !is_image_name(&r.path) {
+                return Err(bad(format!("{:?} is not a .png/.jpg exemplar", r.path)));
+            }
+            root.existing_file(&r.path).map_err(|(c, m)| Response::error(c, m))
+        } else {
+            mesh_file(state, r)
+        }
+    };
+    if !matches!(j.kind.as_str(), "align" | "conformal" | "transfer" | "solid") {
+        return Err(bad(format!(
+            "unknown job kind {:?}: use align, conformal, transfer or solid",
+            j.kind
+        )));
+    }
+    let (id, dir) = state.jobs.next_id(&j.kind);
+    let out_rel = format!("jobs/{dir}");
+    let path_err = |(c, m): (u16, String)| Response::error(c, m);
+    let inputs_rel = format!("jobs/{dir}-inputs");
+    let task = match j.kind.as_str() {
+        "align" => {
+            let mut o = fieldtex::AlignOptions {
+                mesh: need(&j.mesh, "mesh")?,
+                exemplar: need(&j.exemplar, "exemplar")?,
+                size,
+                seed,
+                ..Default::default()
+            };
+            if let Some(c) = &j.curves {
+                crate::mesh_mode::check_curves(c).map_err(bad)?;
+                let p = state
+                    .workspace
+                    .file_for_writing(&inputs_rel, "curves.obj")
+                    .map_err(path_err)?;
+                fieldtex_io::write_obj_polylines(&p, c)
+                    .map_err(|e| Response::error(500, e.to_string()))?;
+                o.curves = Some(p);
+            }
+            JobTask::Align(Box::new(o))
+        }
+        "conformal" => JobTask::Conformal(Box::new(fieldtex::ConformalOptions {
+            mesh: need(&j.mesh, "mesh")?,
+            exemplar: need(&j.exemplar, "exemplar")?,
+            size,
+            seed,
+            ..Default::default()
+        })),
+        "transfer" => {
+            let mut o = fieldtex::TransferCommandOptions {
+                source: need(&j.source, "source")?,
+                target: need(&j.mesh, "mesh")?,
+                size,
+                ..Default::default()
+            };
+            o.transfer.seed = seed;
+            JobTask::Transfer(Box::new(o))
+        }
+        _ => {
+            let resolution = j.resolution.unwrap_or(96);
+            if !(8..=512).contains(&resolution) {
+                return Err(bad(format!("resolution {resolution} is outside 8..=512")));
+            }
+            let cuts = j.cuts.clone().unwrap_or_default();
+            if cuts.len() > 4 || cuts.iter().flatten().any(|x| !x.is_finite()) {
+                return Err(bad("give at most 4 cuts of 6 finite numbers"));
+            }
+            let mut o = fieldtex::SolidOptions {
+                mesh: need(&j.mesh, "mesh")?,
+                exemplar: Some(need(&j.exemplar, "exemplar")?),
+                resolution,
+                cuts,
+                atlas_size: size,
+                seed,
+                ..Default::default()
+            };
+            // Preview quality for interactive cuts: the candidate-triple search looks at
+            // a pool of 256 exemplar pixels instead of 1024 (the analysis dominates a
+            // small run); `fieldtex solid` keeps the full default.
+            o.analysis.pool = SOLID_PREVIEW_POOL;
+            if let Some(sk) = &j.sketch {
+                let text = sk.to_string();
+                let parsed: fieldtex_fields::Sketch =
+                    serde_json::from_value(sk.clone()).map_err(|e| bad(format!("sketch: {e}")))?;
+                parsed.validate().map_err(|e| bad(format!("sketch: {e}")))?;
+                let p = state
+                    .workspace
+                    .file_for_writing(&inputs_rel, "sketch.json")
+                    .map_err(path_err)?;
+                fieldtex_io::atomic_write(&p, text.as_bytes())
+                    .map_err(|e| Response::error(500, e.to_string()))?;
+                o.sketch = Some(p);
+            }
+            JobTask::Solid(Box::new(o))
+        }
+    };
+    let out_dir = state.workspace.dir_for_writing(&out_rel).map_err(path_err)?;
+    let job = state.jobs.submit(id, out_rel, out_dir, task).map_err(|m| Response::error(503, m))?;
+    Ok(Response::json(200, &job.json()))
+}
+
+fn job_get(state: &State, req: &Request) -> Result<Arc<crate::jobs::Job>, Response> {
+    let id = req.query("id").ok_or_else(|| bad("give ?id=JOB"))?;
+    state.jobs.get(id).ok_or_else(|| Response::error(404, format!("no job {id:?}")))
+}
+
+fn job_files(state: &State, req: &Request) -> Result<Response, Response> {
+    let job = job_get(state, req)?;
+    let files =
+        crate::jobs::job_files(&state.workspace, &job).map_err(|(c, m)| Response::error(c, m))?;
+    Ok(Response::json(200, &serde_json::json!({ "id": job.id, "files": files })))
+}
+
+/// Streams a job's state as server-sent events (`data: {json}`) until it ends or the
+/// client goes away: one event per change, checked every 50 ms.
+fn job_events(state: &State, req: &Request, stream: &mut TcpStream) {
+    use std::io::Write;
+    let job = match job_get(state, req) {
+        Ok(j) => j,
+        Err(r) => {
+            write_response(stream, &r);
+            return;
+        }
+    };
+    let head = "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\nConnection: close\r\nX-Content-Type-Options: nosniff\r\n\r\n";
+    if stream.write_all(head.as_bytes()).is_err() {
+        return;
+    }
+    let mut last = String::new();
+    let mut quiet = Instant::now();
+    loop {
+        let finished = job.finished();
+        let text = job.json().to_string();
+        if text != last {
+            if stream.write_all(format!("data: {text}\n\n").as_bytes()).is_err() {
+                return;
+            }
+            let _ = stream.flush();
+            last = text;
+            quiet = Instant::now();
+        } else if quiet.elapsed().as_secs() >= 10 {
+            // A comment line: detects clients that went away.
+            if stream.write_all(b": alive\n\n").is_err() {
+                return;
+            }
+            quiet = Instant::now();
+        }
+        if finished {
+            let _ = stream.write_all(b"event: end\ndata: {}\n\n");
+            let _ = stream.shutdown(std::net::Shutdown::Write);
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
 }

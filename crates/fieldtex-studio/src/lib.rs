@@ -17,6 +17,8 @@
 
 pub mod api;
 pub mod http;
+pub mod jobs;
+pub mod mesh_mode;
 pub mod session;
 pub mod workspace;
 
@@ -37,6 +39,10 @@ pub struct StudioOptions {
     pub workspace: PathBuf,
     /// An extra read-only directory of exemplar images (e.g. the shared exemplars).
     pub exemplars: Option<PathBuf>,
+    /// An extra read-only directory of meshes (e.g. the shared meshes).
+    pub meshes: Option<PathBuf>,
+    /// Jobs (align, conformal, transfer, solid) run at once; more wait. Default 1.
+    pub max_jobs: usize,
     /// Largest upload in bytes. Default 16 MiB.
     pub max_upload_bytes: usize,
     /// Largest JSON body in bytes. Default 4 MiB.
@@ -56,6 +62,8 @@ impl StudioOptions {
             port: 7878,
             workspace,
             exemplars: None,
+            meshes: None,
+            max_jobs: 1,
             max_upload_bytes: 16 << 20,
             max_json_bytes: 4 << 20,
             max_connections: 64,

@@ -121,6 +121,11 @@ impl Root {
     /// Image files (`.png`, `.jpg`, `.jpeg`) under the root, relative paths sorted, at
     /// most `limit`, skipping hidden directories and `target`, at most 4 levels deep.
     pub fn list_images(&self, limit: usize) -> Vec<String> {
+        self.list_matching(limit, is_image_name)
+    }
+
+    /// Files under the root whose name passes `keep`, as [`Root::list_images`].
+    pub fn list_matching(&self, limit: usize, keep: impl Fn(&str) -> bool) -> Vec<String> {
         let mut out = Vec::new();
         let mut stack = vec![(self.dir.clone(), 0usize)];
         while let Some((dir, depth)) = stack.pop() {
@@ -133,7 +138,7 @@ impl Root {
                 if ft.is_dir() && depth < 4 && !name.starts_with('.') && name != "target" {
                     stack.push((e.path(), depth + 1));
                 } else if ft.is_file()
-                    && is_image_name(&name)
+                    && keep(&name)
                     && let Ok(rel) = e.path().strip_prefix(&self.dir)
                     && let Some(s) = rel.to_str()
                 {
@@ -154,6 +159,13 @@ impl Root {
 pub fn is_image_name(name: &str) -> bool {
     let lower = name.to_ascii_lowercase();
     lower.ends_with(".png") || lower.ends_with(".jpg") || lower.ends_with(".jpeg")
+}
+
+/// A mesh file the readers take from an upload or the workspace: `.obj`, `.ply`,
+/// `.stl`, `.glb` (not `.gltf`, whose buffers are separate files), any case.
+pub fn is_mesh_name(name: &str) -> bool {
+    let lower = name.to_ascii_lowercase();
+    [".obj", ".ply", ".stl", ".glb"].iter().any(|e| lower.ends_with(e))
 }
 
 /// A plain file name: 1–128 bytes of `A–Z a–z 0–9 . _ -`, not starting with a dot.

@@ -53,12 +53,20 @@ function showTimings(extra) {
   $('timings').textContent = lines.join('\n');
 }
 
-async function setState(resp, t0) {
+// Edit latencies for the page and the browser test: from the input event that caused
+// the edit (or the request, when there is none) to the end of the redraw.
+const timings = [];
+window.studio = { get state() { return state; }, get field() { return field; }, timings, get busy() { return inFlight || pending !== null; } };
+
+async function setState(resp, t0, tEvent = t0) {
   const [json, f] = decodeState(await resp.arrayBuffer());
   const tNet = performance.now() - t0;
   state = json; field = f;
   const tDraw = redraw();
-  showTimings(`round trip ${tNet.toFixed(1)} ms + draw ${tDraw.toFixed(1)} ms`);
+  const total = performance.now() - tEvent;
+  if (timings.length > 1000) timings.shift();
+  timings.push({ version: json.version, round_trip_ms: tNet, draw_ms: tDraw, event_to_draw_ms: total, solve_ms: json.solve_ms });
+  showTimings(`round trip ${tNet.toFixed(1)} ms + draw ${tDraw.toFixed(1)} ms; event → drawn ${total.toFixed(1)} ms`);
   updateSelectionUi();
   scheduleTexture();
   return json;
@@ -84,18 +92,18 @@ async function newSession(body) {
 // Edits: one in flight; while it runs, newer drag positions replace the pending one.
 let inFlight = false;
 let pending = null;
-async function edit(op) {
-  if (inFlight) { pending = op; return null; }
+async function edit(op, tEvent = performance.now()) {
+  if (inFlight) { pending = { op, tEvent }; return null; }
   inFlight = true;
   let result = null;
   try {
     const t0 = performance.now();
     const resp = await post(`/api/edit?session=${encodeURIComponent(state.session)}`, op);
-    result = await setState(resp, t0);
+    result = await setState(resp, t0, tEvent);
     status('ok');
   } catch (e) { status(e.message, true); }
   inFlight = false;
-  if (pending) { const p = pending; pending = null; await edit(p); }
+  if (pending) { const p = pending; pending = null; await edit(p.op, p.tEvent); }
   return result;
 }
 
@@ -171,7 +179,7 @@ canvas.addEventListener('pointerdown', async (ev) => {
     return;
   }
   if (tool !== 'select') {
-    const r = await edit({ op: 'add_singularity', kind: tool, x: p.x, y: p.y, angle_deg: Number($('angle').value) });
+    const r = await edit({ op: 'add_singularity', kind: tool, x: p.x, y: p.y, angle_deg: Number($('angle').value) }, ev.timeStamp);
     if (r && r.added !== null && r.added !== undefined) { selected = { type: 'singularity', id: r.added }; updateSelectionUi(); redraw(); }
   } else { selected = null; updateSelectionUi(); redraw(); }
 });
@@ -189,7 +197,7 @@ canvas.addEventListener('pointermove', (ev) => {
       ctx.stroke();
     }
   } else if (drag.type === 'singularity') {
-    edit({ op: 'move_singularity', id: drag.id, x: p.x, y: p.y });
+    edit({ op: 'move_singularity', id: drag.id, x: p.x, y: p.y }, ev.timeStamp);
   } else if (drag.type === 'handle') {
     const s = drag.orig;
     const a = (Math.atan2(p.y - s.y, p.x - s.x) * 180) / Math.PI;

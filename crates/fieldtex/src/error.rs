@@ -13,6 +13,9 @@ pub enum Error {
     /// Something failed inside fieldtex (a solver, a numeric breakdown).
     #[error("internal failure: {0}")]
     Internal(String),
+    /// The caller's [`crate::Progress::cancelled`] said stop; no outputs were written.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 impl Error {
@@ -33,6 +36,7 @@ impl Error {
         match self {
             Error::BadInput { .. } => 2,
             Error::Internal(_) => 1,
+            Error::Cancelled => 130,
         }
     }
 }

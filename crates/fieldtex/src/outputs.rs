@@ -76,3 +76,10 @@ pub fn write_text(path: &Path, text: &str) -> Result<()> {
     fieldtex_io::atomic_write(path, text.as_bytes())?;
     Ok(())
 }
+
+/// `Err(Error::Cancelled)` once the caller's progress asks to stop; pipelines call it
+/// between stages, so a cancelled run stops at the next stage boundary and its staged
+/// outputs are dropped uncommitted.
+pub(crate) fn check_cancelled(progress: &dyn crate::Progress) -> Result<()> {
+    if progress.cancelled() { Err(Error::Cancelled) } else { Ok(()) }
+}

@@ -406,6 +406,7 @@ pub(crate) fn align_impl(
         "exemplar_size": [exemplar.width * reduction, exemplar.height * reduction],
         "exemplar_reduction": reduction,
     });
+    crate::outputs::check_cancelled(progress)?;
     // 2. Salient curves and the oriented field (paper A §3–4).
     let mut warnings = Vec::new();
     let (curves, curves_source) = report.time("curves", || {
@@ -447,6 +448,7 @@ pub(crate) fn align_impl(
     let field = oriented.field.vectors.clone();
     let normals = oriented.solver.normals().to_vec();
     drop(oriented);
+    crate::outputs::check_cancelled(progress)?;
     // 3. Atlas and colour carriers (covered texels).
     let size = options.size;
     let CarrierAtlas { atlas, map, covered, carriers } =
@@ -524,6 +526,7 @@ pub(crate) fn align_impl(
             e => Error::Internal(format!("texture optimisation: {e}")),
         })?;
     report.warnings.extend(result.warnings.iter().cloned());
+    crate::outputs::check_cancelled(progress)?;
     let (texture, carrier_of_texel) = carrier_texture(&map, &covered, &result.colors);
     // 6. Metrics.
     let coverage_samples: Vec<fieldtex_eval::CurveSample> = curve_points

@@ -136,6 +136,7 @@ pub fn conformal(
         .time("conformal-map", || global_conformal(&mesh, progress))
         .map_err(|e| Error::Internal(format!("conformal map: {e}")))?;
     report.warnings.extend(warnings);
+    crate::outputs::check_cancelled(progress)?;
     // 2. Optional quasi-isometric relaxation.
     let mut relax_stats = Vec::new();
     if options.quasi_isometric {
@@ -239,6 +240,7 @@ pub fn conformal(
             seed: stream_seed(options.seed, "conformal-image", c.component as u64),
             ..qbase
         };
+        crate::outputs::check_cancelled(progress)?;
         let (image, st) = quilt(&levels, &target, &q, progress);
         quilt_stats.push(json!({"component": c.component, "stats": st}));
         let faces = c.faces.iter().copied().zip(img.corner_texel.iter().copied()).collect();
@@ -269,6 +271,7 @@ pub fn conformal(
         });
     }
     report.timings_ms.push(("quilting".into(), t_quilt.elapsed().as_secs_f64() * 1e3));
+    crate::outputs::check_cancelled(progress)?;
     // 6. One texture: blocks stacked vertically; per-corner UVs.
     let (texture, out_mesh) = report.time("assemble", || assemble(&mesh, &blocks));
     // 7. Outputs.

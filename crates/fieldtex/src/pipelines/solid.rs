@@ -198,6 +198,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
         let edit_ms = report.time("frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
         report.metric("frame_field_edit_ms", edit_ms);
     }
+    crate::outputs::check_cancelled(progress)?;
     // 2. Exemplar analysis and the synthesizer.
     let ex = report
         .time("exemplar_analysis", || {
@@ -210,6 +211,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
     let mut synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
         .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?;
+    crate::outputs::check_cancelled(progress)?;
     // 3. Surface shell → atlas texture → model.glb.
     let (atlas_mesh, texture, shell) =
         report.time("shell", || textured_atlas(&mesh, &aopts, &grid, &mut synth, progress))?;
@@ -222,6 +224,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     report.time("write", || super::write_model(out_dir, &atlas_mesh, Some(&texture)))?;
     let preview = report.time("preview", || preview_with_curves(&atlas_mesh, &texture, &curves));
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    crate::outputs::check_cancelled(progress)?;
     // 4. Cuts.
     let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
     let mut cut_reports = Vec::new();

@@ -191,6 +191,7 @@ pub fn transfer_files(
         "target_vertices": target_mesh.n_vertices(),
         "target_triangles": target_mesh.n_triangles(),
     });
+    crate::outputs::check_cancelled(progress)?;
     // Transfer on surface samples.
     let result = fieldtex_transfer::transfer(
         &source_mesh,
@@ -203,6 +204,7 @@ pub fn transfer_files(
     .map_err(|e| transfer_error(e, options))?;
     report.timings_ms.extend(result.timings_ms.iter().cloned());
     report.warnings.extend(result.warnings.iter().cloned());
+    crate::outputs::check_cancelled(progress)?;
     // Atlas of the target and baking.
     let CarrierAtlas { atlas, map, covered, carriers } =
         carrier_atlas(&target_mesh, &aopts, options.size, &mut report, progress)?;

@@ -1,0 +1,584 @@
+// fieldtex studio, mesh modes: align (crest lines, drawn curves, the field as
+// streamlines, align jobs), solid (sketch curves, the frame field, cut planes computed
+// by solid jobs) and the GLB viewer (texture, wireframe, UV checker, patch colours).
+// three.js comes from /vendor/ (embedded after scripts/setup-studio); without it the
+// page says which command to run.
+
+const $ = (id) => document.getElementById(id);
+const params = new URLSearchParams(location.search);
+const mode = ['align', 'solid', 'viewer'].includes(params.get('mode')) ? params.get('mode') : 'align';
+let THREE, OrbitControls, GLTFLoader;
+let info = null;
+let renderer, scene, camera, controls;
+let meshData = null; // {id, root, path, bbox, crest, ...}
+let meshObj = null; // THREE.Mesh of the opened mesh
+let glbRoot = null; // the GLB scene shown in the viewer
+const groups = {};
+const crestUse = []; // per crest line: used as a curve
+let drawn = []; // curves drawn on the surface (align) — arrays of [x, y, z]
+let sketch = []; // solid sketch curves: {points, axis}
+let drawing = null;
+let cutPlaneObj = null;
+let checkerTexture = null;
+const timings = {};
+window.studioMesh = {
+  get mesh() { return meshData; },
+  get drawn() { return mode === 'solid' ? sketch.map((s) => s.points) : drawn; },
+  get glb() { return glbRoot; },
+  timings,
+  jobs: {},
+};
+
+function status(text, error = false) {
+  $('status').textContent = text;
+  $('status').className = error ? 'error' : '';
+}
+
+async function check(resp) {
+  if (resp.ok) return resp;
+  let msg = `${resp.status}`;
+  try { msg += ': ' + (await resp.json()).error; } catch (_) { /* not JSON */ }
+  throw new Error(msg);
+}
+async function post(path, body) {
+  return check(await fetch(path, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) }));
+}
+
+// ---------------------------------------------------------------- 3-D view
+function setupView() {
+  const box = $('viewport');
+  renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(1);
+  renderer.setSize(720, 560);
+  renderer.setClearColor(0xffffff, 1);
+  box.appendChild(renderer.domElement);
+  scene = new THREE.Scene();
+  camera = new THREE.PerspectiveCamera(40, 720 / 560, 0.001, 1000);
+  camera.position.set(0, 0, 3);
+  controls = new OrbitControls(camera, renderer.domElement);
+  controls.addEventListener('change', render);
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x666677, 2.2));
+  const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+  sun.position.set(1, 2, 3);
+  camera.add(sun);
+  scene.add(camera);
+  for (const g of ['mesh', 'crest', 'drawn', 'field', 'glb', 'cut']) {
+    groups[g] = new THREE.Group();
+    scene.add(groups[g]);
+  }
+  renderer.domElement.addEventListener('pointerdown', onPointerDown);
+  renderer.domElement.addEventListener('pointermove', onPointerMove);
+  renderer.domElement.addEventListener('pointerup', onPointerUp);
+  render();
+}
+
+function render() {
+  if (renderer) renderer.render(scene, camera);
+}
+
+function clearGroup(g) {
+  for (const c of [...groups[g].children]) {
+    groups[g].remove(c);
+    c.traverse((o) => { if (o.geometry) o.geometry.dispose(); });
+  }
+}
+
+function fitCamera(lo, hi) {
+  const c = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+  const r = Math.max(1e-6, Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2);
+  controls.target.copy(c);
+  camera.position.set(c.x + r * 0.9, c.y + r * 0.7, c.z + r * 2.4);
+  camera.near = r / 100; camera.far = r * 100;
+  camera.updateProjectionMatrix();
+  controls.update();
+}
+
+function diag() {
+  if (!meshData) return 1;
+  const [lo, hi] = meshData.bbox;
+  return Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
+
+function polyline(points, color, width = 1) {
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.Float32BufferAttribute(points.flat(), 3));
+  const m = new THREE.LineBasicMaterial({ color, linewidth: width, depthTest: true });
+  return new THREE.Line(g, m);
+}
+
+// ---------------------------------------------------------------- meshes
+async function refreshLists() {
+  const lists = await (await check(await fetch('/api/meshes'))).json();
+  const fill = (sel, items) => {
+    const keep = sel.value;
+    sel.textContent = '';
+    for (const it of items) {
+      const o = new Option((it.root === 'workspace' ? 'workspace/' : '') + it.path, JSON.stringify(it));
+      sel.appendChild(o);
+    }
+    if ([...sel.options].some((o) => o.value === keep)) sel.value = keep;
+  };
+  fill($('mesh-list'), lists.meshes);
+  fill($('glb-list'), lists.glbs);
+}
+
+async function openMesh(ref) {
+  status(`opening ${ref.path}…`);
+  const t0 = performance.now();
+  const buf = await (await post('/api/mesh/open', ref)).arrayBuffer();
+  const view = new DataView(buf);
+  const len = view.getUint32(0, true);
+  const json = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, 4, len)));
+  const pos = new Float32Array(buf, 4 + len, json.vertices * 3);
+  const idx = new Uint32Array(buf, 4 + len + json.vertices * 12, json.triangles * 3);
+  meshData = json;
+  const opt = [...$('mesh-list').options].find((o) => { const v = JSON.parse(o.value); return v.root === json.root && v.path === json.path; });
+  if (opt) $('mesh-list').value = opt.value;
+  clearGroup('mesh'); clearGroup('crest'); clearGroup('drawn'); clearGroup('field'); clearGroup('glb'); clearGroup('cut');
+  glbRoot = null;
+  drawn = []; sketch = [];
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(pos.slice(), 3));
+  g.setIndex(new THREE.BufferAttribute(idx.slice(), 1));
+  g.computeVertexNormals();
+  meshObj = new THREE.Mesh(g, new THREE.MeshStandardMaterial({ color: 0xd9d4c7, roughness: 0.8, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 }));
+  groups.mesh.add(meshObj);
+  fitCamera(json.bbox[0], json.bbox[1]);
+  crestUse.length = 0;
+  const colors = { ridge: 0xcc2222, valley: 0x2255dd, crease: 0x11aa44, given: 0x885500 };
+  const list = $('crest-list');
+  list.textContent = '';
+  json.crest.forEach((c, i) => {
+    crestUse.push(true);
+    const line = polyline(c.points, colors[c.kind] || 0x333333);
+    line.userData.index = i;
+    groups.crest.add(line);
+    const l = document.createElement('label');
+    const cb = document.createElement('input');
+    cb.type = 'checkbox'; cb.checked = true; cb.dataset.index = i;
+    cb.onchange = () => { crestUse[i] = cb.checked; line.visible = cb.checked; render(); };
+    l.append(cb, ` ${c.kind} ${i + 1} (${c.points.length} pts)`);
+    list.appendChild(l);
+  });
+  groups.crest.visible = mode === 'align' && $('show-crest').checked;
+  timings.open_ms = performance.now() - t0;
+  showInfo();
+  applyDisplay();
+  render();
+  status(`${json.path}: ${json.vertices} vertices, ${json.triangles} triangles, ${json.crest.length} crest lines`);
+  if (mode === 'solid') placeCutPlane();
+}
+
+function showInfo(extra = '') {
+  const lines = [];
+  if (meshData) lines.push(`${meshData.path}: ${meshData.triangles} triangles`);
+  if (meshData) for (const w of meshData.warnings.slice(0, 5)) lines.push('warning: ' + w);
+  for (const [k, v] of Object.entries(timings)) lines.push(`${k}: ${typeof v === 'number' ? v.toFixed(1) : v}`);
+  if (extra) lines.push(extra);
+  $('timings').textContent = lines.join('\n');
+}
+
+// ---------------------------------------------------------------- drawing on the surface
+const raycaster = () => new THREE.Raycaster();
+function pick(ev) {
+  if (!meshObj) return null;
+  const r = renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((ev.clientX - r.left) / r.width) * 2 - 1, -((ev.clientY - r.top) / r.height) * 2 + 1);
+  const rc = raycaster();
+  rc.setFromCamera(ndc, camera);
+  const hit = rc.intersectObject(meshObj, false)[0];
+  if (!hit) return null;
+  const n = hit.face ? hit.face.normal.clone().transformDirection(meshObj.matrixWorld) : new THREE.Vector3();
+  return { p: hit.point, n };
+}
+
+function onPointerDown(ev) {
+  if (!$('draw').checked || mode === 'viewer' || ev.button !== 0) return;
+  const h = pick(ev);
+  if (!h) return;
+  controls.enabled = false;
+  renderer.domElement.setPointerCapture(ev.pointerId);
+  drawing = { points: [h.p.toArray()], line: null };
+  ev.preventDefault();
+}
+function onPointerMove(ev) {
+  if (!drawing) return;
+  const h = pick(ev);
+  if (!h) return;
+  const last = drawing.points[drawing.points.length - 1];
+  if (Math.hypot(h.p.x - last[0], h.p.y - last[1], h.p.z - last[2]) < diag() * 0.006) return;
+  drawing.points.push(h.p.toArray());
+  if (drawing.line) groups.drawn.remove(drawing.line);
+  drawing.line = lifted(drawing.points, 0x0b8f3a);
+  groups.drawn.add(drawing.line);
+  render();
+}
+function onPointerUp() {
+  if (!drawing) return;
+  const d = drawing; drawing = null;
+  controls.enabled = true;
+  if (d.points.length >= 2) {
+    if (mode === 'solid') sketch.push({ points: d.points, axis: $('sketch-axis').value });
+    else drawn.push(d.points);
+    status(`${mode === 'solid' ? sketch.length : drawn.length} curve(s) drawn`);
+    if (mode === 'solid' && $('cut-auto').checked) scheduleCut();
+  } else if (d.line) groups.drawn.remove(d.line);
+  render();
+}
+/** A curve drawn a little off the surface (along the view) so it is not hidden. */
+function lifted(points, color) {
+  const eps = diag() * 0.002;
+  const pts = points.map((p) => {
+    const v = new THREE.Vector3(...p);
+    const toCam = camera.position.clone().sub(v).normalize().multiplyScalar(eps);
+    return v.add(toCam).toArray();
+  });
+  return polyline(pts, color, 2);
+}
+
+// ---------------------------------------------------------------- align: field
+function usedCurves() {
+  const c = meshData.crest.filter((_, i) => crestUse[i]).map((l) => l.points);
+  return c.concat(drawn);
+}
+async function showField() {
+  if (!meshData) { status('open a mesh first', true); return; }
+  status('solving the field…');
+  const t0 = performance.now();
+  try {
+    const r = await (await post(`/api/mesh/field?mesh=${meshData.id}`, { curves: usedCurves(), seeds: 400 })).json();
+    clearGroup('field');
+    const segs = [];
+    for (const l of r.lines) for (let i = 1; i < l.length; i++) segs.push(...l[i - 1], ...l[i]);
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(segs, 3));
+    const lines = new THREE.LineSegments(g, new THREE.LineBasicMaterial({ color: 0x1d2a44 }));
+    groups.field.add(lines);
+    groups.field.visible = $('show-field-lines').checked;
+    timings.field_server_ms = r.total_ms;
+    timings.field_round_trip_ms = performance.now() - t0;
+    timings.streamlines = r.lines.length;
+    showInfo();
+    render();
+    status(`field of ${r.curves} curves: ${r.lines.length} streamlines`);
+  } catch (e) { status(e.message, true); }
+}
+
+// ---------------------------------------------------------------- solid: frames and cut
+async function showFrames() {
+  if (!meshData) { status('open a mesh first', true); return; }
+  try {
+    const t0 = performance.now();
+    const r = await (await post(`/api/mesh/frames?mesh=${meshData.id}`, { sketch: sketchJson() })).json();
+    clearGroup('field');
+    const cols = [[0.85, 0.15, 0.1], [0.1, 0.6, 0.15], [0.1, 0.3, 0.9]];
+    const pos = [], col = [];
+    const h = diag() * 0.02;
+    for (const f of r.frames) {
+      for (let a = 0; a < 3; a++) {
+        const ax = f.axes[a];
+        pos.push(...f.p, f.p[0] + h * ax[0], f.p[1] + h * ax[1], f.p[2] + h * ax[2]);
+        col.push(...cols[a], ...cols[a]);
+      }
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+    g.setAttribute('color', new THREE.Float32BufferAttribute(col, 3));
+    groups.field.add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true })));
+    timings.frames_server_ms = r.total_ms;
+    timings.frames_round_trip_ms = performance.now() - t0;
+    showInfo();
+    render();
+    status(`frame field: ${r.frames.length} frames, constraint error max ${r.alignment_error_max_deg.toFixed(2)}°`);
+  } catch (e) { status(e.message, true); }
+}
+function sketchJson() {
+  return { curves: sketch.map((s) => ({ points: s.points, axis: s.axis })) };
+}
+function cutPlane() {
+  const [lo, hi] = meshData.bbox;
+  const a = Number($('cut-axis').value);
+  const t = Number($('cut-pos').value);
+  const p = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2];
+  p[a] = lo[a] + t * (hi[a] - lo[a]);
+  const n = [0, 0, 0]; n[a] = 1;
+  return [...p, ...n];
+}
+function placeCutPlane() {
+  if (!meshData) return;
+  clearGroup('cut');
+  const c = cutPlane();
+  const s = diag();
+  const plane = new THREE.Mesh(new THREE.PlaneGeometry(s, s), new THREE.MeshBasicMaterial({ color: 0x3366cc, transparent: true, opacity: 0.18, side: THREE.DoubleSide, depthWrite: false }));
+  plane.position.set(c[0], c[1], c[2]);
+  plane.lookAt(c[0] + c[3], c[1] + c[4], c[2] + c[5]);
+  cutPlaneObj = plane;
+  groups.cut.add(plane);
+  render();
+}
+let cutTimer = null;
+function scheduleCut() {
+  clearTimeout(cutTimer);
+  cutTimer = setTimeout(() => runJob('solid'), 400);
+}
+
+// ---------------------------------------------------------------- jobs
+function exemplarRef() { return $('exemplar').value ? JSON.parse($('exemplar').value) : null; }
+async function runJob(kind = mode) {
+  if (!meshData) { status('open a mesh first', true); return null; }
+  const body = { kind, mesh: { root: meshData.root, path: meshData.path }, exemplar: exemplarRef(), size: Number($('size').value) || 256 };
+  if (kind === 'align') body.curves = usedCurves();
+  if (kind === 'solid') {
+    if (sketch.length) body.sketch = sketchJson();
+    body.cuts = [cutPlane()];
+    body.resolution = Number($('solid-res').value) || 64;
+    body.size = Math.min(body.size, 256);
+  }
+  try {
+    const job = await (await post('/api/jobs', body)).json();
+    status(`${kind} job ${job.id} queued`);
+    watchJob(job);
+    return job;
+  } catch (e) { status(e.message, true); return null; }
+}
+
+function jobRow(job) {
+  let row = document.getElementById(`job-${job.id}`);
+  if (!row) {
+    row = document.createElement('div');
+    row.id = `job-${job.id}`;
+    row.className = 'job';
+    $('jobs').prepend(row);
+  }
+  return row;
+}
+function renderJob(job) {
+  window.studioMesh.jobs[job.id] = job;
+  const row = jobRow(job);
+  row.textContent = '';
+  const head = document.createElement('div');
+  head.textContent = `${job.kind} ${job.id}: ${job.state}${job.stage ? ' — ' + job.stage : ''} (${job.seconds.toFixed(1)} s)`;
+  row.appendChild(head);
+  if (job.state === 'running' || job.state === 'queued') {
+    const bar = document.createElement('progress');
+    bar.max = Math.max(1, job.total); bar.value = job.done;
+    const cancel = document.createElement('button');
+    cancel.textContent = 'Cancel';
+    cancel.onclick = () => post(`/api/jobs/cancel?id=${job.id}`, {}).catch((e) => status(e.message, true));
+    row.append(bar, cancel);
+  }
+  if (job.error) {
+    const e = document.createElement('div');
+    e.className = 'error';
+    e.textContent = job.error;
+    row.appendChild(e);
+  }
+  for (const f of job.files || []) {
+    const a = document.createElement('a');
+    const rel = `${job.dir}/${f}`;
+    a.href = `/api/file?path=${encodeURIComponent(rel)}`;
+    a.textContent = f; a.download = f;
+    row.append(a, ' ');
+    if (f.endsWith('.glb')) {
+      const v = document.createElement('button');
+      v.textContent = 'view';
+      v.onclick = () => openGlb({ root: 'workspace', path: rel });
+      row.append(v, ' ');
+    }
+  }
+}
+function watchJob(job) {
+  renderJob(job);
+  const es = new EventSource(`/api/jobs/events?id=${encodeURIComponent(job.id)}`);
+  es.onmessage = (ev) => {
+    const j = JSON.parse(ev.data);
+    renderJob(j);
+    if (['done', 'failed', 'cancelled'].includes(j.state)) {
+      es.close();
+      onJobEnd(j);
+    }
+  };
+  es.addEventListener('end', () => es.close());
+  es.onerror = () => es.close();
+}
+async function onJobEnd(job) {
+  if (job.state === 'failed') { status(`${job.kind} failed: ${job.error}`, true); return; }
+  if (job.state !== 'done') { status(`${job.kind} ${job.state}`); return; }
+  status(`${job.kind} done in ${job.seconds.toFixed(1)} s`);
+  await refreshLists().catch(() => {});
+  if (job.kind === 'solid' && job.files.includes('cut-1.png')) {
+    const img = $('cut-image');
+    img.src = `/api/file?path=${encodeURIComponent(job.dir + '/cut-1.png')}&t=${Date.now()}`;
+    img.hidden = false;
+    if (job.files.includes('cut-1.glb')) await openGlb({ root: 'workspace', path: `${job.dir}/cut-1.glb` }, false);
+  } else if (job.files.includes('model.glb')) {
+    await openGlb({ root: 'workspace', path: `${job.dir}/model.glb` });
+  }
+}
+
+// ---------------------------------------------------------------- viewer
+async function openGlb(ref, fit = true) {
+  status(`loading ${ref.path}…`);
+  try {
+    const url = `/api/file?root=${ref.root}&path=${encodeURIComponent(ref.path)}`;
+    const gltf = await new GLTFLoader().loadAsync(url);
+    clearGroup('glb');
+    glbRoot = gltf.scene;
+    glbRoot.traverse((o) => { if (o.isMesh) o.userData.original = o.material; });
+    groups.glb.add(glbRoot);
+    if (groups.mesh) groups.mesh.visible = false;
+    groups.crest.visible = false; groups.drawn.visible = false; groups.field.visible = false;
+    if (fit) {
+      const b = new THREE.Box3().setFromObject(glbRoot);
+      fitCamera(b.min.toArray(), b.max.toArray());
+    }
+    applyDisplay();
+    render();
+    status(`${ref.path} loaded`);
+    window.studioMesh.glbLoaded = ref.path;
+  } catch (e) { status(`${ref.path}: ${e.message || e}`, true); }
+}
+
+function checker() {
+  if (checkerTexture) return checkerTexture;
+  const c = document.createElement('canvas');
+  c.width = c.height = 512;
+  const x = c.getContext('2d');
+  for (let j = 0; j < 16; j++) for (let i = 0; i < 16; i++) {
+    x.fillStyle = (i + j) % 2 ? '#f2f2f2' : (i % 4 === 0 || j % 4 === 0 ? '#d04030' : '#303848');
+    x.fillRect(i * 32, j * 32, 32, 32);
+  }
+  checkerTexture = new THREE.CanvasTexture(c);
+  checkerTexture.colorSpace = THREE.SRGBColorSpace;
+  checkerTexture.flipY = false;
+  return checkerTexture;
+}
+
+/** Per-triangle colours of the connected components of the index graph: the GLB
+ *  writer splits vertices at UV seams, so these are the atlas charts / conformal
+ *  patches. Returns a non-indexed geometry with a colour attribute. */
+function patchGeometry(geom) {
+  const n = geom.attributes.position.count;
+  const index = geom.index ? geom.index.array : Array.from({ length: n }, (_, i) => i);
+  const parent = new Int32Array(n).map((_, i) => i);
+  const find = (a) => { while (parent[a] !== a) { parent[a] = parent[parent[a]]; a = parent[a]; } return a; };
+  for (let t = 0; t < index.length; t += 3) {
+    const a = find(index[t]), b = find(index[t + 1]), c = find(index[t + 2]);
+    parent[b] = a; parent[find(c)] = a;
+  }
+  const g = geom.index ? geom.toNonIndexed() : geom.clone();
+  const colors = new Float32Array(g.attributes.position.count * 3);
+  const ids = new Map();
+  for (let t = 0; t < index.length; t += 3) {
+    const root = find(index[t]);
+    if (!ids.has(root)) ids.set(root, ids.size);
+    const h = (ids.get(root) * 0.61803398875) % 1;
+    const col = new THREE.Color().setHSL(h, 0.65, 0.55);
+    for (let k = 0; k < 3; k++) colors.set([col.r, col.g, col.b], (t + k) * 3);
+  }
+  g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
+  g.userData.patches = ids.size;
+  return g;
+}
+
+function applyDisplay() {
+  const d = document.querySelector('input[name=display]:checked').value;
+  const targets = [];
+  if (glbRoot) glbRoot.traverse((o) => { if (o.isMesh) targets.push(o); });
+  else if (meshObj) targets.push(meshObj);
+  let patches = 0;
+  for (const o of targets) {
+    if (!o.userData.original) o.userData.original = o.material;
+    if (!o.userData.geometry) o.userData.geometry = o.geometry;
+    o.geometry = o.userData.geometry;
+    if (d === 'texture') o.material = o.userData.original;
+    else if (d === 'wireframe') o.material = new THREE.MeshBasicMaterial({ color: 0x223355, wireframe: true });
+    else if (d === 'checker') {
+      o.material = o.geometry.attributes.uv
+        ? new THREE.MeshBasicMaterial({ map: checker() })
+        : new THREE.MeshBasicMaterial({ color: 0xcc4444 });
+    } else {
+      if (!o.userData.patchGeometry) o.userData.patchGeometry = patchGeometry(o.userData.geometry);
+      o.geometry = o.userData.patchGeometry;
+      patches += o.geometry.userData.patches;
+      o.material = new THREE.MeshBasicMaterial({ vertexColors: true });
+    }
+  }
+  timings.display = d + (d === 'patches' ? ` (${patches} patches)` : '');
+  window.studioMesh.patches = patches;
+  showInfo();
+  render();
+}
+
+// ---------------------------------------------------------------- start
+async function upload(input, after) {
+  const f = input.files[0];
+  if (!f) return;
+  if (f.size > info.max_upload_bytes) { status(`${f.name} is over ${info.max_upload_bytes} bytes`, true); return; }
+  try {
+    const name = f.name.replace(/[^A-Za-z0-9._-]/g, '_');
+    const ref = await (await check(await fetch(`/api/upload?name=${encodeURIComponent(name)}`, { method: 'POST', body: f }))).json();
+    await refreshLists();
+    await after(ref);
+  } catch (e) { status(e.message, true); }
+}
+
+async function start() {
+  $('mode-name').textContent = mode;
+  for (const a of document.querySelectorAll('#modes a[data-mode]')) if (a.dataset.mode === mode) a.className = 'active';
+  for (const el of document.querySelectorAll('fieldset[class]')) el.hidden = !el.classList.contains(`for-${mode}`);
+  try {
+    info = await (await check(await fetch('/api/info'))).json();
+  } catch (e) { status(e.message, true); return; }
+  if (!info.three) {
+    const s = $('setup');
+    s.hidden = false;
+    s.textContent = `three.js is not embedded in this build, so the mesh modes cannot start. Run: ${info.setup_command} — then restart fieldtex studio.`;
+    status('three.js missing', true);
+    return;
+  }
+  try {
+    THREE = await import('three');
+    ({ OrbitControls } = await import('three/addons/controls/OrbitControls.js'));
+    ({ GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js'));
+  } catch (e) { status(`cannot load three.js: ${e.message}`, true); return; }
+  setupView();
+  for (const ex of info.exemplars) {
+    $('exemplar').appendChild(new Option((ex.root === 'workspace' ? 'workspace/' : '') + ex.path, JSON.stringify(ex)));
+  }
+  const pick = info.exemplars.find((e) => /stripes|woodgrain/.test(e.path)) || info.exemplars[0];
+  if (pick) $('exemplar').value = JSON.stringify(pick);
+  await refreshLists().catch((e) => status(e.message, true));
+  $('mesh-open').onclick = () => $('mesh-list').value && openMesh(JSON.parse($('mesh-list').value)).catch((e) => status(e.message, true));
+  $('glb-open').onclick = () => $('glb-list').value && openGlb(JSON.parse($('glb-list').value));
+  $('mesh-upload').onchange = () => upload($('mesh-upload'), (ref) => openMesh(ref));
+  $('glb-upload').onchange = () => upload($('glb-upload'), (ref) => openGlb(ref));
+  $('clear-drawn').onclick = () => { drawn = []; sketch = []; clearGroup('drawn'); render(); };
+  $('show-crest').onchange = () => { groups.crest.visible = $('show-crest').checked; render(); };
+  const setAll = (v) => {
+    crestUse.fill(v);
+    for (const cb of $('crest-list').querySelectorAll('input')) cb.checked = v;
+    groups.crest.children.forEach((l) => { l.visible = v; });
+    render();
+  };
+  $('crest-all').onclick = () => setAll(true);
+  $('crest-none').onclick = () => setAll(false);
+  $('show-field').onclick = showField;
+  $('show-field-lines').onchange = () => { groups.field.visible = $('show-field-lines').checked; render(); };
+  $('show-frames').onclick = showFrames;
+  $('cut-pos').oninput = placeCutPlane;
+  $('cut-axis').onchange = () => { placeCutPlane(); if ($('cut-auto').checked) scheduleCut(); };
+  $('cut-pos').onchange = () => { if ($('cut-auto').checked) scheduleCut(); };
+  $('cut-now').onclick = () => runJob('solid');
+  $('run').onclick = () => runJob(mode);
+  for (const r of document.querySelectorAll('input[name=display]')) r.onchange = applyDisplay;
+  const jobs = await (await fetch('/api/jobs')).json().catch(() => ({ jobs: [] }));
+  for (const j of jobs.jobs || []) renderJob(j);
+  const want = params.get('mesh');
+  if (want && mode !== 'viewer') await openMesh(JSON.parse(want)).catch((e) => status(e.message, true));
+  const glb = params.get('glb');
+  if (glb) await openGlb(JSON.parse(glb));
+  status('ready');
+  window.studioMesh.ready = true;
+}
+start();
