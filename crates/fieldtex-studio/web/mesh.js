@@ -136,6 +136,8 @@ async function openMesh(ref) {
   if (opt) $('mesh-list').value = opt.value;
   clearGroup('mesh'); clearGroup('crest'); clearGroup('drawn'); clearGroup('field'); clearGroup('glb'); clearGroup('cut');
   glbRoot = null;
+  groups.mesh.visible = true; groups.drawn.visible = true; groups.field.visible = true;
+  $('cut-image').hidden = true;
   drawn = []; sketch = [];
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.BufferAttribute(pos.slice(), 3));
@@ -309,7 +311,7 @@ function placeCutPlane() {
   clearGroup('cut');
   const c = cutPlane();
   const s = diag();
-  const plane = new THREE.Mesh(new THREE.PlaneGeometry(s, s), new THREE.MeshBasicMaterial({ color: 0x3366cc, transparent: true, opacity: 0.18, side: THREE.DoubleSide, depthWrite: false }));
+  const plane = new THREE.Mesh(new THREE.PlaneGeometry(s, s), new THREE.MeshBasicMaterial({ color: 0x3366cc, transparent: true, opacity: 0.12, side: THREE.DoubleSide, depthWrite: false }));
   plane.position.set(c[0], c[1], c[2]);
   plane.lookAt(c[0] + c[3], c[1] + c[4], c[2] + c[5]);
   cutPlaneObj = plane;
@@ -427,7 +429,11 @@ async function openGlb(ref, fit = true) {
     glbRoot.traverse((o) => { if (o.isMesh) o.userData.original = o.material; });
     groups.glb.add(glbRoot);
     if (groups.mesh) groups.mesh.visible = false;
-    groups.crest.visible = false; groups.drawn.visible = false; groups.field.visible = false;
+    // In solid mode the sketch, the frames and the cut plane stay visible over the cut
+    // mesh; elsewhere the GLB is shown alone.
+    groups.crest.visible = false;
+    groups.drawn.visible = mode === 'solid';
+    groups.field.visible = mode === 'solid';
     if (fit) {
       const b = new THREE.Box3().setFromObject(glbRoot);
       fitCamera(b.min.toArray(), b.max.toArray());
