@@ -24,8 +24,8 @@ pub mod extremality;
 pub mod feature_quality;
 pub mod given_curves;
 pub mod mesh_scale;
+mod segment_grid;
 pub mod sharp_edges;
-mod spatial_grid;
 #[cfg(test)]
 mod test_shapes;
 

@@ -83,6 +83,8 @@ pub use singularity_index::DetectedSingularity;
 pub use sketch::Sketch;
 
 // Paper A §4: curve-constrained harmonic diffusion, greedy curve orientation, metrics.
+mod curve_constraint_sampling;
+mod curve_field_types;
 pub mod greedy_curve_orientation;
 pub mod harmonic_diffusion;
 pub mod nested_dissection;

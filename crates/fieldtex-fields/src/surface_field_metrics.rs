@@ -38,6 +38,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::FieldsError;
+use crate::singularity_index::{turns as index_turns, wrap_angle};
 
 /// A face whose field index is not zero.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -77,13 +78,6 @@ pub struct SurfaceFieldMetrics {
 /// Signed angle from `a` to `b` about `n`.
 fn signed_angle(a: V3, b: V3, n: V3) -> f64 {
     vec3::dot(n, vec3::cross(a, b)).atan2(vec3::dot(a, b))
-}
-
-/// `a` wrapped to `(−π, π]`.
-fn wrap(a: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let r = a - TAU * (a / TAU).round();
-    if r <= -PI { r + TAU } else { r }
 }
 
 /// Per-vertex unit tangent vectors (projected onto the normals), `None` where undefined.
@@ -219,7 +213,7 @@ fn field_turns(
             // θ_ab and θ_ba: `b` follows `a` in the face, or precedes it.
             let (tab, tba) = if t[(ca + 1) % 3] == b { (na, nb + sb) } else { (na + sa, nb) };
             let rho = tba - tab + std::f64::consts::PI;
-            Some(wrap(phi[b as usize]? - phi[a as usize]? - rho))
+            Some(wrap_angle(phi[b as usize]? - phi[a as usize]? - rho))
         })
         .collect();
     let curvature: Vec<Option<f64>> = corner
@@ -246,7 +240,7 @@ pub fn field_singularities(
                 let e = topology.face_edges[f][c] as usize;
                 sum += f64::from(topology.face_edge_signs[f][c]) * turns[e]?;
             }
-            Some((sum / std::f64::consts::TAU).round() as i32)
+            Some(index_turns(sum))
         })
         .collect();
     let mut singularities = Vec::new();

@@ -7,7 +7,8 @@
 //! - [`SurfaceDomain`] (`surface_domain.rs`): colour *carriers* (triangle + barycentric
 //!   coordinates: atlas texels or vertices) with positions, normals and tangent frames
 //!   from a per-vertex direction field. Reusable by the transfer pipeline (paper B).
-//! - [`UniformGrid`]: deterministic radius-neighbour queries over 3-D points.
+//! - Radius-neighbour queries go through `fieldtex_mesh::SpatialGrid` (re-exported here
+//!   as [`UniformGrid`] for the callers that still name it).
 //! - [`sample_set`]: the sample set `X†` by dart throwing over the carriers at spacing
 //!   `r·w·h`, salient-curve carriers first (paper A §5.1).
 //! - [`optimise`]: the coarse-to-fine search/blend loop
@@ -71,11 +72,11 @@ pub mod robust_blend;
 mod sample_set;
 mod surface_domain;
 pub mod texture_optimisation;
-mod uniform_grid;
 
 pub use error::TexOptError;
+/// The workspace's one spatial grid, under its former texopt name.
+pub use fieldtex_mesh::SpatialGrid as UniformGrid;
 pub use options::{FeatureAlignment, TexOptOptions, pyramid_patch_sizes};
 pub use sample_set::sample_set;
 pub use surface_domain::{Carrier, SurfaceDomain, vertex_carriers};
 pub use texture_optimisation::{LevelStats, TexOptResult, optimise};
-pub use uniform_grid::UniformGrid;

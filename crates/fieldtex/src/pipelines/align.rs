@@ -28,11 +28,9 @@ use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, Warning};
 use fieldtex_features::{ExemplarFeatureOptions, ExemplarFeatures};
 use fieldtex_fields::{CurveOrientationOptions, OrientationMode, orient_curves};
-use fieldtex_mesh::TriMesh;
+use fieldtex_mesh::{SpatialGrid, TriMesh};
 use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
-use fieldtex_texopt::{
-    Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, UniformGrid,
-};
+use fieldtex_texopt::{Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -270,7 +268,7 @@ fn curve_distance_band(
     if pts.is_empty() {
         return vec![f64::INFINITY; positions.len()];
     }
-    let grid = UniformGrid::new(&pts, band);
+    let grid = SpatialGrid::new(&pts, band);
     positions
         .par_iter()
         .map(|&p| {
