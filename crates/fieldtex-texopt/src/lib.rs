@@ -9,6 +9,8 @@
 //!   from a per-vertex direction field. Reusable by the transfer pipeline (paper B).
 //! - Radius-neighbour queries go through `fieldtex_mesh::SpatialGrid` (re-exported here
 //!   as [`UniformGrid`] for the callers that still name it).
+//! - [`SurfaceSamples`] (`surface_samples.rs`): the carriers with a nested
+//!   multi-resolution sample hierarchy and public tangent-plane neighbourhoods.
 //! - [`sample_set`]: the sample set `X†` by dart throwing over the carriers at spacing
 //!   `r·w·h`, salient-curve carriers first (paper A §5.1).
 //! - [`optimise`]: the coarse-to-fine search/blend loop
@@ -71,6 +73,7 @@ pub mod patch_search;
 pub mod robust_blend;
 mod sample_set;
 mod surface_domain;
+mod surface_samples;
 pub mod texture_optimisation;
 
 pub use error::TexOptError;
@@ -79,4 +82,5 @@ pub use fieldtex_mesh::SpatialGrid as UniformGrid;
 pub use options::{FeatureAlignment, TexOptOptions, pyramid_patch_sizes};
 pub use sample_set::sample_set;
 pub use surface_domain::{Carrier, SurfaceDomain, vertex_carriers};
+pub use surface_samples::{Neighbour, SurfaceSamples};
 pub use texture_optimisation::{LevelStats, TexOptResult, optimise};
