@@ -101,4 +101,5 @@ pub use harmonic_diffusion::{
 pub use smoothest_field::{SmoothestField, smoothest_field};
 pub use surface_field_metrics::{
     AlignmentError, FieldSingularity, SurfaceFieldMetrics, surface_field_metrics,
+    surface_field_metrics_with,
 };

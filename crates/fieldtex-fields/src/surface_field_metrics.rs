@@ -31,9 +31,7 @@
 //! than `1e-12` count as undefined.
 
 use fieldtex_core::vec3::{self, V3};
-use fieldtex_mesh::{
-    CotanOptions, NormalWeighting, Topology, TriMesh, cotan_edge_weights, vertex_normals,
-};
+use fieldtex_mesh::{MeshGeometry, NormalWeighting, Topology, TriMesh};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -318,6 +316,17 @@ pub fn surface_field_metrics(
     field: &[V3],
     constraints: &[(u32, V3)],
 ) -> Result<SurfaceFieldMetrics, FieldsError> {
+    surface_field_metrics_with(&MeshGeometry::new(mesh), field, constraints)
+}
+
+/// [`surface_field_metrics`] with the topology, angle-weighted normals and cotan edge
+/// weights of a per-mesh [`MeshGeometry`] (computed there at most once per pipeline).
+pub fn surface_field_metrics_with(
+    geometry: &MeshGeometry<'_>,
+    field: &[V3],
+    constraints: &[(u32, V3)],
+) -> Result<SurfaceFieldMetrics, FieldsError> {
+    let mesh = geometry.mesh();
     mesh.validate()?;
     if field.len() != mesh.n_vertices() {
         return Err(FieldsError::InvalidOption {
@@ -326,12 +335,12 @@ pub fn surface_field_metrics(
             expected: "one vector per mesh vertex",
         });
     }
-    let topology = Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let (normals, _) = vertex_normals(mesh, NormalWeighting::Angle);
-    let (weights, _) = cotan_edge_weights(mesh, &topology, &CotanOptions::default())?;
-    let (singularities, undetermined_faces) = field_singularities(mesh, &topology, &normals, field);
+    let topology = geometry.require_topology();
+    let (normals, _) = geometry.require_vertex_normals(NormalWeighting::Angle);
+    let (weights, _) = geometry.require_cotan_edge_weights()?;
+    let (singularities, undetermined_faces) = field_singularities(mesh, topology, normals, field);
     let (dirichlet_energy, dirichlet_energy_ambient) =
-        field_dirichlet_energy(mesh, &topology, &normals, field, &weights);
+        field_dirichlet_energy(mesh, topology, normals, field, weights);
     Ok(SurfaceFieldMetrics {
         index_sum: singularities.iter().map(|s| s.index).sum(),
         euler_characteristic: topology.euler_characteristic(),
@@ -339,6 +348,6 @@ pub fn surface_field_metrics(
         undetermined_faces,
         dirichlet_energy,
         dirichlet_energy_ambient,
-        alignment: constraint_alignment_error(&normals, field, constraints),
+        alignment: constraint_alignment_error(normals, field, constraints),
     })
 }
