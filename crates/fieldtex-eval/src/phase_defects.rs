@@ -37,6 +37,7 @@ use crate::filters::{gaussian_blur, gaussian_kernel, gradient, mirror, mirrored_
 use crate::image_view::ImageView;
 use crate::orientation::{OrientationOptions, luminance_orientation};
 use crate::singularities::loop_winding;
+use fieldtex_fields::singularity_index::turns;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -404,7 +405,7 @@ pub fn phase_defects(
                     // arg(z_{j+1} · conj(z_j)) ∈ (−π, π].
                     total_phase += (f * a - e * c).atan2(e * a + f * c);
                 }
-                let winding = (total_phase / (2.0 * PI)).round() as i32;
+                let winding = turns(total_phase);
                 if winding != 0 {
                     found.push((x as f64 + 1.0, y as f64 + 1.0, winding));
                 }

@@ -20,8 +20,8 @@
 //! dipoles cancel.
 
 use crate::orientation::OrientationMap;
+use fieldtex_fields::singularity_index::loop_turns;
 use serde::Serialize;
-use std::f64::consts::PI;
 
 /// Options of [`singularities`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -80,28 +80,14 @@ pub struct SingularityReport {
     pub cancelled_clusters: usize,
 }
 
-/// Wraps an angle to `(−π, π]`.
-#[inline]
-fn wrap(a: f64) -> f64 {
-    let mut r = a.rem_euclid(2.0 * PI);
-    if r > PI {
-        r -= 2.0 * PI;
-    }
-    r
-}
-
 /// Turns of the doubled angle around the loop through the centres of pixels
-/// `(x, y)`, `(x+1, y)`, `(x+1, y+1)`, `(x, y+1)` (index = turns / 2).
+/// `(x, y)`, `(x+1, y)`, `(x+1, y+1)`, `(x, y+1)` (index = turns / 2), counted by the
+/// workspace's one index routine, `fieldtex_fields::singularity_index::loop_turns`.
 pub(crate) fn loop_winding(map: &OrientationMap, x: usize, y: usize) -> f64 {
     let w = map.width;
     let idx = [y * w + x, y * w + x + 1, (y + 1) * w + x + 1, (y + 1) * w + x];
-    let mut total = 0.0;
-    for k in 0..4 {
-        let a = 2.0 * map.angle[idx[k]] as f64;
-        let b = 2.0 * map.angle[idx[(k + 1) % 4]] as f64;
-        total += wrap(b - a);
-    }
-    (total / (2.0 * PI)).round()
+    let doubled = idx.map(|i| 2.0 * map.angle[i] as f64);
+    f64::from(loop_turns(&doubled))
 }
 
 /// Finds the singularities of `map`; see the module docs.

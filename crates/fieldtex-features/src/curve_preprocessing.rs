@@ -32,8 +32,8 @@
 use crate::FeaturesError;
 use crate::crest_lines::{CrestLine, LineKind, LineSource, polyline_length};
 use crate::error::check_option;
-use crate::spatial_grid::BoxGrid;
 use fieldtex_core::vec3::{self, V3};
+use fieldtex_mesh::SpatialGrid;
 use fieldtex_mesh::UnionFind;
 use serde::Serialize;
 
@@ -209,7 +209,7 @@ fn join_lines(
         .enumerate()
         .map(|(id, &(p, _))| if open(id / 2) { (p, p) } else { ([f64::NAN; 3], [f64::NAN; 3]) })
         .collect();
-    let grid = BoxGrid::new(&boxes, radius.max(unit));
+    let grid = SpatialGrid::from_boxes(&boxes, radius.max(unit));
     let mut candidates: Vec<(f64, u32, u32)> = Vec::new();
     for i in 0..2 * n {
         let (p, Some(di)) = ends[i] else { continue };
@@ -217,7 +217,7 @@ fn join_lines(
             continue;
         }
         let r = [radius; 3];
-        grid.for_each_candidate(vec3::sub(p, r), vec3::add(p, r), |j| {
+        grid.for_each_in_box(vec3::sub(p, r), vec3::add(p, r), |j| {
             let j = j as usize;
             if j <= i || lines[j / 2].kind != lines[i / 2].kind {
                 return;

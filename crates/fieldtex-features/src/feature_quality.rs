@@ -12,8 +12,8 @@
 
 use crate::FeaturesError;
 use crate::mesh_scale::mean_edge_length_of;
+use crate::segment_grid::{SegmentGrid, split_segment};
 use crate::sharp_edges::sharp_edges;
-use crate::spatial_grid::{SegmentGrid, split_segment};
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_mesh::{Topology, TriMesh};
 use rayon::prelude::*;

@@ -17,6 +17,7 @@
 mod crest_crossings;
 pub mod crest_lines;
 pub mod curve_preprocessing;
+pub mod curve_proximity;
 pub mod distance_transform;
 pub mod error;
 pub mod exemplar_feature_lines;
@@ -24,8 +25,8 @@ pub mod extremality;
 pub mod feature_quality;
 pub mod given_curves;
 pub mod mesh_scale;
+mod segment_grid;
 pub mod sharp_edges;
-mod spatial_grid;
 #[cfg(test)]
 mod test_shapes;
 
@@ -34,6 +35,7 @@ pub use crest_lines::{
     crest_lines_with_progress,
 };
 pub use curve_preprocessing::{CurvePreprocessOptions, preprocess_lines, preprocess_polylines};
+pub use curve_proximity::{curve_surface_points, distance_to_curves};
 pub use distance_transform::{euclidean_distance_transform, squared_distance_transform};
 pub use error::FeaturesError;
 pub use exemplar_feature_lines::{

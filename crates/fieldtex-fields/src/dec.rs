@@ -17,8 +17,9 @@
 //!   length; one cotangent on a boundary edge), `⋆2` = `1 / area`.
 //!
 //! Robustness (documented substitutes, counted in [`Dec::clamped_star1`]):
-//! - cotangents are clamped to `[−COT_LIMIT, COT_LIMIT]` (`1e3`), so slivers cannot blow
-//!   up the operator; an edge's `⋆1` is then clamped to be `≥ 0`, since a negative
+//! - `⋆1` comes from `fieldtex_mesh::hodge_star1` (the cotangent weights' one home) with
+//!   its explicit Hodge-star clamp: cotangents are clamped to `[−COT_LIMIT, COT_LIMIT]`
+//!   (`1e3`), so slivers cannot blow up the operator; an edge's `⋆1` is then clamped to be `≥ 0`, since a negative
 //!   dual length (non-Delaunay edge, obtuse boundary angle) would make the divergence
 //!   energy indefinite. Right isosceles grids give exactly `⋆1 = 0` on their diagonals
 //!   (zero dual length), which is correct and not counted as a clamp.
@@ -35,7 +36,7 @@
 use fieldtex_core::vec3::{add, cross, dot, norm, normalize, scale, sub};
 use fieldtex_core::{Warning, Warnings};
 use fieldtex_linalg::SparseMatrix;
-use fieldtex_mesh::{Topology, TriMesh};
+use fieldtex_mesh::{HodgeStarClamp, Topology, TriMesh, hodge_star1};
 use rayon::prelude::*;
 
 use crate::FieldsError;
@@ -158,31 +159,8 @@ impl Dec {
             }
         }
         let ne = topology.n_edges();
-        let mut star1 = vec![0.0; ne];
-        let mut hit_limit = vec![false; ne];
-        for f in 0..nf {
-            let p = mesh.triangle_positions(f);
-            let twice_area = 2.0 * face_areas[f];
-            for k in 0..3 {
-                // Angle at corner k is opposite the edge between corners k+1 and k+2.
-                let a = sub(p[(k + 1) % 3], p[k]);
-                let b = sub(p[(k + 2) % 3], p[k]);
-                let raw_cot = dot(a, b) / twice_area;
-                let cot = raw_cot.clamp(-COT_LIMIT, COT_LIMIT);
-                let e = topology.face_edges[f][(k + 1) % 3] as usize;
-                if cot != raw_cot {
-                    hit_limit[e] = true;
-                }
-                star1[e] += 0.5 * cot;
-            }
-        }
-        let mut clamped_star1 = 0usize;
-        for e in 0..ne {
-            if star1[e] < 0.0 || hit_limit[e] {
-                clamped_star1 += 1;
-                star1[e] = star1[e].max(0.0);
-            }
-        }
+        let clamp = HodgeStarClamp { cot_limit: COT_LIMIT };
+        let (star1, clamped_star1) = hodge_star1(mesh, &topology, &face_areas, Some(&clamp));
         if clamped_star1 > 0 {
             warnings.push(Warning::new(
                 "field-star1-clamped",

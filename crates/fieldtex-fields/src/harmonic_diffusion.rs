@@ -37,6 +37,9 @@
 //! The three components are solved together, one pass over the factor for all three
 //! right-hand sides (`fieldtex_linalg::Cholesky::solve_many`).
 //!
+//! Files: options, constraints and reports in `curve_field_types.rs`; constraint
+//! sampling from curves in `curve_constraint_sampling.rs`; the solver here.
+//!
 //! Not implemented: removing curves (multiple-rank downdates exist in `fieldtex_linalg`,
 //! `Cholesky::remove_diagonal_penalties`, but no caller needs them yet).
 
@@ -47,190 +50,18 @@ use fieldtex_core::Warning;
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_linalg::{Cholesky, FactorLayout, SparseMatrix, SymbolicCholesky};
 use fieldtex_mesh::{
-    CotanOptions, CurvatureOptions, MeshError, NormalWeighting, TriMesh, UnionFind,
+    CotanOptions, CurvatureOptions, MeshError, NormalWeighting, SpatialGrid, TriMesh, UnionFind,
     cotan_laplacian_with, principal_curvatures, vertex_normals,
 };
-use serde::Serialize;
 
 use crate::FieldsError;
+pub use crate::curve_field_types::{
+    AddReport, CurveConstraints, CurveField, CurveFieldOptions, FillOrdering, OverlapPolicy,
+    SolveReport, UnconstrainedFallback, VertexFieldStatus,
+};
 
 /// Sentinel for "no component" (a vertex used by no usable triangle).
 const NONE: u32 = u32::MAX;
-
-/// What to do at a vertex that a second curve also constrains (module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-pub enum OverlapPolicy {
-    /// Keep the tangent of the curve added first. Default.
-    #[default]
-    KeepFirst,
-    /// Target = normalised sum of every oriented tangent at the vertex (`b` only).
-    Average,
-}
-
-/// Field of a connected component that no curve touches.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub enum UnconstrainedFallback {
-    /// The smoothest line field, aligned to principal curvature only where it is
-    /// clearly anisotropic (Knöppel et al. 2013; [`crate::smoothest_field`]). Default.
-    #[default]
-    Smoothest,
-    /// Direction of maximal principal curvature at every vertex (Rusinkiewicz 2004
-    /// estimate; a line field, its sign is arbitrary; swirls on flat parts).
-    PrincipalDirection,
-    /// A global direction projected onto each tangent plane (where it is along the
-    /// normal, any tangent).
-    Direction([f64; 3]),
-    /// Zero vectors.
-    Zero,
-}
-
-/// Options of [`CurveFieldSolver`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CurveFieldOptions {
-    /// Penalty weight `α` of eq. (2). Default `1e8` (paper A). Must be finite and `> 0`.
-    pub penalty: f64,
-    /// Curve resampling step, in mean edge lengths. Default `0.5`. Must lie in
-    /// `(0.001, 1000]`.
-    pub sample_spacing: f64,
-    /// Largest distance from a curve sample to its vertex, in mean edge lengths; farther
-    /// samples are dropped as off the mesh. Default `2.0`. Must lie in `(0, 1000]`.
-    pub max_distance: f64,
-    /// Vertices constrained by several curves. Default [`OverlapPolicy::KeepFirst`].
-    pub overlap: OverlapPolicy,
-    /// Components without constraints. Default [`UnconstrainedFallback::PrincipalDirection`].
-    pub fallback: UnconstrainedFallback,
-    /// New penalties on an already factored component beyond which
-    /// [`CurveFieldSolver::add_constraints_many`] refactors numerically instead of
-    /// applying them as one multiple-rank update. Default 200: one rank-1 update cost ~1/220 of a
-    /// refactorisation from fandisk to the refined horse (`examples/bench_orientation.rs`,
-    /// `refactor_over_rank1`). A greedy step (one curve, tens of vertices) stays below.
-    pub refactor_above: usize,
-    /// Fill-reducing ordering of each component's factor. Default
-    /// [`FillOrdering::NestedDissection`].
-    pub ordering: FillOrdering,
-}
-
-/// Ordering of the unknowns before factorisation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-pub enum FillOrdering {
-    /// Approximate minimum degree (faer).
-    Amd,
-    /// Geometric nested dissection ([`crate::nested_dissection`]): a balanced
-    /// elimination tree with short leaf-to-root paths, which the greedy orientation's
-    /// rank-1 updates and partial solves walk. Default.
-    #[default]
-    NestedDissection,
-}
-
-impl Default for CurveFieldOptions {
-    fn default() -> Self {
-        Self {
-            penalty: 1e8,
-            sample_spacing: 0.5,
-            max_distance: 2.0,
-            overlap: OverlapPolicy::KeepFirst,
-            fallback: UnconstrainedFallback::Smoothest,
-            refactor_above: 200,
-            ordering: FillOrdering::default(),
-        }
-    }
-}
-
-impl CurveFieldOptions {
-    fn validate(&self) -> Result<(), FieldsError> {
-        let check = |name, value: f64, lo: f64, hi: f64, expected| {
-            if value.is_finite() && value > lo && value <= hi {
-                Ok(())
-            } else {
-                Err(FieldsError::InvalidOption { name, value, expected })
-            }
-        };
-        check("penalty", self.penalty, 0.0, f64::MAX, "a finite number > 0 (paper: 1e8)")?;
-        let spacing = "a number of mean edge lengths in (0.001, 1000]";
-        check("sample_spacing", self.sample_spacing, 1e-3, 1e3, spacing)?;
-        check(
-            "max_distance",
-            self.max_distance,
-            0.0,
-            1e3,
-            "a number of mean edge lengths in (0, 1000]",
-        )?;
-        if let UnconstrainedFallback::Direction(d) = self.fallback {
-            let n = vec3::norm(d);
-            if !(n.is_finite() && n > 0.0) {
-                return Err(FieldsError::InvalidOption {
-                    name: "fallback direction length",
-                    value: n,
-                    expected: "a finite, non-zero direction X,Y,Z",
-                });
-            }
-        }
-        Ok(())
-    }
-}
-
-/// The constraints one polyline puts on the mesh, for its forward orientation.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct CurveConstraints {
-    /// Constrained vertices, in the order the curve first reaches them.
-    pub vertices: Vec<u32>,
-    /// Unit tangent per vertex, in its tangent plane, along the polyline's direction.
-    pub tangents: Vec<V3>,
-    /// Arc length of the parts of the polyline that lie on the mesh.
-    pub length: f64,
-    /// Curve samples farther than `max_distance` from the mesh, or non-finite points.
-    pub dropped_samples: usize,
-}
-
-/// How a vertex of a solved field was obtained.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum VertexFieldStatus {
-    /// Diffused from the constraints of its component.
-    Solved,
-    /// The diffused vector is (nearly) normal to the surface or zero: vector set to 0.
-    Degenerate,
-    /// Its component has no constraint (or could not be factored): the fallback.
-    Fallback,
-    /// Used by no usable triangle: vector 0.
-    Isolated,
-}
-
-/// A per-vertex tangent field: `#V × 3` unit vectors (0 where not defined).
-#[derive(Debug, Clone, PartialEq)]
-pub struct CurveField {
-    pub vectors: Vec<V3>,
-    pub status: Vec<VertexFieldStatus>,
-    pub warnings: Vec<Warning>,
-}
-
-/// Cost of one [`CurveFieldSolver::add_constraints`].
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub struct AddReport {
-    /// Vertices that received a penalty now.
-    pub new_vertices: usize,
-    /// Vertices already constrained by an earlier curve (see [`OverlapPolicy`]).
-    pub overlapping_vertices: usize,
-    /// Penalties added by updates of an existing factor (rank-1 terms of the
-    /// multiple-rank updates) and their total time.
-    pub rank1_updates: usize,
-    pub update_seconds: f64,
-    /// First factorisations of components (symbolic + numeric) and their time.
-    pub factorisations: usize,
-    pub factor_seconds: f64,
-}
-
-/// Cost and accuracy of one [`CurveFieldSolver::solve`].
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub struct SolveReport {
-    /// Components re-solved (only those whose constraints changed).
-    pub components_solved: usize,
-    pub seconds: f64,
-    /// Largest relative residual `‖(L+P)x − Pb‖ / ‖Pb‖` over the right-hand sides of the
-    /// full solves.
-    pub max_residual: f64,
-    /// Components updated incrementally ([`CurveFieldSolver::solve_at`]; no residual).
-    pub incremental: usize,
-}
 
 struct Block {
     /// Global vertex indices, increasing (local index = position).
@@ -251,109 +82,15 @@ struct Block {
     partial: bool,
 }
 
-/// Uniform grid over vertex positions for nearest-vertex queries.
-struct VertexGrid {
-    origin: V3,
-    /// Upper corner of the bounding box of the gridded vertices.
-    upper: V3,
-    cell: f64,
-    dims: [usize; 3],
-    offsets: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl VertexGrid {
-    fn new(positions: &[V3], usable: &[bool], cell: f64) -> Self {
-        let pts = || positions.iter().enumerate().filter(|(v, _)| usable[*v]);
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for (_, p) in pts() {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-        let n = pts().count().max(1);
-        let mut cell = cell;
-        let dims = loop {
-            let d = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).max(1));
-            if d[0].saturating_mul(d[1]).saturating_mul(d[2]) <= 8 * n + 64 {
-                break d;
-            }
-            cell *= 1.5;
-        };
-        let mut g =
-            Self { origin: lo, upper: hi, cell, dims, offsets: Vec::new(), items: Vec::new() };
-        let pairs: Vec<(u32, u32)> =
-            pts().map(|(v, p)| (g.cell_index(g.coords(*p)) as u32, v as u32)).collect();
-        let csr = fieldtex_mesh::Csr::from_pairs(dims[0] * dims[1] * dims[2], pairs.into_iter());
-        g.offsets = csr.offsets;
-        g.items = csr.items;
-        g
-    }
-
-    fn coords(&self, p: V3) -> [usize; 3] {
-        [0, 1, 2].map(|k| {
-            let c = ((p[k] - self.origin[k]) / self.cell).floor();
-            c.clamp(0.0, (self.dims[k] - 1) as f64) as usize
-        })
-    }
-
-    fn cell_index(&self, c: [usize; 3]) -> usize {
-        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
-    }
-
-    /// Parameter range `[t0, t1] ⊂ [0, 1]` of the segment `a → b` inside the bounding
-    /// box grown by `radius` (slab method), or `None` when it misses the box.
-    fn clip(&self, a: V3, b: V3, radius: f64) -> Option<(f64, f64)> {
-        let (mut t0, mut t1) = (0.0f64, 1.0f64);
-        for k in 0..3 {
-            let (lo, hi) = (self.origin[k] - radius, self.upper[k] + radius);
-            let d = b[k] - a[k];
-            if d == 0.0 {
-                if a[k] < lo || a[k] > hi {
-                    return None;
-                }
-                continue;
-            }
-            let (u, v) = ((lo - a[k]) / d, (hi - a[k]) / d);
-            t0 = t0.max(u.min(v));
-            t1 = t1.min(u.max(v));
-        }
-        (t0 <= t1).then_some((t0, t1))
-    }
-
-    /// Nearest vertex within `radius` of `p` (ties: lower index).
-    fn nearest(&self, positions: &[V3], p: V3, radius: f64) -> Option<u32> {
-        let lo = self.coords(vec3::sub(p, [radius; 3]));
-        let hi = self.coords(vec3::add(p, [radius; 3]));
-        let mut best: Option<(f64, u32)> = None;
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    let c = self.cell_index([x, y, z]);
-                    for &v in &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
-                        let d = vec3::norm2(vec3::sub(positions[v as usize], p));
-                        if d <= radius * radius && best.is_none_or(|(bd, bv)| (d, v) < (bd, bv)) {
-                            best = Some((d, v));
-                        }
-                    }
-                }
-            }
-        }
-        best.map(|(_, v)| v)
-    }
-}
-
 /// The diffusion system of one mesh with its kept factorisations (module docs).
 ///
 /// Typical use: [`CurveFieldSolver::new`], then per curve
 /// [`CurveFieldSolver::sample_curve`] and [`CurveFieldSolver::add_constraints`] with a
 /// sign, [`CurveFieldSolver::solve`], and finally [`CurveFieldSolver::field`].
 pub struct CurveFieldSolver<'m> {
-    mesh: &'m TriMesh,
-    options: CurveFieldOptions,
-    normals: Vec<V3>,
+    pub(crate) mesh: &'m TriMesh,
+    pub(crate) options: CurveFieldOptions,
+    pub(crate) normals: Vec<V3>,
     component: Vec<u32>,
     local: Vec<u32>,
     blocks: Vec<Block>,
@@ -365,8 +102,9 @@ pub struct CurveFieldSolver<'m> {
     /// Whether `raw[v]` is current (false outside the `needed` set of an incremental
     /// solve, [`CurveFieldSolver::solve_at`]).
     current: Vec<bool>,
-    mean_edge: f64,
-    grid: VertexGrid,
+    pub(crate) mean_edge: f64,
+    /// The usable vertices, for nearest-vertex queries.
+    pub(crate) grid: SpatialGrid,
     warnings: Vec<Warning>,
 }
 
@@ -447,7 +185,10 @@ impl<'m> CurveFieldSolver<'m> {
             })
             .collect::<Result<Vec<_>, FieldsError>>()?;
         let (normals, _) = vertex_normals(mesh, NormalWeighting::Angle);
-        let grid = VertexGrid::new(p, &used, mean_edge);
+        let boxes: Vec<(V3, V3)> = (0..nv)
+            .map(|v| if used[v] { (p[v], p[v]) } else { ([f64::NAN; 3], [f64::NAN; 3]) })
+            .collect();
+        let grid = SpatialGrid::from_boxes(&boxes, mean_edge);
         Ok(Self {
             mesh,
             options: options.clone(),
@@ -501,69 +242,6 @@ impl<'m> CurveFieldSolver<'m> {
     /// Whether vertex `v` carries a penalty.
     pub fn is_constrained(&self, v: usize) -> bool {
         self.targets[v].is_some()
-    }
-
-    /// Constraints of `polyline` (module docs) for its forward orientation. Never fails:
-    /// non-finite points and samples off the mesh are counted in `dropped_samples`.
-    pub fn sample_curve(&self, polyline: &[V3]) -> CurveConstraints {
-        let h = self.mean_edge;
-        let step = self.options.sample_spacing * h;
-        let radius = self.options.max_distance * h;
-        let mut out = CurveConstraints::default();
-        let mut slot: HashMap<u32, usize> = HashMap::new();
-        let mut sums: Vec<(V3, f64)> = Vec::new();
-        let mut prev: Option<V3> = None;
-        for &q in polyline {
-            if !vec3::is_finite(q) {
-                out.dropped_samples += 1;
-                prev = None;
-                continue;
-            }
-            if let Some(a) = prev {
-                let d = vec3::sub(q, a);
-                let len = vec3::norm(d);
-                // Only the part near the mesh is sampled (bounds the work for far or
-                // huge segments); an overflowing length counts as off the mesh.
-                let span = if len.is_finite() { self.grid.clip(a, q, radius) } else { None };
-                if len > 0.0 && span.is_none() {
-                    out.dropped_samples += 1;
-                }
-                if let (true, Some((t0, t1))) = (len > 0.0, span) {
-                    let dir = vec3::scale(d, 1.0 / len);
-                    let k = (len * (t1 - t0) / step).ceil().max(1.0) as usize;
-                    let w = len * (t1 - t0) / k as f64;
-                    for s in 0..k {
-                        let t = t0 + (t1 - t0) * (s as f64 + 0.5) / k as f64;
-                        let x = vec3::lerp(a, q, t);
-                        let Some(v) = self.grid.nearest(&self.mesh.positions, x, radius) else {
-                            out.dropped_samples += 1;
-                            continue;
-                        };
-                        out.length += w;
-                        let i = *slot.entry(v).or_insert_with(|| {
-                            out.vertices.push(v);
-                            sums.push(([0.0; 3], 0.0));
-                            sums.len() - 1
-                        });
-                        sums[i].0 = vec3::add(sums[i].0, vec3::scale(dir, w));
-                        sums[i].1 += w;
-                    }
-                }
-            }
-            prev = Some(q);
-        }
-        let mut keep = Vec::with_capacity(out.vertices.len());
-        for (&v, &(s, w)) in out.vertices.iter().zip(&sums) {
-            let n = self.normals[v as usize];
-            let t = vec3::sub(s, vec3::scale(n, vec3::dot(s, n)));
-            let tn = vec3::norm(t);
-            if tn > 1e-3 * w {
-                keep.push(v);
-                out.tangents.push(vec3::scale(t, 1.0 / tn));
-            }
-        }
-        out.vertices = keep;
-        out
     }
 
     /// Adds the constraints of one curve with orientation `sign` (`+1` forward, `−1`

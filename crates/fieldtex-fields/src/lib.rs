@@ -83,6 +83,8 @@ pub use singularity_index::DetectedSingularity;
 pub use sketch::Sketch;
 
 // Paper A §4: curve-constrained harmonic diffusion, greedy curve orientation, metrics.
+mod curve_constraint_sampling;
+mod curve_field_types;
 pub mod greedy_curve_orientation;
 pub mod harmonic_diffusion;
 pub mod nested_dissection;
@@ -100,4 +102,5 @@ pub use harmonic_diffusion::{
 pub use smoothest_field::{SmoothestField, smoothest_field};
 pub use surface_field_metrics::{
     AlignmentError, FieldSingularity, SurfaceFieldMetrics, surface_field_metrics,
+    surface_field_metrics_with,
 };

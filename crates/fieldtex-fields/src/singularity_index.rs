@@ -19,6 +19,10 @@
 //! `(x+½, y+½)`; the block's centre is the grid point `(x+1, y+1)`), traversed from `+x`
 //! towards `+y`.
 //!
+//! The primitives ([`wrap_angle`], [`turns`], [`loop_turns`]) are the workspace's one
+//! index computation: the per-vertex surface field metrics (`surface_field_metrics.rs`)
+//! and `fieldtex-eval`'s image singularities and phase defects count turns with them.
+//!
 //! Detections closer than a radius are merged ([`cluster_singularities`]): indices are
 //! summed and zero-sum clusters dropped, so a sub-cell dipole does not count, while
 //! separated singularities stay separate.
@@ -37,8 +41,9 @@ pub struct DetectedSingularity {
     pub element: usize,
 }
 
+/// `a` wrapped to `(−π, π]` (the one angle wrap of the index computations).
 #[inline]
-fn wrap(a: f64) -> f64 {
+pub fn wrap_angle(a: f64) -> f64 {
     use std::f64::consts::{PI, TAU};
     let mut a = a % TAU;
     if a > PI {
@@ -47,6 +52,24 @@ fn wrap(a: f64) -> f64 {
         a += TAU;
     }
     a
+}
+
+/// Whole turns in a sum of wrapped angle changes around a closed loop (plus, on a
+/// surface, `N` times the enclosed curvature): `round(total / 2π)`. With the changes
+/// taken on `N`-fold angles this is `N · index`.
+#[inline]
+pub fn turns(total: f64) -> i32 {
+    (total / std::f64::consts::TAU).round() as i32
+}
+
+/// Turns of the angles `angles` (already multiplied by `N`) around a closed loop,
+/// visited in order and back to the first: `turns(Σ wrap(aₖ₊₁ − aₖ))` — the index of
+/// an N-RoSy field around a loop of samples in a flat domain is this over `N`.
+#[inline]
+pub fn loop_turns(angles: &[f64]) -> i32 {
+    let n = angles.len();
+    let total: f64 = (0..n).map(|k| wrap_angle(angles[(k + 1) % n] - angles[k])).sum();
+    turns(total)
 }
 
 /// Triangles around interior vertex `v` in counter-clockwise order, or `None` for
@@ -117,10 +140,10 @@ pub fn vertex_indices(dec: &Dec, face_vectors: &[[f64; 3]], n: u32) -> Vec<Optio
                 let phi_g = dot(ug, g2).atan2(dot(ug, g1));
                 let psi_f = dot(d, f2).atan2(dot(d, f1));
                 let psi_g = dot(d, g2).atan2(dot(d, g1));
-                total += wrap(nf * ((phi_g - psi_g) - (phi_f - psi_f)));
+                total += wrap_angle(nf * ((phi_g - psi_g) - (phi_f - psi_f)));
             }
             let defect = TAU - angle_sum;
-            Some(((total + nf * defect) / TAU).round() as i32)
+            Some(turns(total + nf * defect))
         })
         .collect()
 }
@@ -153,7 +176,6 @@ pub fn pixel_singularities(
     height: usize,
     n: u32,
 ) -> Vec<DetectedSingularity> {
-    use std::f64::consts::TAU;
     if width < 2 || height < 2 || field.len() < width * height {
         return Vec::new();
     }
@@ -168,8 +190,7 @@ pub fn pixel_singularities(
             let mut out = Vec::new();
             for x in 0..width - 1 {
                 let a = [angle(x, y), angle(x + 1, y), angle(x + 1, y + 1), angle(x, y + 1)];
-                let total: f64 = (0..4).map(|k| wrap(a[(k + 1) % 4] - a[k])).sum();
-                let k = (total / TAU).round() as i32;
+                let k = loop_turns(&a);
                 if k != 0 {
                     out.push(DetectedSingularity {
                         position: [x as f64 + 1.0, y as f64 + 1.0, 0.0],

@@ -31,13 +31,12 @@
 //! than `1e-12` count as undefined.
 
 use fieldtex_core::vec3::{self, V3};
-use fieldtex_mesh::{
-    CotanOptions, NormalWeighting, Topology, TriMesh, cotan_edge_weights, vertex_normals,
-};
+use fieldtex_mesh::{MeshGeometry, NormalWeighting, Topology, TriMesh};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::FieldsError;
+use crate::singularity_index::{turns as index_turns, wrap_angle};
 
 /// A face whose field index is not zero.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -77,13 +76,6 @@ pub struct SurfaceFieldMetrics {
 /// Signed angle from `a` to `b` about `n`.
 fn signed_angle(a: V3, b: V3, n: V3) -> f64 {
     vec3::dot(n, vec3::cross(a, b)).atan2(vec3::dot(a, b))
-}
-
-/// `a` wrapped to `(−π, π]`.
-fn wrap(a: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let r = a - TAU * (a / TAU).round();
-    if r <= -PI { r + TAU } else { r }
 }
 
 /// Per-vertex unit tangent vectors (projected onto the normals), `None` where undefined.
@@ -219,7 +211,7 @@ fn field_turns(
             // θ_ab and θ_ba: `b` follows `a` in the face, or precedes it.
             let (tab, tba) = if t[(ca + 1) % 3] == b { (na, nb + sb) } else { (na + sa, nb) };
             let rho = tba - tab + std::f64::consts::PI;
-            Some(wrap(phi[b as usize]? - phi[a as usize]? - rho))
+            Some(wrap_angle(phi[b as usize]? - phi[a as usize]? - rho))
         })
         .collect();
     let curvature: Vec<Option<f64>> = corner
@@ -246,7 +238,7 @@ pub fn field_singularities(
                 let e = topology.face_edges[f][c] as usize;
                 sum += f64::from(topology.face_edge_signs[f][c]) * turns[e]?;
             }
-            Some((sum / std::f64::consts::TAU).round() as i32)
+            Some(index_turns(sum))
         })
         .collect();
     let mut singularities = Vec::new();
@@ -324,6 +316,17 @@ pub fn surface_field_metrics(
     field: &[V3],
     constraints: &[(u32, V3)],
 ) -> Result<SurfaceFieldMetrics, FieldsError> {
+    surface_field_metrics_with(&MeshGeometry::new(mesh), field, constraints)
+}
+
+/// [`surface_field_metrics`] with the topology, angle-weighted normals and cotan edge
+/// weights of a per-mesh [`MeshGeometry`] (computed there at most once per pipeline).
+pub fn surface_field_metrics_with(
+    geometry: &MeshGeometry<'_>,
+    field: &[V3],
+    constraints: &[(u32, V3)],
+) -> Result<SurfaceFieldMetrics, FieldsError> {
+    let mesh = geometry.mesh();
     mesh.validate()?;
     if field.len() != mesh.n_vertices() {
         return Err(FieldsError::InvalidOption {
@@ -332,12 +335,12 @@ pub fn surface_field_metrics(
             expected: "one vector per mesh vertex",
         });
     }
-    let topology = Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let (normals, _) = vertex_normals(mesh, NormalWeighting::Angle);
-    let (weights, _) = cotan_edge_weights(mesh, &topology, &CotanOptions::default())?;
-    let (singularities, undetermined_faces) = field_singularities(mesh, &topology, &normals, field);
+    let topology = geometry.require_topology();
+    let (normals, _) = geometry.require_vertex_normals(NormalWeighting::Angle);
+    let (weights, _) = geometry.require_cotan_edge_weights()?;
+    let (singularities, undetermined_faces) = field_singularities(mesh, topology, normals, field);
     let (dirichlet_energy, dirichlet_energy_ambient) =
-        field_dirichlet_energy(mesh, &topology, &normals, field, &weights);
+        field_dirichlet_energy(mesh, topology, normals, field, weights);
     Ok(SurfaceFieldMetrics {
         index_sum: singularities.iter().map(|s| s.index).sum(),
         euler_characteristic: topology.euler_characteristic(),
@@ -345,6 +348,6 @@ pub fn surface_field_metrics(
         undetermined_faces,
         dirichlet_energy,
         dirichlet_energy_ambient,
-        alignment: constraint_alignment_error(&normals, field, constraints),
+        alignment: constraint_alignment_error(normals, field, constraints),
     })
 }

@@ -26,6 +26,10 @@
 //! nothing. Both counts are returned as [`Warning`]s (`cotan-area-floored`,
 //! `cotan-triangles-skipped`) and in [`CotanStats`].
 //!
+//! **DEC Hodge star.** [`hodge_star1`] gives the same edge cotangents for DEC code, with
+//! the Hodge-star clamp (`|cot| ≤ 1e3`, `⋆1 ≥ 0`) as an explicit option
+//! ([`HodgeStarClamp`]); `fieldtex-fields`' `Dec` uses it with the clamp.
+//!
 //! Not implemented: intrinsic Delaunay edge flips (Sharp, Soliman & Crane 2019), which
 //! would make every weight non-negative but change the sparsity pattern away from the mesh
 //! edges; obtuse triangles therefore still give negative weights, as in libigl.
@@ -228,6 +232,70 @@ pub fn cotan_edge_weights(
         }
     }
     Ok((w, stats.warnings()))
+}
+
+/// The Hodge-star clamp of DEC operators, an explicit option of [`hodge_star1`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HodgeStarClamp {
+    /// Largest accepted `|cot|` of a triangle angle. Default `1e3` (about 0.06° or
+    /// 179.94°).
+    pub cot_limit: f64,
+}
+
+impl Default for HodgeStarClamp {
+    fn default() -> Self {
+        Self { cot_limit: 1e3 }
+    }
+}
+
+/// The DEC Hodge star on edges, `⋆1_e = ½ Σ cot` over the triangles of edge `e`
+/// (indexed like `topology.edges`, built from `mesh.triangles`), with each cotangent
+/// computed as `(a · b) / (2 A_f)` from the caller's `face_areas` (`#F`, positive; DEC
+/// code floors zero areas itself). With `clamp`, every cotangent is limited to
+/// `±cot_limit` and every edge weight raised to `≥ 0` (a negative dual length has no
+/// meaning for a Hodge star) — the rule of paper D's field design; without it the raw
+/// weights are returned (what conformal maps need). Returns the weights and the number
+/// of clamped edges (0 without a clamp).
+///
+/// This and the Laplacian's relative area floor (module docs) are the workspace's two
+/// cotangent robustness rules, both here: the floor keeps `L` positive semi-definite and
+/// keeps negative (obtuse) weights; the Hodge-star clamp makes `⋆1 ≥ 0`.
+pub fn hodge_star1(
+    mesh: &TriMesh,
+    topology: &Topology,
+    face_areas: &[f64],
+    clamp: Option<&HodgeStarClamp>,
+) -> (Vec<f64>, usize) {
+    let ne = topology.n_edges();
+    let limit = clamp.map_or(f64::INFINITY, |c| c.cot_limit);
+    let mut star1 = vec![0.0; ne];
+    let mut hit_limit = vec![false; ne];
+    for (f, &area) in face_areas.iter().enumerate().take(mesh.n_triangles()) {
+        let p = mesh.triangle_positions(f);
+        let twice_area = 2.0 * area;
+        for k in 0..3 {
+            // Angle at corner k is opposite the edge between corners k+1 and k+2.
+            let a = vec3::sub(p[(k + 1) % 3], p[k]);
+            let b = vec3::sub(p[(k + 2) % 3], p[k]);
+            let raw_cot = vec3::dot(a, b) / twice_area;
+            let cot = raw_cot.clamp(-limit, limit);
+            let e = topology.face_edges[f][(k + 1) % 3] as usize;
+            if cot != raw_cot {
+                hit_limit[e] = true;
+            }
+            star1[e] += 0.5 * cot;
+        }
+    }
+    let mut clamped = 0usize;
+    if clamp.is_some() {
+        for e in 0..ne {
+            if star1[e] < 0.0 || hit_limit[e] {
+                clamped += 1;
+                star1[e] = star1[e].max(0.0);
+            }
+        }
+    }
+    (star1, clamped)
 }
 
 /// Corners grouped by vertex (counting sort): `items[offsets[v]..offsets[v + 1]]` are

@@ -18,9 +18,11 @@ pub use topology::{Csr, Topology, UnionFind};
 pub mod areas;
 pub mod bvh;
 pub mod cotan_laplacian;
+pub mod dart_throwing;
 pub mod directional_occlusion;
 pub mod heat_geodesic;
 pub mod mass_matrix;
+pub mod mesh_geometry;
 pub mod normals;
 pub mod plane_cut;
 pub mod point_inside;
@@ -28,6 +30,7 @@ pub mod poisson_disk_sampling;
 pub mod polygon_triangulation;
 pub mod principal_curvature;
 pub mod solid_angle_curvature;
+pub mod spatial_grid;
 pub mod sphere_directions;
 
 // Inspection and repair.
@@ -41,8 +44,9 @@ pub use areas::{
     vertex_areas,
 };
 pub use cotan_laplacian::{
-    CotanOptions, CotanStats, cotan_edge_weights, cotan_face_weights, cotan_laplacian,
-    cotan_laplacian_and_mass, cotan_laplacian_triplets, cotan_laplacian_with,
+    CotanOptions, CotanStats, HodgeStarClamp, cotan_edge_weights, cotan_face_weights,
+    cotan_laplacian, cotan_laplacian_and_mass, cotan_laplacian_triplets, cotan_laplacian_with,
+    hodge_star1,
 };
 pub use mass_matrix::{lumped_mass, mass_matrix};
 pub use normals::{NormalWeighting, face_normals, vertex_normals};
@@ -72,11 +76,15 @@ mod repair_tests;
 #[cfg(test)]
 mod test_fixtures;
 pub use bvh::{Bvh, ClosestPoint, Hit, Ray};
+pub use dart_throwing::{DartThrower, dart_throwing, nested_dart_throwing};
 pub use directional_occlusion::{DirectionalOcclusionOptions, directional_occlusion_sh};
+pub use mesh_geometry::MeshGeometry;
 pub use plane_cut::{PlaneCut, cut_with_plane};
 pub use point_inside::points_inside;
 pub use poisson_disk_sampling::{
     PoissonDiskOptions, PoissonDiskSamples, SurfaceSample, poisson_disk_sampling,
+    poisson_disk_sampling_nested,
 };
 pub use polygon_triangulation::triangulate_polygons;
 pub use solid_angle_curvature::{OrientedPoint, SolidAngleOptions, solid_angle_curvature};
+pub use spatial_grid::{IncrementalGrid, SpatialGrid};

@@ -20,9 +20,13 @@
 //! the area and corrected a few times from the counts obtained; the result is within a
 //! few percent of the target, never exact (truncating would leave holes).
 //!
+//! [`poisson_disk_sampling_nested`] gives nested sets for decreasing radii (the
+//! multi-resolution mode of [`crate::dart_throwing`]).
+//!
 //! Not implemented: geodesic (on-surface) distances, Yuksel's (2015) sample elimination.
 
 use crate::areas::triangle_area;
+use crate::dart_throwing::DartThrower;
 use crate::{MeshError, TriMesh};
 use fieldtex_core::Warning;
 use fieldtex_core::vec3::{self, V3};
@@ -76,126 +80,6 @@ pub struct PoissonDiskSamples {
 const CHUNK: usize = 4096;
 const CHUNKS_PER_BATCH: usize = 32;
 
-/// Open-addressing hash grid of accepted samples: cell → first sample, `next` links.
-///
-/// Cell coordinates are packed into 21 bits each (wrapping; points of far-apart cells
-/// that share a key only cost a distance test, never a wrong answer), and the slot is a
-/// *linear* function of the cell so that the 27 neighbours of a cell fall on few cache
-/// lines.
-struct HashGrid {
-    origin: V3,
-    inv_cell: f64,
-    /// `(packed cell key, first sample)`; `EMPTY` heads mark free slots.
-    slots: Vec<(u64, u32)>,
-    mask: usize,
-    next: Vec<u32>,
-    points: Vec<V3>,
-    used: usize,
-}
-
-const EMPTY: u32 = u32::MAX;
-const KEY_BITS: u32 = 21;
-const KEY_MASK: i64 = (1 << KEY_BITS) - 1;
-
-/// The 27 cell offsets, the cell itself first, then `x` fastest.
-const NEIGHBOUR_ORDER: [[i64; 3]; 27] = {
-    let mut out = [[0i64; 3]; 27];
-    let mut k = 1;
-    let mut i = 0;
-    while i < 27 {
-        let d = [(i % 3) as i64 - 1, ((i / 3) % 3) as i64 - 1, (i / 9) as i64 - 1];
-        if !(d[0] == 0 && d[1] == 0 && d[2] == 0) {
-            out[k] = d;
-            k += 1;
-        }
-        i += 1;
-    }
-    out
-};
-
-impl HashGrid {
-    fn new(origin: V3, cell: f64, expected: usize) -> Self {
-        let cap = (2 * expected.max(16)).next_power_of_two();
-        Self {
-            origin,
-            inv_cell: 1.0 / cell,
-            slots: vec![(0, EMPTY); cap],
-            mask: cap - 1,
-            next: Vec::new(),
-            points: Vec::new(),
-            used: 0,
-        }
-    }
-
-    #[inline]
-    fn cell(&self, p: V3) -> [i64; 3] {
-        [0, 1, 2].map(|k| ((p[k] - self.origin[k]) * self.inv_cell).floor() as i64)
-    }
-
-    #[inline]
-    fn key(c: [i64; 3]) -> u64 {
-        ((c[0] & KEY_MASK) | (c[1] & KEY_MASK) << KEY_BITS | (c[2] & KEY_MASK) << (2 * KEY_BITS))
-            as u64
-    }
-
-    /// Slot of cell `c`: the one holding its key, or the free slot where it would go.
-    #[inline]
-    fn slot(&self, c: [i64; 3]) -> usize {
-        let key = Self::key(c);
-        let h = (c[0] as u64)
-            .wrapping_add((c[1] as u64).wrapping_mul(0x9E37_79B1))
-            .wrapping_add((c[2] as u64).wrapping_mul(0x85EB_CA77_C2B2_AE63));
-        let mut i = h as usize & self.mask;
-        while self.slots[i].1 != EMPTY && self.slots[i].0 != key {
-            i = (i + 1) & self.mask;
-        }
-        i
-    }
-
-    /// Whether an accepted sample lies closer than `sqrt(r2)` to `p`.
-    fn has_neighbour(&self, p: V3, r2: f64) -> bool {
-        let c = self.cell(p);
-        // Own cell first: near saturation most candidates are rejected there.
-        NEIGHBOUR_ORDER.iter().any(|d| {
-            let mut s = self.slots[self.slot([c[0] + d[0], c[1] + d[1], c[2] + d[2]])].1;
-            while s != EMPTY {
-                if vec3::norm2(vec3::sub(self.points[s as usize], p)) < r2 {
-                    return true;
-                }
-                s = self.next[s as usize];
-            }
-            false
-        })
-    }
-
-    fn insert(&mut self, p: V3) {
-        if 2 * (self.used + 1) > self.slots.len() {
-            self.grow();
-        }
-        let c = self.cell(p);
-        let i = self.slot(c);
-        if self.slots[i].1 == EMPTY {
-            self.slots[i].0 = Self::key(c);
-            self.used += 1;
-        }
-        self.next.push(self.slots[i].1);
-        self.slots[i].1 = self.points.len() as u32;
-        self.points.push(p);
-    }
-
-    fn grow(&mut self) {
-        let old = std::mem::replace(&mut self.slots, vec![(0, EMPTY); 2 * self.mask + 2]);
-        self.mask = self.slots.len() - 1;
-        for (_, head) in old {
-            if head != EMPTY {
-                // Any point of the bucket gives its cell.
-                let i = self.slot(self.cell(self.points[head as usize]));
-                self.slots[i] = (Self::key(self.cell(self.points[head as usize])), head);
-            }
-        }
-    }
-}
-
 /// Walker's alias table (Vose's construction): `O(1)` area-weighted triangle choice.
 struct AliasTable {
     prob: Vec<f64>,
@@ -241,7 +125,8 @@ impl AliasTable {
     }
 }
 
-/// One dart-throwing pass with radius `r` over `n_candidates` candidates.
+/// One dart-throwing pass with radius `r` over `n_candidates` candidates, starting from
+/// the accepted `seeds` (not repeated in the result).
 fn throw(
     mesh: &TriMesh,
     table: &AliasTable,
@@ -249,13 +134,16 @@ fn throw(
     r: f64,
     n_candidates: usize,
     seed: u64,
+    seeds: &[SurfaceSample],
 ) -> Vec<SurfaceSample> {
     let origin = mesh.bounding_box().map_or([0.0; 3], |b| b.min);
     let expected = (0.7 * total / (r * r)).min(n_candidates as f64) as usize;
-    let mut grid = HashGrid::new(origin, r, expected);
+    let mut thrower = DartThrower::new(origin, r, expected + seeds.len());
+    for s in seeds {
+        thrower.seed(s.position);
+    }
     let mut samples = Vec::with_capacity(expected);
     let n_chunks = n_candidates.div_ceil(CHUNK);
-    let r2 = r * r;
     let generate = |batch: usize| -> Vec<Vec<SurfaceSample>> {
         (batch..(batch + CHUNKS_PER_BATCH).min(n_chunks))
             .into_par_iter()
@@ -284,12 +172,11 @@ fn throw(
     while batch < n_chunks {
         let next_batch = batch + CHUNKS_PER_BATCH;
         let cands = std::mem::take(&mut current);
-        let (grid, samples) = (&mut grid, &mut samples);
+        let (thrower, samples) = (&mut thrower, &mut samples);
         let ((), next) = rayon::join(
             move || {
                 for cand in cands.into_iter().flatten() {
-                    if !grid.has_neighbour(cand.position, r2) {
-                        grid.insert(cand.position);
+                    if thrower.offer(cand.position) {
                         samples.push(cand);
                     }
                 }
@@ -315,20 +202,7 @@ pub fn poisson_disk_sampling(
         found,
     };
     let mut warnings = Vec::new();
-    // Area CDF over triangles with finite corners.
-    let areas: Vec<f64> = (0..mesh.n_triangles())
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|f| {
-            let p = mesh.triangle_positions(f);
-            if p.iter().all(|q| vec3::is_finite(*q)) {
-                triangle_area(p[0], p[1], p[2])
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let total: f64 = areas.iter().sum();
+    let (areas, total) = triangle_weights(mesh);
     let radius_for = |count: usize| (0.7 * total / count as f64).sqrt();
     let mut r = match (options.radius, options.target_count) {
         (Some(r), _) if r > 0.0 && r.is_finite() => r,
@@ -343,23 +217,11 @@ pub fn poisson_disk_sampling(
         ));
         return Ok((PoissonDiskSamples { samples: Vec::new(), radius: r }, warnings));
     }
-    let factor = if options.candidate_factor > 0.0 { options.candidate_factor } else { 16.0 };
-    let candidates_for = |r: f64, warnings: &mut Vec<Warning>| {
-        let want = factor * 0.7 * total / (r * r);
-        if want > options.max_candidates as f64 {
-            warnings.push(Warning::new(
-                "sampling-candidates-capped",
-                format!(
-                    "radius {r:e} would need {want:.3e} candidates; capped at {}, so the \
-                     samples keep their minimum distance but may leave gaps",
-                    options.max_candidates
-                ),
-            ));
-        }
-        (want.ceil() as usize).clamp(1, options.max_candidates.max(1))
-    };
+    let candidates_for =
+        |r: f64, warnings: &mut Vec<Warning>| candidate_count(options, total, r, warnings);
     let table = AliasTable::new(&areas, total);
-    let mut samples = throw(mesh, &table, total, r, candidates_for(r, &mut warnings), options.seed);
+    let mut samples =
+        throw(mesh, &table, total, r, candidates_for(r, &mut warnings), options.seed, &[]);
     if options.radius.is_none() {
         let target = options.target_count.unwrap_or(1) as f64;
         for _ in 0..4 {
@@ -368,10 +230,94 @@ pub fn poisson_disk_sampling(
                 break;
             }
             r *= ratio.sqrt();
-            samples = throw(mesh, &table, total, r, candidates_for(r, &mut warnings), options.seed);
+            samples =
+                throw(mesh, &table, total, r, candidates_for(r, &mut warnings), options.seed, &[]);
         }
     }
     Ok((PoissonDiskSamples { samples, radius: r }, warnings))
+}
+
+/// Nested Poisson-disk sample sets of the surface for strictly decreasing `radii`
+/// (multi-resolution mode, [`crate::dart_throwing`]): level `k` keeps every sample of
+/// level `k − 1` as its prefix and adds darts at spacing `radii[k]`, so each level is
+/// `radii[k]`-separated and close to maximal. `options.radius` and
+/// `options.target_count` are ignored; seed, candidate factor and cap apply per level.
+/// Errors on bad indices or radii; a mesh without area gives empty levels and a warning.
+pub fn poisson_disk_sampling_nested(
+    mesh: &TriMesh,
+    radii: &[f64],
+    options: &PoissonDiskOptions,
+) -> Result<(Vec<PoissonDiskSamples>, Vec<Warning>), MeshError> {
+    crate::checks::check_indices(mesh)?;
+    let decreasing = radii.windows(2).all(|w| w[1] < w[0]);
+    if radii.is_empty() || !decreasing || radii.iter().any(|r| !(r.is_finite() && *r > 0.0)) {
+        return Err(MeshError::Precondition {
+            operation: "nested Poisson-disk sampling",
+            requirement: "one or more positive finite radii, strictly decreasing",
+            found: format!("{radii:?}"),
+        });
+    }
+    let mut warnings = Vec::new();
+    let (areas, total) = triangle_weights(mesh);
+    if !(total > 0.0 && total.is_finite()) {
+        warnings.push(Warning::new(
+            "sampling-no-area",
+            "the mesh has no triangle with positive finite area; no samples were drawn",
+        ));
+        let empty = |&r: &f64| PoissonDiskSamples { samples: Vec::new(), radius: r };
+        return Ok((radii.iter().map(empty).collect(), warnings));
+    }
+    let table = AliasTable::new(&areas, total);
+    let mut levels: Vec<PoissonDiskSamples> = Vec::with_capacity(radii.len());
+    let mut samples: Vec<SurfaceSample> = Vec::new();
+    for &r in radii {
+        let n = candidate_count(options, total, r, &mut warnings);
+        let added = throw(mesh, &table, total, r, n, options.seed, &samples);
+        samples.extend(added);
+        levels.push(PoissonDiskSamples { samples: samples.clone(), radius: r });
+    }
+    Ok((levels, warnings))
+}
+
+/// Triangle areas (zero for triangles with a non-finite corner) and their sum.
+fn triangle_weights(mesh: &TriMesh) -> (Vec<f64>, f64) {
+    let areas: Vec<f64> = (0..mesh.n_triangles())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|f| {
+            let p = mesh.triangle_positions(f);
+            if p.iter().all(|q| vec3::is_finite(*q)) {
+                triangle_area(p[0], p[1], p[2])
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let total: f64 = areas.iter().sum();
+    (areas, total)
+}
+
+/// Number of candidates for radius `r` on area `total` (module docs), with a warning
+/// when the cap cuts it.
+fn candidate_count(
+    options: &PoissonDiskOptions,
+    total: f64,
+    r: f64,
+    warnings: &mut Vec<Warning>,
+) -> usize {
+    let factor = if options.candidate_factor > 0.0 { options.candidate_factor } else { 16.0 };
+    let want = factor * 0.7 * total / (r * r);
+    if want > options.max_candidates as f64 {
+        warnings.push(Warning::new(
+            "sampling-candidates-capped",
+            format!(
+                "radius {r:e} would need {want:.3e} candidates; capped at {}, so the \
+                 samples keep their minimum distance but may leave gaps",
+                options.max_candidates
+            ),
+        ));
+    }
+    (want.ceil() as usize).clamp(1, options.max_candidates.max(1))
 }
 
 #[cfg(test)]

@@ -4,30 +4,18 @@
 use super::*;
 use crate::primitives::{grid, icosphere};
 use crate::test_meshes::{categories, load_obj};
-use std::collections::HashMap;
 
-/// The smallest pairwise distance, by an independent grid hash of cell size `r`
-/// (any pair closer than `r` lies in neighbouring cells).
+/// The smallest pairwise distance below `r` (else infinity), through the static
+/// [`crate::SpatialGrid`] (not the incremental grid the sampler uses).
 fn min_distance(points: &[V3], r: f64) -> f64 {
-    let key = |p: V3| [0, 1, 2].map(|k| (p[k] / r).floor() as i64);
-    let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
-    for (i, p) in points.iter().enumerate() {
-        cells.entry(key(*p)).or_default().push(i);
-    }
+    let grid = crate::SpatialGrid::new(points, r);
     let mut best = f64::INFINITY;
     for (i, p) in points.iter().enumerate() {
-        let c = key(*p);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    for &j in cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]).into_iter().flatten() {
-                        if j != i {
-                            best = best.min(vec3::norm(vec3::sub(points[j], *p)));
-                        }
-                    }
-                }
+        grid.for_each_within(points, *p, r, |j, d2| {
+            if j as usize != i {
+                best = best.min(d2.sqrt());
             }
-        }
+        });
     }
     best
 }
@@ -136,4 +124,28 @@ fn bad_options_and_arealess_meshes() {
     let (s, w) = poisson_disk_sampling(&m, &o).unwrap();
     assert!(w.iter().any(|w| w.code == "sampling-candidates-capped"));
     check("capped", &m, &s);
+}
+
+#[test]
+fn nested_levels_are_prefixes_and_keep_their_radius() {
+    let m = icosphere(3);
+    let radii = [0.4, 0.2, 0.1];
+    let (levels, w) =
+        poisson_disk_sampling_nested(&m, &radii, &PoissonDiskOptions::default()).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    assert_eq!(levels.len(), 3);
+    for k in 0..3 {
+        check("nested", &m, &levels[k]);
+        assert_eq!(levels[k].radius, radii[k]);
+        if k > 0 {
+            let (prev, cur) = (&levels[k - 1].samples, &levels[k].samples);
+            assert!(cur.len() > 2 * prev.len(), "{} vs {}", cur.len(), prev.len());
+            assert_eq!(&cur[..prev.len()], &prev[..]);
+        }
+    }
+    // The coarsest level is the single-radius sampling with the same seed.
+    let opts = PoissonDiskOptions { radius: Some(0.4), ..Default::default() };
+    assert_eq!(poisson_disk_sampling(&m, &opts).unwrap().0.samples, levels[0].samples);
+    let bad = poisson_disk_sampling_nested(&m, &[0.1, 0.2], &PoissonDiskOptions::default());
+    assert!(bad.is_err());
 }

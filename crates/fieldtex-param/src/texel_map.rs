@@ -74,6 +74,26 @@ impl TexelMap {
         Some(p)
     }
 
+    /// The texel (row-major index) that shows the surface point `(triangle, bary)`
+    /// through `mesh`'s UVs — the inverse of [`Self::surface_point`] up to the texel
+    /// size; `None` without UVs, for a bad triangle index or outside the image.
+    pub fn texel_at(&self, mesh: &TriMesh, triangle: u32, bary: [f64; 3]) -> Option<usize> {
+        let uv = mesh.uvs.as_ref()?;
+        let t = uv.indices.get(triangle as usize)?;
+        let (mut u, mut v) = (0.0, 0.0);
+        for k in 0..3 {
+            let c = uv.values.get(t[k] as usize)?;
+            u += bary[k] * c[0];
+            v += bary[k] * c[1];
+        }
+        let x = (u * self.width as f64).floor();
+        let y = ((1.0 - v) * self.height as f64).floor();
+        if !(x >= 0.0 && y >= 0.0 && x < self.width as f64 && y < self.height as f64) {
+            return None;
+        }
+        Some(y as usize * self.width + x as usize)
+    }
+
     /// Number of texels covered by charts (gutters excluded).
     pub fn n_covered(&self) -> usize {
         (0..self.source.len()).filter(|&i| self.is_covered(i)).count()
@@ -302,5 +322,15 @@ mod tests {
         assert!(m.is_covered(m.source[g] as usize));
         // Far corner stays empty.
         assert!(m.entries[15].is_none() && m.source[15] == u32::MAX);
+        // Every covered texel whose centre is inside the triangle maps back to itself.
+        for t in (0..256).filter(|&t| m.is_covered(t)) {
+            let e = m.entries[t].unwrap();
+            let b = e.bary.map(f64::from);
+            if b.iter().any(|&x| x < 0.01) {
+                continue;
+            }
+            assert_eq!(m.texel_at(&mesh, e.triangle, b), Some(t), "texel {t}");
+        }
+        assert_eq!(m.texel_at(&mesh, 7, [1.0, 0.0, 0.0]), None);
     }
 }

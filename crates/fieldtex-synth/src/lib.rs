@@ -48,6 +48,7 @@ mod level_tables;
 pub mod parallel_synthesis;
 pub mod solid;
 pub mod synthesis_options;
+mod synthesis_subset;
 
 pub use characteristic_scale::{CharacteristicScale, characteristic_scale};
 pub use color_lookup::{ColorFilter, color_lookup};
@@ -56,4 +57,6 @@ pub use error::SynthError;
 pub use exemplar_analysis::{APPEARANCE_DIMS, AnalysisLevel, AnalysisOptions, ExemplarAnalysis};
 pub use exemplar_policy::{FittedExemplar, MAX_EXEMPLAR_SIDE, fit_exemplar};
 pub use image_quilting::{QuiltStats, QuiltTarget, QuiltingOptions, quilt};
-pub use parallel_synthesis::{SynthesisOptions, SynthesisResult, synthesize};
+pub use parallel_synthesis::{
+    SubsetSynthesis, SynthesisOptions, SynthesisResult, synthesize, synthesize_subset,
+};

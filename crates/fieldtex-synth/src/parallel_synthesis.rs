@@ -73,6 +73,7 @@ use crate::color_lookup::color_lookup;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
 use crate::flip_combing::comb_flips;
 use crate::level_tables::{LevelTables, NONE, OFFS8, frobenius, mat_vec, tabulate};
+use crate::synthesis_subset::SubsetPlan;
 
 /// Corner offsets `Δ` of the four-corner neighbourhood; bit 0 of the index is the x
 /// sign (0 = −1), bit 1 the y sign.
@@ -401,18 +402,86 @@ pub fn synthesize(
     let avx2 = std::arch::is_x86_feature_detected!("avx2");
     #[cfg(not(target_arch = "x86_64"))]
     let avx2 = false;
-    synthesize_with(analysis, domain, options, progress, avx2)
+    let run = synthesize_with(analysis, domain, options, progress, avx2, None)?;
+    let (out_w, out_h) = domain.output_size();
+    let filter = options.color_filter;
+    let pixels = run.coords.par_iter().map(|&u| color_lookup(analysis, u, filter)).collect();
+    Ok(SynthesisResult {
+        colors: Image { width: out_w, height: out_h, pixels },
+        coords: run.coords,
+        flips: run.flips,
+        level_timings_ms: run.level_timings_ms,
+    })
 }
 
-/// [`synthesize`] with the AVX2 build of the correction on or off (`avx2` only when
-/// the CPU supports it).
+/// Result of [`synthesize_subset`]: the requested finest samples, in the order given.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SubsetSynthesis {
+    /// The requested sample indices (row-major over [`SynthesisDomain::output_size`]).
+    pub samples: Vec<usize>,
+    /// Exemplar colour of each requested sample.
+    pub colors: Vec<[f32; 4]>,
+    /// Exemplar coordinate of each requested sample.
+    pub coords: Vec<[f32; 2]>,
+    /// Flip indicator of each requested sample.
+    pub flips: Vec<bool>,
+    /// Samples computed per level, finest first (the dependency sets' sizes).
+    pub evaluated_per_level: Vec<usize>,
+}
+
+/// The requested finest samples of [`synthesize`] computed from their dependency sets
+/// only ([`crate::synthesis_subset`]): the same bits as the same samples of a full
+/// synthesis with the same options and seed, for any thread count. Errors as
+/// [`synthesize`], and on a requested index outside the finest level.
+pub fn synthesize_subset(
+    analysis: &ExemplarAnalysis,
+    domain: &dyn SynthesisDomain,
+    options: &SynthesisOptions,
+    requested: &[usize],
+    progress: &dyn Progress,
+) -> Result<SubsetSynthesis, SynthError> {
+    let n0 = domain.sample_count(0);
+    if let Some(&bad) = requested.iter().find(|&&r| r >= n0) {
+        return Err(SynthError::InvalidDomain {
+            reason: format!("requested sample {bad} ≥ finest sample count {n0}"),
+        });
+    }
+    #[cfg(target_arch = "x86_64")]
+    let avx2 = std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx2 = false;
+    let run = synthesize_with(analysis, domain, options, progress, avx2, Some(requested))?;
+    let filter = options.color_filter;
+    Ok(SubsetSynthesis {
+        samples: requested.to_vec(),
+        colors: requested
+            .par_iter()
+            .map(|&r| color_lookup(analysis, run.coords[r], filter))
+            .collect(),
+        coords: requested.iter().map(|&r| run.coords[r]).collect(),
+        flips: requested.iter().map(|&r| run.flips[r]).collect(),
+        evaluated_per_level: run.evaluated_per_level,
+    })
+}
+
+/// Finest-level state after the last level (full, or right at the planned samples).
+struct EngineRun {
+    coords: Vec<[f32; 2]>,
+    flips: Vec<bool>,
+    level_timings_ms: Vec<f64>,
+    evaluated_per_level: Vec<usize>,
+}
+
+/// The engine with the AVX2 build of the correction on or off (`avx2` only when the CPU
+/// supports it), over every sample or only the dependency sets of `requested`.
 fn synthesize_with(
     analysis: &ExemplarAnalysis,
     domain: &dyn SynthesisDomain,
     options: &SynthesisOptions,
     progress: &dyn Progress,
     avx2: bool,
-) -> Result<SynthesisResult, SynthError> {
+    requested: Option<&[usize]>,
+) -> Result<EngineRun, SynthError> {
     validate(options, analysis)?;
     let n0 = domain.sample_count(0);
     let (out_w, out_h) = domain.output_size();
@@ -452,10 +521,34 @@ fn synthesize_with(
         vec![false; n_init]
     };
     let mut level_timings_ms = Vec::with_capacity(levels);
+    let passes_of = |level: usize| {
+        if level == 0 {
+            options.finest_passes.unwrap_or(options.correction_passes)
+        } else if level >= 2 {
+            options.coarse_passes.unwrap_or(options.correction_passes)
+        } else {
+            options.correction_passes
+        }
+    };
+    // Subset mode: every level tabulated first, then the dependency sets planned.
+    let (plan, mut planned_tables) = match requested {
+        None => (None, Vec::new()),
+        Some(r) => {
+            let all = (0..levels)
+                .map(|l| tabulate(domain, l, options.scale, options.subpasses, true))
+                .collect::<Result<Vec<_>, _>>()?;
+            let plan = SubsetPlan::new(&all, n_init, passes_of, r);
+            (Some(plan), all.into_iter().map(Some).collect::<Vec<_>>())
+        }
+    };
 
     for level in (0..levels).rev() {
         let start = Instant::now();
-        let tables = tabulate(domain, level, options.scale, options.subpasses, true)?;
+        let tables = match planned_tables.get_mut(level).and_then(Option::take) {
+            Some(t) => t,
+            None => tabulate(domain, level, options.scale, options.subpasses, true)?,
+        };
+        let start_mask = plan.as_ref().map(|p| &p.start[level]);
         let an = analysis.level(level);
         let ex = ExemplarLevel::new(analysis, level, options.rosy_fix);
         let spacing = an.spacing as f32;
@@ -470,6 +563,11 @@ fn synthesize_with(
         let (mut ns, mut nf): (Vec<[f32; 2]>, Vec<bool>) = (0..n)
             .into_par_iter()
             .map(|i| {
+                if let Some(m) = start_mask
+                    && !m[i]
+                {
+                    return ([0.0; 2], false);
+                }
                 let (par, off) = tables.parent[i];
                 let par = par as usize;
                 let jpar = pj[par];
@@ -507,18 +605,16 @@ fn synthesize_with(
             keep_flips: rosy && options.keep_flips,
             trapezoid: rosy && options.trapezoid_frames,
         };
-        let passes = if level == 0 {
-            options.finest_passes.unwrap_or(options.correction_passes)
-        } else if level >= 2 {
-            options.coarse_passes.unwrap_or(options.correction_passes)
-        } else {
-            options.correction_passes
-        };
-        for _ in 0..passes {
-            for class in &tables.classes {
-                let updates: Vec<([f32; 2], bool)> =
-                    class.par_iter().map(|&p| pass.correct(p as usize, &ns, &nf)).collect();
-                for (&p, (u, f)) in class.iter().zip(updates) {
+        let n_classes = tables.classes.len();
+        for pass_index in 0..passes_of(level) {
+            for (c, class) in tables.classes.iter().enumerate() {
+                let step = plan.as_ref().map(|p| &p.steps[level][pass_index * n_classes + c]);
+                let updates: Vec<(u32, ([f32; 2], bool))> = class
+                    .par_iter()
+                    .filter(|&&p| step.is_none_or(|m| m[p as usize]))
+                    .map(|&p| (p, pass.correct(p as usize, &ns, &nf)))
+                    .collect();
+                for (p, (u, f)) in updates {
                     ns[p as usize] = u;
                     nf[p as usize] = f;
                 }
@@ -531,14 +627,8 @@ fn synthesize_with(
         progress.advance(1);
     }
     progress.finish_stage();
-    let filter = options.color_filter;
-    let pixels = s.par_iter().map(|&u| color_lookup(analysis, u, filter)).collect();
-    Ok(SynthesisResult {
-        colors: Image { width: out_w, height: out_h, pixels },
-        coords: s,
-        flips: fl,
-        level_timings_ms,
-    })
+    let evaluated_per_level = plan.map_or_else(|| vec![n0; 1], |p| p.evaluated());
+    Ok(EngineRun { coords: s, flips: fl, level_timings_ms, evaluated_per_level })
 }
 
 #[cfg(test)]

@@ -7,7 +7,10 @@
 //! - [`SurfaceDomain`] (`surface_domain.rs`): colour *carriers* (triangle + barycentric
 //!   coordinates: atlas texels or vertices) with positions, normals and tangent frames
 //!   from a per-vertex direction field. Reusable by the transfer pipeline (paper B).
-//! - [`UniformGrid`]: deterministic radius-neighbour queries over 3-D points.
+//! - Radius-neighbour queries go through `fieldtex_mesh::SpatialGrid` (re-exported here
+//!   as [`UniformGrid`] for the callers that still name it).
+//! - [`SurfaceSamples`] (`surface_samples.rs`): the carriers with a nested
+//!   multi-resolution sample hierarchy and public tangent-plane neighbourhoods.
 //! - [`sample_set`]: the sample set `X†` by dart throwing over the carriers at spacing
 //!   `r·w·h`, salient-curve carriers first (paper A §5.1).
 //! - [`optimise`]: the coarse-to-fine search/blend loop
@@ -70,12 +73,14 @@ pub mod patch_search;
 pub mod robust_blend;
 mod sample_set;
 mod surface_domain;
+mod surface_samples;
 pub mod texture_optimisation;
-mod uniform_grid;
 
 pub use error::TexOptError;
+/// The workspace's one spatial grid, under its former texopt name.
+pub use fieldtex_mesh::SpatialGrid as UniformGrid;
 pub use options::{FeatureAlignment, TexOptOptions, pyramid_patch_sizes};
 pub use sample_set::sample_set;
 pub use surface_domain::{Carrier, SurfaceDomain, vertex_carriers};
+pub use surface_samples::{Neighbour, SurfaceSamples};
 pub use texture_optimisation::{LevelStats, TexOptResult, optimise};
-pub use uniform_grid::UniformGrid;

@@ -26,10 +26,11 @@
 use crate::exemplar_patches::{ExemplarLevel, GRID};
 use crate::patch_search::{Match, Placement, search_sample};
 use crate::robust_blend::{BlendMode, blend, robust_weight};
-use crate::{FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, UniformGrid, sample_set};
+use crate::{FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, sample_set};
 use fieldtex_core::rng::stream_seed;
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_core::{Image, Progress, Warning};
+use fieldtex_mesh::SpatialGrid;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
@@ -95,8 +96,8 @@ pub(crate) struct LevelContext<'a> {
     /// indexes `active_positions`.
     pub active: Vec<u32>,
     pub active_positions: Vec<V3>,
-    pub carrier_grid: UniformGrid,
-    pub sample_grid: UniformGrid,
+    pub carrier_grid: SpatialGrid,
+    pub sample_grid: SpatialGrid,
     /// Footprint radius (half diagonal of the patch), surface units.
     pub radius: f64,
     pub neighbours: Vec<u32>,
@@ -251,8 +252,8 @@ pub fn optimise(
         let subset = active.len() < domain.len();
         let active_positions: Vec<V3> =
             active.iter().map(|&c| domain.positions()[c as usize]).collect();
-        let carrier_grid = UniformGrid::new(&active_positions, 0.5 * radius);
-        let sample_grid = UniformGrid::new(&sample_positions, 0.5 * radius);
+        let carrier_grid = SpatialGrid::new(&active_positions, 0.5 * radius);
+        let sample_grid = SpatialGrid::new(&sample_positions, 0.5 * radius);
         let k_neighbours = options.coherence_neighbours.clamp(1, 32);
         let neighbours =
             nearest_samples(&sample_grid, &sample_positions, 2.5 * spacing, k_neighbours);
@@ -412,7 +413,7 @@ pub fn optimise(
 
 /// Up to `k` nearest other samples within `radius` per sample (`#S × k`, padded with
 /// `u32::MAX`), ordered by (distance, index).
-fn nearest_samples(grid: &UniformGrid, pos: &[V3], radius: f64, k: usize) -> Vec<u32> {
+fn nearest_samples(grid: &SpatialGrid, pos: &[V3], radius: f64, k: usize) -> Vec<u32> {
     let mut out = vec![u32::MAX; pos.len() * k];
     out.par_chunks_mut(k).enumerate().for_each(|(p, row)| {
         let mut best: Vec<(f64, u32)> = Vec::with_capacity(k + 1);

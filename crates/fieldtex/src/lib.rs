@@ -34,11 +34,14 @@ pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};
 pub use pipelines::eval::{Guidance, ImageMetrics, eval_files};
 pub use pipelines::field::{FieldCommandOptions, FieldSummary, field_file};
-pub use pipelines::field_texture::{FieldTextureOptions, synthesize_field_texture};
+pub use pipelines::field_texture::{
+    FieldTextureOptions, synthesize_field_texture, synthesize_field_texture_with,
+};
 pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, repair_file};
 pub use pipelines::orient::{DesignedSingularity, FieldSource, OrientOptions, orient};
 pub use pipelines::render::{RenderCommandOptions, render_file};
 pub use pipelines::solid::{SolidGrid, SolidOptions, solid};
+pub use pipelines::synthesis::AnalysisCache;
 pub use pipelines::transfer as pipelines_transfer;
 pub use pipelines::transfer::{TransferCommandOptions, transfer_files};
 pub use pipelines::transfer_fidelity::transfer_fidelity_files;

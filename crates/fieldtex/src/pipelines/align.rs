@@ -30,10 +30,7 @@ use fieldtex_features::{ExemplarFeatureOptions, ExemplarFeatures};
 use fieldtex_fields::{CurveOrientationOptions, OrientationMode, orient_curves};
 use fieldtex_mesh::TriMesh;
 use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
-use fieldtex_texopt::{
-    Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, UniformGrid,
-};
-use rayon::prelude::*;
+use fieldtex_texopt::{Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -206,98 +203,289 @@ fn preview_with_curves(
     render(&scene, &RenderOptions { size, ..Default::default() })
 }
 
-/// Surface points `(triangle, barycentric)` along `curves`, about `spacing` apart, with
-/// the curve length each point stands for (for length-weighted measures).
-fn curve_surface_points(
-    bvh: &fieldtex_mesh::Bvh,
-    curves: &[Vec<[f64; 3]>],
-    spacing: f64,
-) -> Vec<((u32, [f64; 3]), f64)> {
-    let mut pts = Vec::new();
-    for c in curves {
-        for s in c.windows(2) {
-            let len = fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(s[1], s[0]));
-            if !len.is_finite() {
-                continue;
-            }
-            let n = ((len / spacing).ceil() as usize).clamp(1, 10_000);
-            for k in 0..n {
-                let t = (k as f64 + 0.5) / n as f64;
-                let p = fieldtex_core::vec3::lerp(s[0], s[1], t);
-                if let Some(cp) = bvh.closest_point(p) {
-                    pts.push(((cp.triangle, cp.barycentric), len / n as f64));
+/// The option checks of [`align`] that do not need the inputs.
+fn check_options(options: &AlignOptions) -> Result<()> {
+    if !(options.scale.is_finite() && options.scale > 0.0 && options.scale <= 64.0) {
+        return Err(Error::bad_input(
+            None,
+            format!("--scale must be in (0, 64], got {}", options.scale),
+        ));
+    }
+    if let Some(d) = options.direction
+        && !(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0))
+    {
+        return Err(Error::bad_input(
+            None,
+            format!("--direction must be three finite numbers, not all zero; got {d:?}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The exemplar's feature lines: read from `--exemplar-lines`, or detected.
+fn exemplar_feature_lines(
+    options: &AlignOptions,
+    exemplar: &Image,
+    toroidal: bool,
+) -> Result<ExemplarFeatures> {
+    match &options.exemplar_lines {
+        Some(p) => {
+            let lines: Vec<Vec<[f32; 2]>> = fieldtex_io::read_obj_polylines(p)?
+                .into_iter()
+                .map(|l| l.into_iter().map(|q| [q[0] as f32, q[1] as f32]).collect())
+                .collect();
+            fieldtex_features::exemplar_features_from_polylines(
+                exemplar.width,
+                exemplar.height,
+                &lines,
+                toroidal,
+            )
+            .map_err(|e| Error::bad_input(Some(p), e.to_string()))
+        }
+        None => fieldtex_features::detect_exemplar_feature_lines(
+            exemplar,
+            &ExemplarFeatureOptions { toroidal, ..Default::default() },
+        )
+        .map_err(|e| Error::bad_input(Some(&options.exemplar), e.to_string())),
+    }
+}
+
+/// What [`align_metrics`] measures on.
+struct MetricInputs<'a> {
+    atlas_mesh: &'a TriMesh,
+    map: &'a fieldtex_param::TexelMap,
+    covered: &'a [usize],
+    carrier_of_texel: &'a [u32],
+    curve_points: &'a [((u32, [f64; 3]), f64)],
+    exemplar: &'a Image,
+    exemplar_features: &'a ExemplarFeatures,
+    texture: &'a Image,
+    field: &'a [[f64; 3]],
+    texels_per_pixel: f64,
+    seed: u64,
+}
+
+/// The metrics of an align run: texture optimisation levels, feature-line coverage,
+/// orientation error on the surface and contrast, into `report`.
+fn align_metrics(
+    m: &MetricInputs<'_>,
+    result: &fieldtex_texopt::TexOptResult,
+    feature_align: bool,
+    n_carriers: usize,
+    report: &mut Report,
+) -> Result<()> {
+    let size = m.map.width;
+    let coverage_samples: Vec<fieldtex_eval::CurveSample> = m
+        .curve_points
+        .iter()
+        .filter_map(|&((f, b), w)| {
+            let texel = m.map.texel_at(m.atlas_mesh, f, b)?;
+            let src = m.map.source[texel];
+            let k = *m.carrier_of_texel.get(src as usize)?;
+            // texopt puts pixel centres at i + 0.5, the distance map at i.
+            (k != u32::MAX).then(|| {
+                let c = result.source[k as usize];
+                fieldtex_eval::CurveSample {
+                    exemplar_xy: [c[0] as f64 - 0.5, c[1] as f64 - 0.5],
+                    length: w,
                 }
-            }
-        }
-    }
-    pts
-}
-
-/// Distance from each carrier to the nearest salient curve, within the band where paper
-/// A §5.2 constrains samples (half the largest patch up to 32 px, plus a margin); `+∞`
-/// beyond it.
-///
-/// Paper A uses the geodesic distance. Inside the band (at most 16 exemplar pixels) the
-/// 3-D distance to the curve equals it up to `O(κ d²)`, and unlike the heat method
-/// (whose distances are smoothed over a few edges near the source) it is exact at the
-/// curve, where the constraint matters most. The curves are sampled every `h / 4`, so
-/// the distance is within `h / 8` of the distance to the polyline.
-fn curve_distance_band(
-    positions: &[[f64; 3]],
-    curves: &[Vec<[f64; 3]>],
-    h: f64,
-    topts: &TexOptOptions,
-) -> Vec<f64> {
-    use fieldtex_core::vec3::{lerp, norm, sub};
-    // Coarse pyramid levels (w > 32) span whole structures; the constraint acts near
-    // the curve, within half a 32-px patch (the finest levels' reach).
-    let w = topts.patch_sizes.iter().copied().max().unwrap_or(8).min(32) as f64;
-    let band = (0.5 * w + 2.0) * h;
-    let step = 0.25 * h;
-    let mut pts = Vec::new();
-    for c in curves {
-        for s in c.windows(2) {
-            let len = norm(sub(s[1], s[0]));
-            if !len.is_finite() {
-                continue;
-            }
-            let n = ((len / step).ceil() as usize).clamp(1, 100_000);
-            for k in 0..=n {
-                pts.push(lerp(s[0], s[1], k as f64 / n as f64));
-            }
-        }
-    }
-    if pts.is_empty() {
-        return vec![f64::INFINITY; positions.len()];
-    }
-    let grid = UniformGrid::new(&pts, band);
-    positions
-        .par_iter()
-        .map(|&p| {
-            let mut best = f64::INFINITY;
-            grid.for_each_within(&pts, p, band, |_, d2| best = best.min(d2));
-            let d = best.sqrt();
-            if d <= band { d } else { f64::INFINITY }
+            })
         })
-        .collect()
+        .collect();
+    // Per-level wall times belong to the (nondeterministic) timings section.
+    let mut levels = serde_json::to_value(&result.levels).unwrap_or_default();
+    for (l, stats) in levels.as_array_mut().into_iter().flatten().zip(&result.levels) {
+        if let Some(o) = l.as_object_mut() {
+            o.remove("seconds");
+        }
+        report.timings_ms.push((format!("synthesis_w{}", stats.patch_size), stats.seconds * 1e3));
+    }
+    report.metric(
+        "texopt",
+        serde_json::json!({
+            "pixel_size": result.pixel_size,
+            "carriers": n_carriers,
+            "levels": levels,
+            "feature_align": feature_align,
+            "exemplar_feature_lines": m.exemplar_features.lines.len(),
+        }),
+    );
+    let coverage = fieldtex_eval::feature_line_coverage(
+        &coverage_samples,
+        &m.exemplar_features.distance,
+        m.exemplar_features.width,
+        m.exemplar_features.height,
+        &fieldtex_eval::FeatureCoverageOptions {
+            tolerance_px: 1.0,
+            toroidal: m.exemplar_features.toroidal,
+        },
+    )
+    .map_err(|e| Error::Internal(format!("feature coverage: {e}")))?;
+    report.metric("feature_coverage", &coverage);
+    // Orientation error on the surface, by tangent-plane resampling of the baked texture.
+    let internal = |e: fieldtex_eval::EvalError| Error::Internal(format!("metrics: {e}"));
+    let (exemplar, texture) = (m.exemplar, m.texture);
+    let orientation = report.time("metrics", || -> Result<_> {
+        let ebuf = fieldtex_eval::rgb_buffer(exemplar);
+        let eview = fieldtex_eval::ImageView::new(&ebuf, exemplar.width, exemplar.height, 3)
+            .map_err(internal)?;
+        let (exemplar_angle_deg, exemplar_coherence) =
+            fieldtex_eval::dominant_orientation(&eview).map_err(internal)?;
+        let tbuf = fieldtex_eval::rgb_buffer(texture);
+        let tview = fieldtex_eval::ImageView::new(&tbuf, size, size, 3).map_err(internal)?;
+        let uvs =
+            m.atlas_mesh.uvs.as_ref().ok_or_else(|| Error::Internal("atlas without UVs".into()))?;
+        let opts = fieldtex_eval::SurfaceOrientationOptions {
+            exemplar_angle_deg,
+            seed: m.seed,
+            ..Default::default()
+        };
+        let r = fieldtex_eval::surface_orientation_error(m.atlas_mesh, uvs, &tview, m.field, &opts)
+            .map_err(internal)?;
+        Ok(serde_json::json!({
+            "exemplar_angle_deg": exemplar_angle_deg,
+            "exemplar_coherence": exemplar_coherence,
+            "surface": r,
+        }))
+    })?;
+    report.metric("orientation_error", orientation);
+    // Contrast and crispness of the covered texels against the exemplar.
+    let sharpness = report.time("metrics_contrast", || -> Result<_> {
+        let tbuf = fieldtex_eval::rgb_buffer(texture);
+        let tview = fieldtex_eval::ImageView::new(&tbuf, size, size, 3).map_err(internal)?;
+        let ebuf = fieldtex_eval::rgb_buffer(exemplar);
+        let eview = fieldtex_eval::ImageView::new(&ebuf, exemplar.width, exemplar.height, 3)
+            .map_err(internal)?;
+        let mut mask = vec![false; size * size];
+        m.covered.iter().for_each(|&i| mask[i] = true);
+        fieldtex_eval::contrast_sharpness(&tview, Some(&mask), &eview, m.texels_per_pixel)
+            .map_err(internal)
+    })?;
+    report.metric("contrast", sharpness);
+    Ok(())
 }
 
-/// Texel index of a surface point, through the atlas UVs (`None` off the atlas).
-fn texel_of(mesh: &TriMesh, size: usize, triangle: u32, bary: [f64; 3]) -> Option<usize> {
-    let uv = mesh.uvs.as_ref()?;
-    let t = uv.indices.get(triangle as usize)?;
-    let (mut u, mut v) = (0.0, 0.0);
-    for k in 0..3 {
-        let c = uv.values.get(t[k] as usize)?;
-        u += bary[k] * c[0];
-        v += bary[k] * c[1];
+/// `--keep`: the salient curves as OBJ polylines and the field as a PLY with vertex
+/// attributes `fx fy fz`.
+fn write_curves_and_field(
+    stage: &Path,
+    mesh: &TriMesh,
+    curves: &[Vec<[f64; 3]>],
+    normals: Vec<[f64; 3]>,
+    field: &[[f64; 3]],
+) -> Result<()> {
+    fieldtex_io::write_obj_polylines(&stage.join("curves.obj"), curves)?;
+    let mut ply_mesh = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
+    ply_mesh.vertex_normals = Some(normals);
+    let comp = |k: usize| -> Vec<f32> { field.iter().map(|v| v[k] as f32).collect() };
+    let (fx, fy, fz) = (comp(0), comp(1), comp(2));
+    fieldtex_io::write_ply(
+        &stage.join("field.ply"),
+        &ply_mesh,
+        &[("fx", &fx), ("fy", &fy), ("fz", &fz)],
+        true,
+    )?;
+    Ok(())
+}
+
+/// Reads the mesh and the exemplar (or takes the in-memory ones) and fits the exemplar
+/// to the size policy; returns the mesh as loaded, the exemplar used and its reduction.
+fn load_inputs(
+    options: &AlignOptions,
+    given: Option<(&TriMesh, &Image)>,
+    report: &mut Report,
+) -> Result<(fieldtex_io::LoadedMesh, Image, usize)> {
+    let (loaded, exemplar) = match given {
+        None => {
+            let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
+            (loaded, fieldtex_io::read_image(&options.exemplar)?)
+        }
+        Some((mesh, exemplar)) => (
+            fieldtex_io::LoadedMesh {
+                mesh: mesh.clone(),
+                base_color: None,
+                warnings: Vec::new(),
+                format: fieldtex_io::MeshFormat::Obj,
+            },
+            exemplar.clone(),
+        ),
+    };
+    report.warnings.extend(loaded.warnings.iter().cloned());
+    // One exemplar policy for every pipeline: reduce above the size limit, with a warning.
+    let fitted = fieldtex_synth::fit_exemplar(exemplar, fieldtex_synth::MAX_EXEMPLAR_SIDE);
+    report.warnings.extend(fitted.warning.clone());
+    let (exemplar, reduction) = (fitted.image, fitted.factor);
+    let min_side = TexOptOptions::default().patch_sizes.into_iter().max().unwrap_or(8);
+    if exemplar.width < min_side || exemplar.height < min_side {
+        return Err(Error::bad_input(
+            Some(&options.exemplar),
+            format!(
+                "the exemplar is {}×{} pixels; align needs at least {min_side}×{min_side} (its largest patch)",
+                exemplar.width, exemplar.height
+            ),
+        ));
     }
-    let x = (u * size as f64).floor();
-    let y = ((1.0 - v) * size as f64).floor();
-    if !(x >= 0.0 && y >= 0.0 && x < size as f64 && y < size as f64) {
-        return None;
+    Ok((loaded, exemplar, reduction))
+}
+
+/// `#V` vectors, one per mesh vertex.
+type VertexVectors = Vec<[f64; 3]>;
+
+/// The curve-aligned field of paper A §4 (greedy or arbitrary orientation) with its
+/// metrics in `report`; returns the per-vertex field and the normals it was projected on.
+fn oriented_field(
+    mesh: &TriMesh,
+    curves: &[Vec<[f64; 3]>],
+    curves_source: &str,
+    options: &AlignOptions,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<(VertexVectors, VertexVectors)> {
+    let mode = if options.greedy {
+        OrientationMode::Greedy
+    } else {
+        OrientationMode::Arbitrary { seed: options.seed }
+    };
+    let mut copts = CurveOrientationOptions { mode, ..Default::default() };
+    if let Some(d) = options.direction {
+        copts.field.fallback = fieldtex_fields::UnconstrainedFallback::Direction(d);
     }
-    Some(y as usize * size + x as usize)
+    let oriented = report
+        .time("field", || orient_curves(mesh, curves, &copts, progress))
+        .map_err(|e| Error::Internal(format!("field: {e}")))?;
+    report.warnings.extend(oriented.warnings.iter().cloned());
+    report.warnings.extend(oriented.field.warnings.iter().cloned());
+    let field_metrics = fieldtex_fields::surface_field_metrics(
+        mesh,
+        &oriented.field.vectors,
+        &oriented.solver.constraints(),
+    )
+    .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
+    report.metric(
+        "field",
+        serde_json::json!({
+            "curves": curves.len(),
+            "curves_source": curves_source,
+            "orientation": if options.greedy { "greedy" } else { "arbitrary" },
+            "singularities": field_metrics.singularities.len(),
+            "index_sum": field_metrics.index_sum,
+            "dirichlet_energy": field_metrics.dirichlet_energy,
+            "alignment_mean_deg": field_metrics.alignment.mean_deg,
+        }),
+    );
+    let field = oriented.field.vectors.clone();
+    let normals = oriented.solver.normals().to_vec();
+    Ok((field, normals))
+}
+
+/// A texture-optimisation error as bad input (the exemplar's fault) or internal.
+fn texopt_error(e: TexOptError, exemplar: &Path) -> Error {
+    match e {
+        TexOptError::ExemplarTooSmall { .. }
+        | TexOptError::ExemplarBufferSize { .. }
+        | TexOptError::NonFiniteExemplar { .. } => Error::bad_input(Some(exemplar), e.to_string()),
+        e => Error::Internal(format!("texture optimisation: {e}")),
+    }
 }
 
 /// Runs `fieldtex align` into `out_dir` (module docs).
@@ -333,56 +521,14 @@ pub(crate) fn align_impl(
     progress: &dyn Progress,
 ) -> Result<Report> {
     let aopts = atlas_options(options.size, 4)?;
-    if !(options.scale.is_finite() && options.scale > 0.0 && options.scale <= 64.0) {
-        return Err(Error::bad_input(
-            None,
-            format!("--scale must be in (0, 64], got {}", options.scale),
-        ));
-    }
-    if let Some(d) = options.direction
-        && !(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0))
-    {
-        return Err(Error::bad_input(
-            None,
-            format!("--direction must be three finite numbers, not all zero; got {d:?}"),
-        ));
-    }
+    check_options(options)?;
     let mut inputs = vec![options.mesh.as_path(), options.exemplar.as_path()];
     if let Some(c) = &options.curves {
         inputs.push(c);
     }
     let mut report =
         Report::new("align", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let (loaded, exemplar) = match given {
-        None => {
-            let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
-            (loaded, fieldtex_io::read_image(&options.exemplar)?)
-        }
-        Some((mesh, exemplar)) => (
-            fieldtex_io::LoadedMesh {
-                mesh: mesh.clone(),
-                base_color: None,
-                warnings: Vec::new(),
-                format: fieldtex_io::MeshFormat::Obj,
-            },
-            exemplar.clone(),
-        ),
-    };
-    report.warnings.extend(loaded.warnings.iter().cloned());
-    // One exemplar policy for every pipeline: reduce above the size limit, with a warning.
-    let fitted = fieldtex_synth::fit_exemplar(exemplar, fieldtex_synth::MAX_EXEMPLAR_SIDE);
-    report.warnings.extend(fitted.warning.clone());
-    let (exemplar, reduction) = (fitted.image, fitted.factor);
-    let min_side = TexOptOptions::default().patch_sizes.into_iter().max().unwrap_or(8);
-    if exemplar.width < min_side || exemplar.height < min_side {
-        return Err(Error::bad_input(
-            Some(&options.exemplar),
-            format!(
-                "the exemplar is {}×{} pixels; align needs at least {min_side}×{min_side} (its largest patch)",
-                exemplar.width, exemplar.height
-            ),
-        ));
-    }
+    let (loaded, exemplar, reduction) = load_inputs(options, given, &mut report)?;
     for name in ["model.glb", "preview.png", "report.json", "curves.obj", "field.ply"] {
         fieldtex_io::ensure_not_input(&out_dir.join(name), &inputs)?;
     }
@@ -413,41 +559,8 @@ pub(crate) fn align_impl(
         salient_curves(&mesh, &options.mesh, options.curves.as_deref(), &mut warnings)
     })?;
     report.warnings.extend(warnings);
-    let mode = if options.greedy {
-        OrientationMode::Greedy
-    } else {
-        OrientationMode::Arbitrary { seed: options.seed }
-    };
-    let mut copts = CurveOrientationOptions { mode, ..Default::default() };
-    if let Some(d) = options.direction {
-        copts.field.fallback = fieldtex_fields::UnconstrainedFallback::Direction(d);
-    }
-    let oriented = report
-        .time("field", || orient_curves(&mesh, &curves, &copts, progress))
-        .map_err(|e| Error::Internal(format!("field: {e}")))?;
-    report.warnings.extend(oriented.warnings.iter().cloned());
-    report.warnings.extend(oriented.field.warnings.iter().cloned());
-    let field_metrics = fieldtex_fields::surface_field_metrics(
-        &mesh,
-        &oriented.field.vectors,
-        &oriented.solver.constraints(),
-    )
-    .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
-    report.metric(
-        "field",
-        serde_json::json!({
-            "curves": curves.len(),
-            "curves_source": curves_source,
-            "orientation": if options.greedy { "greedy" } else { "arbitrary" },
-            "singularities": field_metrics.singularities.len(),
-            "index_sum": field_metrics.index_sum,
-            "dirichlet_energy": field_metrics.dirichlet_energy,
-            "alignment_mean_deg": field_metrics.alignment.mean_deg,
-        }),
-    );
-    let field = oriented.field.vectors.clone();
-    let normals = oriented.solver.normals().to_vec();
-    drop(oriented);
+    let (field, normals) =
+        oriented_field(&mesh, &curves, &curves_source, options, &mut report, progress)?;
     crate::outputs::check_cancelled(progress)?;
     // 3. Atlas and colour carriers (covered texels).
     let size = options.size;
@@ -478,33 +591,18 @@ pub(crate) fn align_impl(
     let bvh =
         fieldtex_mesh::Bvh::build(&atlas.mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
     let h = topts.pixel_size.unwrap_or(1.0);
-    let curve_points = curve_surface_points(&bvh, &curves, h);
-    let exemplar_features = report.time("exemplar_features", || -> Result<ExemplarFeatures> {
-        match &options.exemplar_lines {
-            Some(p) => {
-                let lines: Vec<Vec<[f32; 2]>> = fieldtex_io::read_obj_polylines(p)?
-                    .into_iter()
-                    .map(|l| l.into_iter().map(|q| [q[0] as f32, q[1] as f32]).collect())
-                    .collect();
-                fieldtex_features::exemplar_features_from_polylines(
-                    exemplar.width,
-                    exemplar.height,
-                    &lines,
-                    topts.toroidal,
-                )
-                .map_err(|e| Error::bad_input(Some(p), e.to_string()))
-            }
-            None => fieldtex_features::detect_exemplar_feature_lines(
-                &exemplar,
-                &ExemplarFeatureOptions { toroidal: topts.toroidal, ..Default::default() },
-            )
-            .map_err(|e| Error::bad_input(Some(&options.exemplar), e.to_string())),
-        }
-    })?;
+    let curve_points = fieldtex_features::curve_surface_points(&bvh, &curves, h);
+    let exemplar_features = report
+        .time("exemplar_features", || exemplar_feature_lines(options, &exemplar, topts.toroidal))?;
     report.warnings.extend(exemplar_features.warnings.iter().cloned());
     let features = if options.feature_align && !curve_points.is_empty() {
-        let carrier_curve_distance = report
-            .time("curve_distance", || curve_distance_band(domain.positions(), &curves, h, &topts));
+        // Paper A constrains samples within half a patch of a curve; coarse levels
+        // (w > 32) span whole structures, so the band is half a 32-px patch plus 2 px.
+        let w = topts.patch_sizes.iter().copied().max().unwrap_or(8).min(32) as f64;
+        let band = (0.5 * w + 2.0) * h;
+        let carrier_curve_distance = report.time("curve_distance", || {
+            fieldtex_features::distance_to_curves(domain.positions(), &curves, 0.25 * h, band)
+        });
         Some(FeatureAlignment {
             exemplar_distance: exemplar_features.distance.clone(),
             carrier_curve_distance,
@@ -517,103 +615,25 @@ pub(crate) fn align_impl(
         .time("synthesis", || {
             fieldtex_texopt::optimise(&domain, &exemplar, &topts, features.as_ref(), progress)
         })
-        .map_err(|e| match e {
-            TexOptError::ExemplarTooSmall { .. }
-            | TexOptError::ExemplarBufferSize { .. }
-            | TexOptError::NonFiniteExemplar { .. } => {
-                Error::bad_input(Some(&options.exemplar), e.to_string())
-            }
-            e => Error::Internal(format!("texture optimisation: {e}")),
-        })?;
+        .map_err(|e| texopt_error(e, &options.exemplar))?;
     report.warnings.extend(result.warnings.iter().cloned());
     crate::outputs::check_cancelled(progress)?;
     let (texture, carrier_of_texel) = carrier_texture(&map, &covered, &result.colors);
     // 6. Metrics.
-    let coverage_samples: Vec<fieldtex_eval::CurveSample> = curve_points
-        .iter()
-        .filter_map(|&((f, b), w)| {
-            let texel = texel_of(&atlas.mesh, size, f, b)?;
-            let src = map.source[texel];
-            let k = *carrier_of_texel.get(src as usize)?;
-            // texopt puts pixel centres at i + 0.5, the distance map at i.
-            (k != u32::MAX).then(|| {
-                let c = result.source[k as usize];
-                fieldtex_eval::CurveSample {
-                    exemplar_xy: [c[0] as f64 - 0.5, c[1] as f64 - 0.5],
-                    length: w,
-                }
-            })
-        })
-        .collect();
-    // Per-level wall times belong to the (nondeterministic) timings section.
-    let mut levels = serde_json::to_value(&result.levels).unwrap_or_default();
-    for (l, stats) in levels.as_array_mut().into_iter().flatten().zip(&result.levels) {
-        if let Some(o) = l.as_object_mut() {
-            o.remove("seconds");
-        }
-        report.timings_ms.push((format!("synthesis_w{}", stats.patch_size), stats.seconds * 1e3));
-    }
-    report.metric(
-        "texopt",
-        serde_json::json!({
-            "pixel_size": result.pixel_size,
-            "carriers": carriers.len(),
-            "levels": levels,
-            "feature_align": features.is_some(),
-            "exemplar_feature_lines": exemplar_features.lines.len(),
-        }),
-    );
-    let coverage = fieldtex_eval::feature_line_coverage(
-        &coverage_samples,
-        &exemplar_features.distance,
-        exemplar_features.width,
-        exemplar_features.height,
-        &fieldtex_eval::FeatureCoverageOptions {
-            tolerance_px: 1.0,
-            toroidal: exemplar_features.toroidal,
-        },
-    )
-    .map_err(|e| Error::Internal(format!("feature coverage: {e}")))?;
-    report.metric("feature_coverage", &coverage);
-    // Orientation error on the surface, by tangent-plane resampling of the baked texture.
-    let internal = |e: fieldtex_eval::EvalError| Error::Internal(format!("metrics: {e}"));
-    let orientation = report.time("metrics", || -> Result<_> {
-        let ebuf = fieldtex_eval::rgb_buffer(&exemplar);
-        let eview = fieldtex_eval::ImageView::new(&ebuf, exemplar.width, exemplar.height, 3)
-            .map_err(internal)?;
-        let (exemplar_angle_deg, exemplar_coherence) =
-            fieldtex_eval::dominant_orientation(&eview).map_err(internal)?;
-        let tbuf = fieldtex_eval::rgb_buffer(&texture);
-        let tview = fieldtex_eval::ImageView::new(&tbuf, size, size, 3).map_err(internal)?;
-        let uvs =
-            atlas.mesh.uvs.as_ref().ok_or_else(|| Error::Internal("atlas without UVs".into()))?;
-        let opts = fieldtex_eval::SurfaceOrientationOptions {
-            exemplar_angle_deg,
-            seed: options.seed,
-            ..Default::default()
-        };
-        let r = fieldtex_eval::surface_orientation_error(&atlas.mesh, uvs, &tview, &field, &opts)
-            .map_err(internal)?;
-        Ok(serde_json::json!({
-            "exemplar_angle_deg": exemplar_angle_deg,
-            "exemplar_coherence": exemplar_coherence,
-            "surface": r,
-        }))
-    })?;
-    report.metric("orientation_error", orientation);
-    // Contrast and crispness of the covered texels against the exemplar.
-    let sharpness = report.time("metrics_contrast", || -> Result<_> {
-        let tbuf = fieldtex_eval::rgb_buffer(&texture);
-        let tview = fieldtex_eval::ImageView::new(&tbuf, size, size, 3).map_err(internal)?;
-        let ebuf = fieldtex_eval::rgb_buffer(&exemplar);
-        let eview = fieldtex_eval::ImageView::new(&ebuf, exemplar.width, exemplar.height, 3)
-            .map_err(internal)?;
-        let mut mask = vec![false; size * size];
-        covered.iter().for_each(|&i| mask[i] = true);
-        fieldtex_eval::contrast_sharpness(&tview, Some(&mask), &eview, texels_per_pixel)
-            .map_err(internal)
-    })?;
-    report.metric("contrast", sharpness);
+    let inputs = MetricInputs {
+        atlas_mesh: &atlas.mesh,
+        map: &map,
+        covered: &covered,
+        carrier_of_texel: &carrier_of_texel,
+        curve_points: &curve_points,
+        exemplar: &exemplar,
+        exemplar_features: &exemplar_features,
+        texture: &texture,
+        field: &field,
+        texels_per_pixel,
+        seed: options.seed,
+    };
+    align_metrics(&inputs, &result, features.is_some(), carriers.len(), &mut report)?;
     // 7. Outputs.
     report.time("write", || super::write_model(stage, &atlas.mesh, Some(&texture)))?;
     let preview = report.time("preview", || {
@@ -621,17 +641,7 @@ pub(crate) fn align_impl(
     });
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     if options.keep {
-        fieldtex_io::write_obj_polylines(&stage.join("curves.obj"), &curves)?;
-        let mut ply_mesh = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
-        ply_mesh.vertex_normals = Some(normals.clone());
-        let comp = |k: usize| -> Vec<f32> { field.iter().map(|v| v[k] as f32).collect() };
-        let (fx, fy, fz) = (comp(0), comp(1), comp(2));
-        fieldtex_io::write_ply(
-            &stage.join("field.ply"),
-            &ply_mesh,
-            &[("fx", &fx), ("fy", &fy), ("fz", &fz)],
-            true,
-        )?;
+        write_curves_and_field(stage, &mesh, &curves, normals, &field)?;
     }
     if let Some(extra) = extra {
         extra(stage, &mut report)?;

@@ -103,8 +103,8 @@ pub fn field_file(
     warnings.extend(result.field.warnings.iter().cloned());
     let metrics = surface_field_metrics(&mesh, &result.field.vectors, &result.solver.constraints())
         .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
-    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let chi = topo.euler_characteristic();
+    // The metrics' topology gives χ (no second `Topology::build` of the same mesh).
+    let chi = metrics.euler_characteristic;
     // field.ply: positions, the solver's normals, the field.
     let mut ply_mesh = fieldtex_mesh::TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
     ply_mesh.vertex_normals = Some(result.solver.normals().to_vec());

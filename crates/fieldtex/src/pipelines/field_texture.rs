@@ -3,6 +3,7 @@
 //! synthesis as [`super::orient::orient`] (paper D), without files or metrics.
 
 use super::orient::{FieldSource, OrientOptions};
+use super::synthesis::AnalysisCache;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use std::path::PathBuf;
@@ -27,12 +28,30 @@ impl Default for FieldTextureOptions {
 /// (`width · height` unit vectors `(dx, dy)`, row-major, x right, y down). Returns the
 /// texture and a report holding the stage timings (`analysis`, `synthesis`) and
 /// whether the exemplar analysis came from the cache.
+///
+/// The exemplar analysis goes through the process-wide [`AnalysisCache::process`]; a
+/// caller that keeps its own cache uses [`synthesize_field_texture_with`].
 pub fn synthesize_field_texture(
     exemplar: &Image,
     field: &[[f32; 2]],
     width: usize,
     height: usize,
     options: &FieldTextureOptions,
+    progress: &dyn Progress,
+) -> Result<(Image, Report)> {
+    let cache = AnalysisCache::process();
+    synthesize_field_texture_with(exemplar, field, width, height, options, cache, progress)
+}
+
+/// [`synthesize_field_texture`] with the caller's own analysis cache (one per studio
+/// session or exemplar set, say).
+pub fn synthesize_field_texture_with(
+    exemplar: &Image,
+    field: &[[f32; 2]],
+    width: usize,
+    height: usize,
+    options: &FieldTextureOptions,
+    cache: &AnalysisCache,
     progress: &dyn Progress,
 ) -> Result<(Image, Report)> {
     if width == 0 || height == 0 || field.len() != width * height {
@@ -69,6 +88,7 @@ pub fn synthesize_field_texture(
         height,
         per_pixel,
         &orient,
+        cache,
         &mut report,
         progress,
     )?;

@@ -226,6 +226,7 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         n,
         per_pixel,
         options,
+        super::synthesis::AnalysisCache::process(),
         &mut report,
         progress,
     )
@@ -261,8 +262,9 @@ pub(crate) fn orient_in_memory(
     let n = options.size;
     // In-memory exemplars (the demo's procedural ones) are never reduced.
     let per_pixel = options.exemplar_pixels_per_output_pixel(1);
+    let cache = super::synthesis::AnalysisCache::process();
     let synth = super::synthesis::synthesize_image(
-        exemplar, &field, n, n, per_pixel, options, report, progress,
+        exemplar, &field, n, n, per_pixel, options, cache, report, progress,
     )?;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     report.metric("designed_singularities", &designed);

@@ -152,7 +152,9 @@ pub(crate) fn orient_patch(
     report.metric("chart_coverage", n_inside as f64 / (n * n) as f64);
     let aopts = fieldtex_synth::AnalysisOptions::default();
     let (analysis, cached) = report
-        .time("analysis", || super::synthesis::cached_analysis(&exemplar, &aopts, progress))
+        .time("analysis", || {
+            super::synthesis::AnalysisCache::process().analysis(&exemplar, &aopts, progress)
+        })
         .map_err(|e| Error::bad_input(Some(&options.exemplar), format!("exemplar: {e}")))?;
     report.metric("analysis_cached", cached);
     let domain = ImageDomain::new(n, n, jac)

@@ -1,5 +1,5 @@
-//! Glue between the pipelines and `fieldtex-synth`: exemplar analysis with an
-//! in-process cache, and image-domain synthesis from a per-pixel direction field.
+//! Glue between the pipelines and `fieldtex-synth`: exemplar analysis through an
+//! explicit [`AnalysisCache`], and image-domain synthesis from a per-pixel direction field.
 
 use super::orient::OrientOptions;
 use crate::{Error, Progress, Report, Result};
@@ -9,9 +9,52 @@ use fieldtex_synth::{
 };
 use std::sync::{Arc, Mutex};
 
-/// The most recent analysis, keyed by a hash of the exemplar pixels and the options:
-/// interactive callers that re-synthesise with a new field reuse it.
-static ANALYSIS_CACHE: Mutex<Option<(u64, Arc<ExemplarAnalysis>)>> = Mutex::new(None);
+/// A cache of the most recent exemplar analysis, keyed by a hash of the exemplar pixels
+/// and the analysis options: an explicit object that an interactive caller (the
+/// studio) keeps and passes to each re-synthesis with a new field, so the analysis is
+/// computed once per exemplar. One-shot pipelines (`orient`, the curved patch, the
+/// field texture without a cache of its own) use [`AnalysisCache::process`], the
+/// instance shared by the whole process, which only saves work when a process runs
+/// several of them on the same exemplar.
+#[derive(Debug, Default)]
+pub struct AnalysisCache {
+    slot: Mutex<Option<(u64, Arc<ExemplarAnalysis>)>>,
+}
+
+/// The instance behind [`AnalysisCache::process`].
+static PROCESS_CACHE: AnalysisCache = AnalysisCache::new();
+
+impl AnalysisCache {
+    /// An empty cache.
+    pub const fn new() -> Self {
+        Self { slot: Mutex::new(None) }
+    }
+
+    /// The cache shared by every caller in this process that does not keep its own.
+    pub fn process() -> &'static AnalysisCache {
+        &PROCESS_CACHE
+    }
+
+    /// The analysis of `exemplar` with `options`, from the cache when the last request
+    /// had the same exemplar and options (the `bool`), else computed and kept.
+    pub fn analysis(
+        &self,
+        exemplar: &Image,
+        options: &AnalysisOptions,
+        progress: &dyn Progress,
+    ) -> std::result::Result<(Arc<ExemplarAnalysis>, bool), fieldtex_synth::SynthError> {
+        let key = analysis_key(exemplar, options);
+        let mut guard = self.slot.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((k, a)) = guard.as_ref()
+            && *k == key
+        {
+            return Ok((a.clone(), true));
+        }
+        let a = Arc::new(ExemplarAnalysis::new(exemplar, options, progress)?);
+        *guard = Some((key, a.clone()));
+        Ok((a, false))
+    }
+}
 
 fn analysis_key(exemplar: &Image, options: &AnalysisOptions) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -32,24 +75,6 @@ fn analysis_key(exemplar: &Image, options: &AnalysisOptions) -> u64 {
     h
 }
 
-/// The analysis of `exemplar`, computed once per exemplar and options.
-pub(crate) fn cached_analysis(
-    exemplar: &Image,
-    options: &AnalysisOptions,
-    progress: &dyn Progress,
-) -> std::result::Result<(Arc<ExemplarAnalysis>, bool), fieldtex_synth::SynthError> {
-    let key = analysis_key(exemplar, options);
-    let mut guard = ANALYSIS_CACHE.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((k, a)) = guard.as_ref()
-        && *k == key
-    {
-        return Ok((a.clone(), true));
-    }
-    let a = Arc::new(ExemplarAnalysis::new(exemplar, options, progress)?);
-    *guard = Some((key, a.clone()));
-    Ok((a, false))
-}
-
 /// Synthesises a `width × height` texture whose exemplar x axis follows `field`, at
 /// `per_pixel` exemplar pixels per output pixel.
 #[allow(clippy::too_many_arguments)]
@@ -60,12 +85,13 @@ pub(crate) fn synthesize_image(
     height: usize,
     per_pixel: f64,
     options: &OrientOptions,
+    cache: &AnalysisCache,
     report: &mut Report,
     progress: &dyn Progress,
 ) -> Result<Image> {
     let aopts = AnalysisOptions::default();
     let (analysis, cached) = report
-        .time("analysis", || cached_analysis(exemplar, &aopts, progress))
+        .time("analysis", || cache.analysis(exemplar, &aopts, progress))
         .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
     report.metric("analysis_cached", cached);
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
