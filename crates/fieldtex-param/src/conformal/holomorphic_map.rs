@@ -21,7 +21,8 @@ use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
 use super::critical_trajectories::critical_trajectories;
 use super::harmonic_one_forms::{face_vectors, harmonic_projection};
 use super::holomorphic_basis::conjugates;
-use super::periodic_uv::{Lattice, along2, integrate, reduce_faces, signed_area};
+use super::periodic_uv::{Lattice, along2, integrate, reduce_basis, reduce_faces, signed_area};
+use super::seam_placement::shortest_level;
 use super::translation_patches::{PatchOptions, translation_patches};
 use super::tree_cotree::tree_cotree;
 use super::uniform_form::most_uniform_form;
@@ -35,6 +36,8 @@ use fieldtex_mesh::{CotanOptions, Topology, TriMesh, cotan_face_weights};
 pub const TRAJECTORY_LENGTH: f64 = 0.15;
 /// Largest patch piece side, in units of `√(UV area)`.
 pub const PIECE_SIDE: f64 = 1.0;
+/// Candidate levels tried for each period seam of a torus image.
+pub const SEAM_LEVELS: usize = 64;
 /// Objective evaluations of the most-uniform-form search.
 pub const UNIFORM_FORM_EVALS: usize = 400;
 /// Face rings drawn as ghosts beyond each cut (image margins, §4.2).
@@ -173,8 +176,7 @@ pub fn holomorphic_map_with(
         let de = d[e as usize];
         [b0[0] + de[0] - b1[0], b0[1] + de[1] - b1[1]]
     };
-    let z1 = period(tc.generators[0]);
-    let z2 = period(tc.generators[1]);
+    let (z1, z2) = reduce_basis(period(tc.generators[0]), period(tc.generators[1]));
     let len1 = (z1[0] * z1[0] + z1[1] * z1[1]).sqrt();
     if len1 <= 0.0 || !len1.is_finite() {
         return Err(conformal_error("the first period of the holomorphic 1-form vanishes"));
@@ -207,6 +209,18 @@ pub fn holomorphic_map_with(
     }
     b[0] = b[0].rem_euclid(len1);
     let lattice = Lattice { a: Some(len1), b: Some(b) };
+    // Seams along the shortest level curves: first v (then reduce in y), then u.
+    let shift = |corner: &mut Vec<[[f64; 2]; 3]>, base: &mut Vec<[f64; 2]>, s: [f64; 2]| {
+        for p in corner.iter_mut().flat_map(|c| c.iter_mut()).chain(base.iter_mut()) {
+            p[0] -= s[0];
+            p[1] -= s[1];
+        }
+    };
+    let cy = shortest_level(&corner, tris, &mesh.positions, 1, b[1], SEAM_LEVELS);
+    shift(&mut corner, &mut base, [0.0, cy]);
+    reduce_faces(&mut corner, &Lattice { a: None, b: Some(b) });
+    let cx = shortest_level(&corner, tris, &mesh.positions, 0, len1, SEAM_LEVELS);
+    shift(&mut corner, &mut base, [cx, 0.0]);
     reduce_faces(&mut corner, &lattice);
     Ok(ComponentMap {
         method: ConformalMethod::HolomorphicTorus,

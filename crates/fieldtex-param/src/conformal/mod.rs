@@ -28,6 +28,7 @@ pub mod holomorphic_basis;
 pub mod holomorphic_map;
 pub mod mass_spring;
 pub mod periodic_uv;
+pub mod seam_placement;
 pub mod slit_cylinder;
 pub mod translation_patches;
 pub mod tree_cotree;
@@ -43,6 +44,10 @@ use crate::ParamError;
 use fieldtex_core::{Progress, Warning};
 use fieldtex_mesh::{Topology, TriMesh};
 use serde::Serialize;
+
+/// Holes whose boundary is at least this many `√area` long stay open for the double
+/// cover; smaller ones are capped.
+pub const LARGE_HOLE: f64 = 0.3;
 
 /// Vertex rings around slit and zero points flagged as near a singularity.
 pub const NEAR_RINGS: usize = 3;
@@ -273,14 +278,41 @@ pub fn global_conformal(
         let chi = capped.mesh.n_vertices() as i64 - ctopo.n_edges() as i64
             + capped.mesh.n_triangles() as i64;
         let genus = ((2 - chi).max(0) / 2) as usize;
-        // Open surfaces whose double cover has genus ≥ 2 use it (paper §3); a disk or an
-        // annulus (double genus 0 or 1) stays capped: the slit cylinder then gives the
-        // map the double cover would give for an annulus.
-        let cover_genus = 2 * genus + capped.n_holes;
-        let cover_genus = cover_genus.saturating_sub(1);
+        // Open surfaces use the double cover (paper §3) when the holes that count make
+        // its genus ≥ 2. A hole counts when its boundary is at least `LARGE_HOLE` √area
+        // long; smaller holes stay capped (doubled, a tiny hole becomes a thin handle
+        // whose conformal factor is extreme). A disk or an annulus (double genus 0 or
+        // 1) stays capped: the slit cylinder gives the map an annulus's double gives.
+        let sub_area: f64 = (0..sub.n_triangles())
+            .map(|f| {
+                let p = sub.triangle_positions(f);
+                0.5 * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
+                    fieldtex_core::vec3::sub(p[1], p[0]),
+                    fieldtex_core::vec3::sub(p[2], p[0]),
+                ))
+            })
+            .sum();
+        let large: Vec<u32> = capped
+            .caps
+            .iter()
+            .filter(|c| c.1 >= LARGE_HOLE * sub_area.sqrt())
+            .map(|c| c.0)
+            .collect();
+        let cover_genus = (2 * genus + large.len()).saturating_sub(1);
         let mut double = None;
-        if manifold && capped.n_holes > 0 && cover_genus >= 2 && faces.len() >= 8 {
-            let dc = double_cover::double_cover(&sub);
+        if manifold && !large.is_empty() && cover_genus >= 2 && faces.len() >= 8 {
+            // The input with its small holes capped, large holes open, doubled.
+            let partly = TriMesh::new(
+                capped.mesh.positions.clone(),
+                capped
+                    .mesh
+                    .triangles
+                    .iter()
+                    .copied()
+                    .filter(|t| !t.iter().any(|v| large.contains(v)))
+                    .collect(),
+            );
+            let dc = double_cover::double_cover(&partly);
             match holomorphic_map::holomorphic_map(&dc.mesh, cover_genus, faces.len()) {
                 Ok(m) => double = Some((dc, m)),
                 Err(e) => warnings.push(Warning::new(
