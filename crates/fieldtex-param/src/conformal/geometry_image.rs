@@ -42,6 +42,8 @@ pub struct GeometryImage {
     /// across a cut between patches: margin texels drawn from [`super::Ghost`]s and the
     /// texels they continue (both directions listed).
     pub links: Vec<(u32, u32)>,
+    /// `(margin texel, texel it continues, face)` for every ghost-drawn margin texel.
+    pub margin_copies: Vec<(u32, u32, u32)>,
 }
 
 impl GeometryImage {
@@ -187,6 +189,8 @@ impl GeometryImage {
         }
         // Ghosts fill uncovered margin texels and link them to the texels they continue.
         let mut links: Vec<(u32, u32)> = Vec::new();
+        let mut margin_copies: Vec<(u32, u32, u32)> = Vec::new();
+        let real: Vec<bool> = tau.iter().map(|t| !t.is_nan()).collect();
         for (f, shift, cu) in &ghost_corners {
             let f = *f;
             let fl = face_lambda[f];
@@ -221,6 +225,10 @@ impl GeometryImage {
                     if qx < 0.0 || qy < 0.0 || qx >= width as f64 || qy >= height as f64 {
                         continue;
                     }
+                    let j = qy as usize * width + qx as usize;
+                    if !real[j] {
+                        continue; // rounding landed off the surface: leave it free
+                    }
                     let l1 = ((px - t[0][0]) * (t[2][1] - t[0][1])
                         - (py - t[0][1]) * (t[2][0] - t[0][0]))
                         / det;
@@ -230,9 +238,9 @@ impl GeometryImage {
                     let (l1, l2) = (l1.clamp(0.0, 1.0), l2.clamp(0.0, 1.0));
                     let l0 = (1.0 - l1 - l2).max(0.0);
                     tau[i] = ((l0 * tv[0] + l1 * tv[1] + l2 * tv[2]) / (l0 + l1 + l2)) as f32;
-                    let j = qy as usize * width + qx as usize;
                     links.push((i as u32, j as u32));
                     links.push((j as u32, i as u32));
+                    margin_copies.push((i as u32, j as u32, f as u32));
                 }
             });
         }
@@ -251,6 +259,17 @@ impl GeometryImage {
             face_lambda,
             face_area,
             links,
+            margin_copies,
+        }
+    }
+
+    /// Boundary consistency after synthesis (§4.2: "copied to fill P1 of geometry
+    /// image 2"): every ghost-drawn margin texel takes the colour of the texel it
+    /// continues, so the texture matches across every cut whatever order the synthesis
+    /// visited the two sides in. `pixels` is `width × height`, row-major.
+    pub fn copy_margins<T: Copy>(&self, pixels: &mut [T]) {
+        for &(g, r, _) in &self.margin_copies {
+            pixels[g as usize] = pixels[r as usize];
         }
     }
 

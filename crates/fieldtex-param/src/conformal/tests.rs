@@ -198,6 +198,29 @@ fn genus_two_is_cut_into_patches_along_critical_trajectories() {
     let (a, b) = img.links[0];
     img.partners(a as usize % img.width, a as usize / img.width, &mut out);
     assert!(out.contains(&(b as usize % img.width, b as usize / img.width)));
+    // Every margin texel continues a texel that shows the same face (within the span
+    // rasteriser's edge texels and the ½-texel rounding: 1.5 texels; a wrong shift is
+    // off by a whole patch), and after the copy the margins match their partners.
+    assert!(!img.margin_copies.is_empty());
+    for &(g, r, f) in &img.margin_copies {
+        let p = [(r as usize % img.width) as f64 + 0.5, (r as usize / img.width) as f64 + 0.5];
+        let t = img.corner_texel[f as usize];
+        let d = (0..3)
+            .map(|k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let e = [b[0] - a[0], b[1] - a[1]];
+                // Signed distance to the edge's line (positive inside; texel rows go down,
+                // so the triangle is clockwise in texel coordinates).
+                ((p[0] - a[0]) * e[1] - (p[1] - a[1]) * e[0]) / (e[0] * e[0] + e[1] * e[1]).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(d > -1.5, "margin texel {g} → {r} lies {d} texels outside face {f}");
+    }
+    let mut pixels: Vec<u32> = (0..(img.width * img.height) as u32).collect();
+    img.copy_margins(&mut pixels);
+    for &(g, r, _) in &img.margin_copies {
+        assert_eq!(pixels[g as usize], pixels[r as usize]);
+    }
 }
 
 #[test]

@@ -245,8 +245,10 @@ pub fn conformal(
             seed: stream_seed(options.seed, "conformal-image", c.component as u64),
             ..qbase
         };
-        let (image, st) = quilt(&levels, &target, &q, progress);
-        quilt_stats.push(json!({"component": c.component, "stats": st}));
+        let (mut image, st) = quilt(&levels, &target, &q, progress);
+        // Margins across patch cuts take their partners' colours (§4.2).
+        img.copy_margins(&mut image.pixels);
+        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len()}));
         let faces = c.faces.iter().copied().zip(img.corner_texel.iter().copied()).collect();
         blocks.push(Block {
             image,
