@@ -257,3 +257,25 @@ fn a_disk_with_two_holes_is_mapped_through_its_double_cover() {
     // A coarse flat grid with sharp corners (conjugate misfit ~26 %), hence the bound.
     assert!(distortion(c).angle_mean < 1.3, "{}", distortion(c).angle_mean);
 }
+
+#[test]
+fn genus_two_patches_are_the_same_for_one_and_two_threads() {
+    let mesh = genus_two_slab(3);
+    let run = |t: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
+        pool.install(|| {
+            let c = global_conformal(&mesh, &NoProgress).unwrap().0.remove(0);
+            (c.corner_uv, c.map.patch, c.map.ghosts.len())
+        })
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a.1, b.1);
+    assert_eq!(a.2, b.2);
+    assert!(
+        a.0.iter()
+            .flatten()
+            .flatten()
+            .zip(b.0.iter().flatten().flatten())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    );
+}
