@@ -8,7 +8,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
 runs=1
 exemplar=pebbles_Rocks002
-meshes="stanford-bunny torus rocker-arm fertility"
+meshes="stanford-bunny torus rocker-arm fertility demosthenes-bust-open"
 while [ $# -gt 0 ]; do
   case "$1" in
     --runs) runs="$2"; shift 2 ;;

@@ -203,5 +203,12 @@ fn zero_points_of_shared_meshes() {
         assert_eq!(c["zero_points"].as_u64(), Some(zeros), "{name}: {:?}", c["zero_point_indices"]);
         assert_eq!(z, -(zeros as i64), "{name}: zero-point indices sum to 2 − 2g");
         assert_eq!(r["metrics"]["distortion_all_faces"]["flipped_triangles"], 0, "{name}");
+        assert_eq!(c["distortion"]["flipped"], 0, "{name}");
+        if genus >= 2 {
+            // Genus ≥ 2: critical-trajectory patches, not the fallback atlas.
+            assert_eq!(c["method"], "critical-trajectory-patches", "{name}");
+            assert!(c["critical_trajectories"].as_u64().unwrap() >= 6, "{name}");
+            assert!(c["margin_links"].as_u64().unwrap() > 0, "{name}");
+        }
     }
 }

@@ -38,6 +38,12 @@ pub struct GeometryImage {
     pub face_lambda: Vec<f64>,
     /// Per face: surface area.
     pub face_area: Vec<f64>,
+    /// Texel pairs `(a, b)` (row-major indices, sorted) that show the same surface point
+    /// across a cut between patches: margin texels drawn from [`super::Ghost`]s and the
+    /// texels they continue (both directions listed).
+    pub links: Vec<(u32, u32)>,
+    /// `(margin texel, texel it continues, face)` for every ghost-drawn margin texel.
+    pub margin_copies: Vec<(u32, u32, u32)>,
 }
 
 impl GeometryImage {
@@ -66,7 +72,19 @@ impl GeometryImage {
         let h_in = (dy * sy).round() as usize;
         // Margin: how far corners reach outside the domain, plus filtering slack.
         let mut spill: f64 = 0.0;
-        for cu in &component.corner_uv {
+        let nf = component.faces.len();
+        let ghost_corners: Vec<(usize, [f64; 2], [[f64; 2]; 3])> = component
+            .map
+            .ghosts
+            .iter()
+            .filter(|g| (g.face as usize) < nf)
+            .map(|g| {
+                let c = component.corner_uv[g.face as usize]
+                    .map(|p| [p[0] - g.shift[0], p[1] - g.shift[1]]);
+                (g.face as usize, g.shift, c)
+            })
+            .collect();
+        for cu in component.corner_uv.iter().chain(ghost_corners.iter().map(|g| &g.2)) {
             for p in cu {
                 spill = spill
                     .max((x0 - p[0]) * sx)
@@ -84,7 +102,6 @@ impl GeometryImage {
             .map(|cu| cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]))
             .collect();
         let mesh = &component.local_mesh;
-        let nf = component.faces.len();
         let mut face_lambda = vec![f64::NAN; nf];
         let mut face_area = vec![0.0; nf];
         let mut vtau = vec![0.0; mesh.n_vertices()];
@@ -170,6 +187,65 @@ impl GeometryImage {
                 });
             }
         }
+        // Ghosts fill uncovered margin texels and link them to the texels they continue.
+        let mut links: Vec<(u32, u32)> = Vec::new();
+        let mut margin_copies: Vec<(u32, u32, u32)> = Vec::new();
+        let real: Vec<bool> = tau.iter().map(|t| !t.is_nan()).collect();
+        for (f, shift, cu) in &ghost_corners {
+            let f = *f;
+            let fl = face_lambda[f];
+            let tv = mesh.triangles[f].map(|v| vtau[v as usize]);
+            let tv = if tv.iter().any(|t| t.is_nan()) {
+                if fl.is_nan() {
+                    continue;
+                }
+                [1.0 / fl; 3]
+            } else {
+                tv
+            };
+            let t = cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]);
+            let (dx, dy) = (shift[0] * sx, -shift[1] * sy);
+            let det = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
+                - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]);
+            if det.abs() <= 0.0 {
+                continue;
+            }
+            triangle_row_spans(t, 0.0, |row, c0, c1| {
+                if row < 0 || row >= height as i64 {
+                    return;
+                }
+                let py = row as f64 + 0.5;
+                for col in c0.max(0)..=c1.min(width as i64 - 1) {
+                    let i = row as usize * width + col as usize;
+                    if !tau[i].is_nan() {
+                        continue;
+                    }
+                    let px = col as f64 + 0.5;
+                    let (qx, qy) = ((px + dx).floor(), (py + dy).floor());
+                    if qx < 0.0 || qy < 0.0 || qx >= width as f64 || qy >= height as f64 {
+                        continue;
+                    }
+                    let j = qy as usize * width + qx as usize;
+                    if !real[j] {
+                        continue; // rounding landed off the surface: leave it free
+                    }
+                    let l1 = ((px - t[0][0]) * (t[2][1] - t[0][1])
+                        - (py - t[0][1]) * (t[2][0] - t[0][0]))
+                        / det;
+                    let l2 = ((t[1][0] - t[0][0]) * (py - t[0][1])
+                        - (t[1][1] - t[0][1]) * (px - t[0][0]))
+                        / det;
+                    let (l1, l2) = (l1.clamp(0.0, 1.0), l2.clamp(0.0, 1.0));
+                    let l0 = (1.0 - l1 - l2).max(0.0);
+                    tau[i] = ((l0 * tv[0] + l1 * tv[1] + l2 * tv[2]) / (l0 + l1 + l2)) as f32;
+                    links.push((i as u32, j as u32));
+                    links.push((j as u32, i as u32));
+                    margin_copies.push((i as u32, j as u32, f as u32));
+                }
+            });
+        }
+        links.sort_unstable();
+        links.dedup();
         Self {
             width,
             height,
@@ -182,12 +258,34 @@ impl GeometryImage {
             corner_texel,
             face_lambda,
             face_area,
+            links,
+            margin_copies,
         }
     }
 
-    /// Texels that show the same surface point as `(i, j)` (its lattice translates that
-    /// fall inside the canvas).
+    /// Boundary consistency after synthesis (§4.2: "copied to fill P1 of geometry
+    /// image 2"): every ghost-drawn margin texel takes the colour of the texel it
+    /// continues, so the texture matches across every cut whatever order the synthesis
+    /// visited the two sides in. `pixels` is `width × height`, row-major.
+    pub fn copy_margins<T: Copy>(&self, pixels: &mut [T]) {
+        for &(g, r, _) in &self.margin_copies {
+            pixels[g as usize] = pixels[r as usize];
+        }
+    }
+
+    /// Texels that show the same surface point as `(i, j)`: its lattice translates that
+    /// fall inside the canvas, and its [`Self::links`].
     pub fn partners(&self, i: usize, j: usize, out: &mut Vec<(usize, usize)>) {
+        if !self.links.is_empty() {
+            let t = (j * self.width + i) as u32;
+            let lo = self.links.partition_point(|l| l.0 < t);
+            for l in &self.links[lo..] {
+                if l.0 != t {
+                    break;
+                }
+                out.push((l.1 as usize % self.width, l.1 as usize / self.width));
+            }
+        }
         let Some(px) = self.period_x else {
             return;
         };

@@ -11,24 +11,58 @@
 //! `z2` — one conformal geometry image without zero points.
 //!
 //! For `g ≥ 2` the paper picks the most uniform combination (Jin, Wang, Yau & Gu 2004)
-//! and cuts along critical trajectories. Implemented here: the basis, its conjugates and
-//! the zero points of the basis form with the most uniform `|φ|` (a search over the
-//! `2g` basis forms — a substitute for Jin et al.'s optimisation); the trajectory
-//! patches are **not** implemented, the caller falls back to a chart atlas.
+//! and cuts along critical trajectories. Implemented here: the basis, its conjugates,
+//! the combination with the most uniform conformal factor ([`super::uniform_form`], a
+//! compass search — a substitute for Jin et al.'s solver) and its zero points; then the critical
+//! horizontal trajectories through the zero points ([`super::critical_trajectories`])
+//! cut the surface into patches, each mapped by `∫φ` ([`super::translation_patches`]).
 
 use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
+use super::critical_trajectories::critical_trajectories;
 use super::harmonic_one_forms::{face_vectors, harmonic_projection};
 use super::holomorphic_basis::conjugates;
-use super::periodic_uv::{Lattice, integrate, reduce_faces, signed_area};
+use super::periodic_uv::{Lattice, along2, integrate, reduce_basis, reduce_faces, signed_area};
+use super::seam_placement::shortest_level;
+use super::translation_patches::{PatchOptions, translation_patches};
 use super::tree_cotree::tree_cotree;
+use super::uniform_form::most_uniform_form;
 use super::zero_points::vertex_indices;
 use super::{ComponentMap, ConformalMethod};
 use crate::ParamError;
 use fieldtex_core::vec3;
 use fieldtex_mesh::{CotanOptions, Topology, TriMesh, cotan_face_weights};
 
-/// Holomorphic data of a closed genus-`g ≥ 1` mesh; a UV map when `g = 1`.
-pub fn holomorphic_map(mesh: &TriMesh, genus: usize) -> Result<ComponentMap, ParamError> {
+/// Length budget of a critical trajectory, in units of `√(surface area)`.
+pub const TRAJECTORY_LENGTH: f64 = 0.15;
+/// Largest patch piece side, in units of `√(UV area)`.
+pub const PIECE_SIDE: f64 = 1.0;
+/// Candidate levels tried for each period seam of a torus image.
+pub const SEAM_LEVELS: usize = 64;
+/// Objective evaluations of the most-uniform-form search.
+pub const UNIFORM_FORM_EVALS: usize = 400;
+/// Face rings drawn as ghosts beyond each cut (image margins, §4.2).
+pub const GHOST_RINGS: usize = 1;
+
+/// Holomorphic data and the UV map of a closed genus-`g ≥ 1` mesh.
+/// For `g ≥ 2` only the first `n_keep` faces get UVs (the input's faces of a capped or
+/// doubled mesh).
+pub fn holomorphic_map(
+    mesh: &TriMesh,
+    genus: usize,
+    n_keep: usize,
+) -> Result<ComponentMap, ParamError> {
+    holomorphic_map_with(mesh, genus, n_keep, TRAJECTORY_LENGTH, PIECE_SIDE)
+}
+
+/// [`holomorphic_map`] with the trajectory length budget (× `√area`) and the patch piece
+/// side (× `√(UV area)`) given.
+pub fn holomorphic_map_with(
+    mesh: &TriMesh,
+    genus: usize,
+    n_keep: usize,
+    trajectory_length: f64,
+    piece_side: f64,
+) -> Result<ComponentMap, ParamError> {
     let nv = mesh.n_vertices();
     let nf = mesh.n_triangles();
     let tris = &mesh.triangles;
@@ -64,38 +98,77 @@ pub fn holomorphic_map(mesh: &TriMesh, genus: usize) -> Result<ComponentMap, Par
         normals[f] = vec3::normalize(n2).unwrap_or([0.0, 0.0, 1.0]);
     }
     let conj = conjugates(&xs, &areas, &normals)?;
-    // The basis form with the most uniform |φ| (area-weighted coefficient of variation).
-    let cv = |x: &Vec<[f64; 3]>| {
-        let (mut s, mut s2, mut wsum) = (0.0, 0.0, 0.0);
-        for f in 0..nf {
-            let m = vec3::norm(x[f]);
-            s += areas[f] * m;
-            s2 += areas[f] * m * m;
-            wsum += areas[f];
-        }
-        let mean = s / wsum;
-        ((s2 / wsum - mean * mean).max(0.0)).sqrt() / mean.max(f64::MIN_POSITIVE)
-    };
-    let k = (0..xs.len()).min_by(|&i, &j| cv(&xs[i]).total_cmp(&cv(&xs[j]))).unwrap_or(0);
-    let zero_points =
-        vertex_indices(&mesh.positions, tris, |v| topo.vertex_faces(v).to_vec(), &xs[k], &keep);
-    let star: Vec<f64> = (0..topo.n_edges())
-        .map(|e| (0..forms.len()).map(|j| conj.coefficients[k][j] * forms[j][e]).sum())
+    // Genus 1: the form is unique up to a complex factor (the best basis form, no
+    // search). Genus ≥ 2: the combination with the most uniform conformal factor.
+    let evals = if genus >= 2 { UNIFORM_FORM_EVALS } else { 0 };
+    let uniform = most_uniform_form(&xs, &areas, evals);
+    let a = uniform.coefficients.clone();
+    let x_re: Vec<[f64; 3]> = (0..nf)
+        .map(|f| (0..xs.len()).fold([0.0; 3], |v, k| vec3::add(v, vec3::scale(xs[k][f], a[k]))))
         .collect();
-    if genus != 1 {
+    let zero_points =
+        vertex_indices(&mesh.positions, tris, |v| topo.vertex_faces(v).to_vec(), &x_re, &keep);
+    // ⋆(Σ a_k ω_k) = Σ_k a_k Σ_j c_kj ω_j.
+    let b: Vec<f64> = (0..forms.len())
+        .map(|j| (0..forms.len()).map(|k| a[k] * conj.coefficients[k][j]).sum())
+        .collect();
+    let mut d: Vec<[f64; 2]> = (0..topo.n_edges())
+        .map(|e| {
+            let re: f64 = (0..forms.len()).map(|k| a[k] * forms[k][e]).sum();
+            let im: f64 = (0..forms.len()).map(|j| b[j] * forms[j][e]).sum();
+            [re, im]
+        })
+        .collect();
+    if genus >= 2 {
+        // Orientation: ∇v = n × ∇u keeps it, but guard against a reversed discrete star.
+        let positive: f64 = (0..nf)
+            .map(|f| {
+                let c = [[0.0, 0.0], along2(&topo, &d, f, 0, 1), along2(&topo, &d, f, 0, 2)];
+                signed_area(&c).signum()
+            })
+            .sum();
+        if positive < 0.0 {
+            for v in d.iter_mut() {
+                v[0] = -v[0];
+            }
+        }
+        let zeros: Vec<u32> = zero_points.iter().map(|z| z.0).collect();
+        let area: f64 = areas.iter().sum();
+        let (trajectories, cut) = critical_trajectories(
+            &mesh.positions,
+            tris,
+            &topo,
+            &d,
+            &zeros,
+            trajectory_length * area.sqrt(),
+        );
+        let kept: Vec<bool> = (0..nf).map(|f| f < n_keep).collect();
+        let layout = translation_patches(
+            &mesh.positions,
+            tris,
+            &topo,
+            &d,
+            &cut,
+            &kept,
+            PatchOptions { rings: GHOST_RINGS, piece_side },
+        );
         return Ok(ComponentMap {
-            method: ConformalMethod::HolomorphicBasisOnly,
-            corner: Vec::new(),
-            base: Vec::new(),
-            apex: Vec::new(),
-            lattice: Lattice { a: None, b: None },
+            method: ConformalMethod::CriticalTrajectoryPatches,
+            corner: layout.corner,
+            base: vec![[f64::NAN; 2]; nv],
+            apex: vec![None; nf],
             zero_points,
             conjugate_residual: conj.residual,
-            slit_vertices: Vec::new(),
             harmonic_forms: forms.len(),
+            patch: layout.patch,
+            ghosts: layout.ghosts,
+            cut_curves: trajectories.into_iter().map(|t| t.points).collect(),
+            small_patches: layout.small_patches,
+            folded_faces: layout.folded,
+            stretch_cv: Some([uniform.cv_basis, uniform.cv]),
+            ..ComponentMap::empty(ConformalMethod::CriticalTrajectoryPatches)
         });
     }
-    let d: Vec<[f64; 2]> = (0..topo.n_edges()).map(|e| [forms[k][e], star[e]]).collect();
     let puv = integrate(&topo, tris, &keep, &d);
     let period = |e: u32| {
         let ed = topo.edges[e as usize];
@@ -103,8 +176,7 @@ pub fn holomorphic_map(mesh: &TriMesh, genus: usize) -> Result<ComponentMap, Par
         let de = d[e as usize];
         [b0[0] + de[0] - b1[0], b0[1] + de[1] - b1[1]]
     };
-    let z1 = period(tc.generators[0]);
-    let z2 = period(tc.generators[1]);
+    let (z1, z2) = reduce_basis(period(tc.generators[0]), period(tc.generators[1]));
     let len1 = (z1[0] * z1[0] + z1[1] * z1[1]).sqrt();
     if len1 <= 0.0 || !len1.is_finite() {
         return Err(conformal_error("the first period of the holomorphic 1-form vanishes"));
@@ -137,6 +209,18 @@ pub fn holomorphic_map(mesh: &TriMesh, genus: usize) -> Result<ComponentMap, Par
     }
     b[0] = b[0].rem_euclid(len1);
     let lattice = Lattice { a: Some(len1), b: Some(b) };
+    // Seams along the shortest level curves: first v (then reduce in y), then u.
+    let shift = |corner: &mut Vec<[[f64; 2]; 3]>, base: &mut Vec<[f64; 2]>, s: [f64; 2]| {
+        for p in corner.iter_mut().flat_map(|c| c.iter_mut()).chain(base.iter_mut()) {
+            p[0] -= s[0];
+            p[1] -= s[1];
+        }
+    };
+    let cy = shortest_level(&corner, tris, &mesh.positions, 1, b[1], SEAM_LEVELS);
+    shift(&mut corner, &mut base, [0.0, cy]);
+    reduce_faces(&mut corner, &Lattice { a: None, b: Some(b) });
+    let cx = shortest_level(&corner, tris, &mesh.positions, 0, len1, SEAM_LEVELS);
+    shift(&mut corner, &mut base, [cx, 0.0]);
     reduce_faces(&mut corner, &lattice);
     Ok(ComponentMap {
         method: ConformalMethod::HolomorphicTorus,
@@ -146,7 +230,7 @@ pub fn holomorphic_map(mesh: &TriMesh, genus: usize) -> Result<ComponentMap, Par
         lattice,
         zero_points,
         conjugate_residual: conj.residual,
-        slit_vertices: Vec::new(),
         harmonic_forms: forms.len(),
+        ..ComponentMap::empty(ConformalMethod::HolomorphicTorus)
     })
 }

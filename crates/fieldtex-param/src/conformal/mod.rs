@@ -2,20 +2,25 @@
 //! of every connected component of a mesh into *conformal geometry images*: rectangles
 //! whose opposite sides are identified by translations ([`Lattice`]).
 //!
-//! Per component (holes are capped first, [`hole_caps`]; caps are dropped afterwards):
+//! Per component — with boundary, the [`double_cover`] when its genus is ≥ 2 (first copy
+//! kept), otherwise holes capped ([`hole_caps`], caps dropped afterwards):
 //! - genus 0 → [`slit_cylinder`]: two point slits, one cylinder image (periodic in x);
 //! - genus 1 → [`holomorphic_map`]: holomorphic 1-form, one torus image (periodic in x
 //!   and, with a shift, in y), no zero points;
-//! - genus ≥ 2 → the holomorphic basis and its zero points are computed, but the
-//!   critical-trajectory patches are not: the component is reported as
-//!   [`ConformalMethod::HolomorphicBasisOnly`] and the caller must parameterise it
-//!   another way (the `conformal` pipeline uses a chart atlas).
+//! - genus ≥ 2 → [`holomorphic_map`] then [`critical_trajectories`] and
+//!   [`translation_patches`]: the surface is cut along the critical horizontal
+//!   trajectories through the zero points and each patch is mapped by integrating the
+//!   form; the patches are packed into one image, and [`translation_patches::Ghost`]s
+//!   across the cuts give the margins their partners
+//!   ([`ConformalMethod::CriticalTrajectoryPatches`]).
 //!
 //! UVs are per corner: a triangle's corners are its local chart of `∫φ` moved into the
 //! fundamental domain by one lattice translation; corners may stick out of the domain by
 //! up to one triangle, which is why texture images get margins (Wang et al. §4.2).
 
 pub mod cotan_system;
+pub mod critical_trajectories;
+pub mod double_cover;
 pub mod geometry_image;
 pub mod harmonic_one_forms;
 pub mod hole_caps;
@@ -23,18 +28,26 @@ pub mod holomorphic_basis;
 pub mod holomorphic_map;
 pub mod mass_spring;
 pub mod periodic_uv;
+pub mod seam_placement;
 pub mod slit_cylinder;
+pub mod translation_patches;
 pub mod tree_cotree;
+pub mod uniform_form;
 pub mod zero_points;
 
 pub use geometry_image::GeometryImage;
 pub use mass_spring::{MassSpringOptions, MassSpringStats};
 pub use periodic_uv::Lattice;
+pub use translation_patches::Ghost;
 
 use crate::ParamError;
 use fieldtex_core::{Progress, Warning};
 use fieldtex_mesh::{Topology, TriMesh};
 use serde::Serialize;
+
+/// Holes whose boundary is at least this many `√area` long stay open for the double
+/// cover; smaller ones are capped.
+pub const LARGE_HOLE: f64 = 0.3;
 
 /// Vertex rings around slit and zero points flagged as near a singularity.
 pub const NEAR_RINGS: usize = 3;
@@ -47,6 +60,9 @@ pub enum ConformalMethod {
     SlitCylinder,
     /// Genus 1: holomorphic 1-form, one periodic rectangle.
     HolomorphicTorus,
+    /// Genus ≥ 2: holomorphic 1-form, cut along its critical horizontal trajectories
+    /// into patches, each mapped by integrating the form, packed into one image.
+    CriticalTrajectoryPatches,
     /// Genus ≥ 2: holomorphic basis and zero points only; no UVs.
     HolomorphicBasisOnly,
     /// The construction failed (see the note); no UVs.
@@ -72,6 +88,55 @@ pub struct ComponentMap {
     pub slit_vertices: Vec<u32>,
     /// Number of harmonic 1-forms computed.
     pub harmonic_forms: usize,
+    /// Per capped face: patch id (empty: one patch).
+    pub patch: Vec<u32>,
+    /// Faces drawn shifted beside a patch across a cut (empty for lattice images).
+    pub ghosts: Vec<Ghost>,
+    /// Traced cut curves (3-D polylines), e.g. the critical trajectories.
+    pub cut_curves: Vec<Vec<[f64; 3]>>,
+    /// Patches made by the overlap guard that hold under 1 % of the faces.
+    pub small_patches: usize,
+    /// Faces the discrete form folds, given their own one-face charts.
+    pub folded_faces: usize,
+    /// Area-stretch CV of the best basis form and of the optimised form (genus ≥ 2).
+    pub stretch_cv: Option<[f64; 2]>,
+}
+
+impl ComponentMap {
+    /// An empty map of the given method (no UVs).
+    pub fn empty(method: ConformalMethod) -> Self {
+        Self {
+            method,
+            corner: Vec::new(),
+            base: Vec::new(),
+            apex: Vec::new(),
+            lattice: Lattice { a: None, b: None },
+            zero_points: Vec::new(),
+            conjugate_residual: f64::NAN,
+            slit_vertices: Vec::new(),
+            harmonic_forms: 0,
+            patch: Vec::new(),
+            ghosts: Vec::new(),
+            cut_curves: Vec::new(),
+            small_patches: 0,
+            stretch_cv: None,
+            folded_faces: 0,
+        }
+    }
+
+    /// Number of patches (images regions) of the map.
+    pub fn n_patches(&self) -> usize {
+        if self.corner.is_empty() {
+            0
+        } else {
+            self.patch
+                .iter()
+                .filter(|&&p| p != u32::MAX)
+                .map(|&p| p as usize + 1)
+                .max()
+                .unwrap_or(1)
+        }
+    }
 }
 
 /// One component's conformal geometry image.
@@ -99,7 +164,9 @@ pub struct ConformalComponent {
     pub conjugate_residual: f64,
     pub harmonic_forms: usize,
     pub note: Option<String>,
-    /// Capped component mesh (local indices) and local → global vertex ids.
+    /// Genus of the double cover when the component (with boundary) was doubled.
+    pub double_cover_genus: Option<usize>,
+    /// Capped (or doubled) component mesh (local indices) and local → global vertex ids.
     pub local_mesh: TriMesh,
     pub local_to_global: Vec<u32>,
     pub map: ComponentMap,
@@ -161,7 +228,7 @@ impl ConformalComponent {
         &mut self,
         options: &MassSpringOptions,
     ) -> Option<MassSpringStats> {
-        if !self.has_uv() {
+        if !self.has_uv() || self.method == ConformalMethod::CriticalTrajectoryPatches {
             return None;
         }
         let n_orig = self.faces.len();
@@ -211,35 +278,85 @@ pub fn global_conformal(
         let chi = capped.mesh.n_vertices() as i64 - ctopo.n_edges() as i64
             + capped.mesh.n_triangles() as i64;
         let genus = ((2 - chi).max(0) / 2) as usize;
-        let result = if !manifold {
-            Err(cotan_system::conformal_error(
-                "the capped component is not a closed manifold (non-manifold edges)",
-            ))
-        } else if faces.len() < 8 {
-            Err(cotan_system::conformal_error("fewer than 8 triangles"))
-        } else if genus == 0 {
-            let mut caps = capped.caps.clone();
-            caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
-            // A hole becomes a cylinder end only when it is large (its boundary at least
-            // 0.3 √area); small holes stay capped and the slits go to extremal points.
-            let area: f64 = (0..sub.n_triangles())
-                .map(|f| {
-                    let p = sub.triangle_positions(f);
-                    0.5 * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
-                        fieldtex_core::vec3::sub(p[1], p[0]),
-                        fieldtex_core::vec3::sub(p[2], p[0]),
-                    ))
-                })
-                .sum();
-            caps.retain(|c| c.1 >= 0.3 * area.sqrt());
-            let a = caps.first().map(|c| c.0 as usize);
-            let b = match (caps.first(), caps.get(1)) {
-                (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),
-                _ => None,
-            };
-            slit_cylinder::slit_cylinder(&capped.mesh, [a, b])
+        // Open surfaces use the double cover (paper §3) when the holes that count make
+        // its genus ≥ 2. A hole counts when its boundary is at least `LARGE_HOLE` √area
+        // long; smaller holes stay capped (doubled, a tiny hole becomes a thin handle
+        // whose conformal factor is extreme). A disk or an annulus (double genus 0 or
+        // 1) stays capped: the slit cylinder gives the map an annulus's double gives.
+        let sub_area: f64 = (0..sub.n_triangles())
+            .map(|f| {
+                let p = sub.triangle_positions(f);
+                0.5 * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
+                    fieldtex_core::vec3::sub(p[1], p[0]),
+                    fieldtex_core::vec3::sub(p[2], p[0]),
+                ))
+            })
+            .sum();
+        let large: Vec<u32> = capped
+            .caps
+            .iter()
+            .filter(|c| c.1 >= LARGE_HOLE * sub_area.sqrt())
+            .map(|c| c.0)
+            .collect();
+        let cover_genus = (2 * genus + large.len()).saturating_sub(1);
+        let mut double = None;
+        if manifold && !large.is_empty() && cover_genus >= 2 && faces.len() >= 8 {
+            // The input with its small holes capped, large holes open, doubled.
+            let partly = TriMesh::new(
+                capped.mesh.positions.clone(),
+                capped
+                    .mesh
+                    .triangles
+                    .iter()
+                    .copied()
+                    .filter(|t| !t.iter().any(|v| large.contains(v)))
+                    .collect(),
+            );
+            let dc = double_cover::double_cover(&partly);
+            match holomorphic_map::holomorphic_map(&dc.mesh, cover_genus, faces.len()) {
+                Ok(m) => double = Some((dc, m)),
+                Err(e) => warnings.push(Warning::new(
+                    "conformal-double-cover-failed",
+                    format!("component {ci}: the double cover (genus {cover_genus}) failed ({e}); holes are capped instead"),
+                )),
+            }
+        }
+        let mut twin: Vec<u32> = Vec::new();
+        let (capped_mesh, result, is_double) = if let Some((dc, m)) = double {
+            twin = dc.twin;
+            (dc.mesh, Ok(m), true)
         } else {
-            holomorphic_map::holomorphic_map(&capped.mesh, genus)
+            let r = if !manifold {
+                Err(cotan_system::conformal_error(
+                    "the capped component is not a closed manifold (non-manifold edges)",
+                ))
+            } else if faces.len() < 8 {
+                Err(cotan_system::conformal_error("fewer than 8 triangles"))
+            } else if genus == 0 {
+                let mut caps = capped.caps.clone();
+                caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+                // A hole becomes a cylinder end only when it is large (its boundary at least
+                // 0.3 √area); small holes stay capped and the slits go to extremal points.
+                let area: f64 = (0..sub.n_triangles())
+                    .map(|f| {
+                        let p = sub.triangle_positions(f);
+                        0.5 * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
+                            fieldtex_core::vec3::sub(p[1], p[0]),
+                            fieldtex_core::vec3::sub(p[2], p[0]),
+                        ))
+                    })
+                    .sum();
+                caps.retain(|c| c.1 >= 0.3 * area.sqrt());
+                let a = caps.first().map(|c| c.0 as usize);
+                let b = match (caps.first(), caps.get(1)) {
+                    (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),
+                    _ => None,
+                };
+                slit_cylinder::slit_cylinder(&capped.mesh, [a, b])
+            } else {
+                holomorphic_map::holomorphic_map(&capped.mesh, genus, faces.len())
+            };
+            (capped.mesh, r, false)
         };
         let (map, note) = match result {
             Ok(m) => {
@@ -253,26 +370,17 @@ pub fn global_conformal(
                     "conformal-component-failed",
                     format!("component {ci} ({} triangles, genus {genus}): {e}", faces.len()),
                 ));
-                (
-                    ComponentMap {
-                        method: ConformalMethod::Failed,
-                        corner: Vec::new(),
-                        base: Vec::new(),
-                        apex: Vec::new(),
-                        lattice: Lattice { a: None, b: None },
-                        zero_points: Vec::new(),
-                        conjugate_residual: f64::NAN,
-                        slit_vertices: Vec::new(),
-                        harmonic_forms: 0,
-                    },
-                    Some(e.to_string()),
-                )
+                (ComponentMap::empty(ConformalMethod::Failed), Some(e.to_string()))
             }
         };
         let zero_points = map
             .zero_points
             .iter()
-            .map(|&(v, i)| (local_to_global.get(v as usize).copied().unwrap_or(u32::MAX), i))
+            .map(|&(v, i)| {
+                // On a double cover, a zero on the second copy is reported at its twin.
+                let v = twin.get(v as usize).map_or(v, |&t| t.min(v));
+                (local_to_global.get(v as usize).copied().unwrap_or(u32::MAX), i)
+            })
             .collect();
         let mut c = ConformalComponent {
             component: ci,
@@ -289,7 +397,8 @@ pub fn global_conformal(
             conjugate_residual: map.conjugate_residual,
             harmonic_forms: map.harmonic_forms,
             note,
-            local_mesh: capped.mesh,
+            double_cover_genus: is_double.then_some(cover_genus),
+            local_mesh: capped_mesh,
             local_to_global,
             map,
         };

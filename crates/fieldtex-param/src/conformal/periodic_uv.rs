@@ -135,7 +135,43 @@ pub fn reduce_faces(corner: &mut [[[f64; 2]; 3]], lattice: &Lattice) {
     }
 }
 
+/// Lagrange–Gauss reduction of a 2-D lattice basis: returns a basis of the same lattice
+/// whose first vector is a shortest non-zero lattice vector and whose second is the
+/// shortest independent one (`|⟨z1, z2⟩| ≤ |z1|²/2`). A torus image cut along the
+/// shortest period has the shortest seams (e.g. meridians rather than helices).
+pub fn reduce_basis(mut z1: [f64; 2], mut z2: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+    let n2 = |z: [f64; 2]| z[0] * z[0] + z[1] * z[1];
+    for _ in 0..64 {
+        if n2(z2) < n2(z1) {
+            std::mem::swap(&mut z1, &mut z2);
+        }
+        let d = n2(z1);
+        if d <= 0.0 || !d.is_finite() {
+            break;
+        }
+        let m = ((z1[0] * z2[0] + z1[1] * z2[1]) / d).round();
+        if m == 0.0 {
+            break;
+        }
+        z2 = [z2[0] - m * z1[0], z2[1] - m * z1[1]];
+    }
+    (z1, z2)
+}
+
 /// Signed UV area of a face.
 pub fn signed_area(c: &[[f64; 2]; 3]) -> f64 {
     0.5 * ((c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_reduction_finds_the_short_basis() {
+        // The rectangular lattice (1, 0), (0, 4) given by a sheared basis.
+        let (z1, z2) = reduce_basis([3.0, 4.0], [5.0, 8.0]);
+        assert_eq!(z1.map(f64::abs), [1.0, 0.0]);
+        assert_eq!(z2.map(f64::abs), [0.0, 4.0]);
+    }
 }

@@ -248,6 +248,7 @@ pub fn slit_cylinder(mesh: &TriMesh, ends: [Option<usize>; 2]) -> Result<Compone
         conjugate_residual: residual,
         slit_vertices: vec![a as u32, b as u32],
         harmonic_forms: 1,
+        ..ComponentMap::empty(super::ConformalMethod::SlitCylinder)
     })
 }
 

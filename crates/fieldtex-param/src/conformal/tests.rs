@@ -101,3 +101,181 @@ fn same_result_for_one_and_two_threads() {
             .all(|(x, y)| x.to_bits() == y.to_bits())
     );
 }
+
+/// The boundary of a slab of `7 × 3 × 1` unit voxels with two holes (genus 2), each
+/// voxel face split into `n × n` quads of two triangles.
+fn genus_two_slab(n: usize) -> fieldtex_mesh::TriMesh {
+    let filled = |c: [i64; 3]| {
+        (0..7).contains(&c[0])
+            && (0..3).contains(&c[1])
+            && c[2] == 0
+            && !(c[1] == 1 && (c[0] == 1 || c[0] == 5))
+    };
+    let mut index = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut vid = |p: [i64; 3], positions: &mut Vec<[f64; 3]>| -> u32 {
+        *index.entry(p).or_insert_with(|| {
+            positions.push(p.map(|x| x as f64 / n as f64));
+            (positions.len() - 1) as u32
+        })
+    };
+    let n = n as i64;
+    for x in -1..8i64 {
+        for y in -1..4i64 {
+            for z in -1..2i64 {
+                let c = [x, y, z];
+                if !filled(c) {
+                    continue;
+                }
+                for a in 0..3 {
+                    for s in [-1i64, 1] {
+                        let mut nb = c;
+                        nb[a] += s;
+                        if filled(nb) {
+                            continue;
+                        }
+                        let (b, e) = ((a + 1) % 3, (a + 2) % 3);
+                        let mut base = c.map(|v| v * n);
+                        if s > 0 {
+                            base[a] += n;
+                        }
+                        for i in 0..n {
+                            for j in 0..n {
+                                let p = |di: i64, dj: i64| {
+                                    let mut q = base;
+                                    q[b] += i + di;
+                                    q[e] += j + dj;
+                                    q
+                                };
+                                let v = [p(0, 0), p(1, 0), p(1, 1), p(0, 1)]
+                                    .map(|q| vid(q, &mut positions));
+                                if s > 0 {
+                                    triangles.push([v[0], v[1], v[2]]);
+                                    triangles.push([v[0], v[2], v[3]]);
+                                } else {
+                                    triangles.push([v[0], v[2], v[1]]);
+                                    triangles.push([v[0], v[3], v[2]]);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    fieldtex_mesh::TriMesh::new(positions, triangles)
+}
+
+#[test]
+fn genus_two_is_cut_into_patches_along_critical_trajectories() {
+    let mesh = genus_two_slab(4);
+    let (comps, warnings) = global_conformal(&mesh, &NoProgress).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let c = &comps[0];
+    assert_eq!(c.genus, 2);
+    assert_eq!(c.method, ConformalMethod::CriticalTrajectoryPatches);
+    // Poincaré–Hopf: the zero indices sum to χ = 2 − 2g.
+    let total: i32 = c.zero_points.iter().map(|z| z.1).sum();
+    assert_eq!(total, -2, "{:?}", c.zero_points);
+    assert!(!c.map.cut_curves.is_empty());
+    let all = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &|_| false);
+    assert_eq!(all.flipped, 0);
+    // A coarse voxel surface: the discrete conjugate misfits by ~16 %, hence the bound.
+    assert!(distortion(c).angle_mean < 1.2, "{}", distortion(c).angle_mean);
+    // The packed layout is injective: no two faces overlap.
+    let cu = &c.corner_uv;
+    for f in 0..cu.len() {
+        for g in f + 1..cu.len() {
+            assert!(!translation_patches::triangles_overlap(&cu[f], &cu[g]), "{f} {g}");
+        }
+    }
+    // Across every cut the two charts differ by one translation (ghosts continue it).
+    assert!(!c.map.ghosts.is_empty());
+    let img = GeometryImage::new(c, 256);
+    assert!(!img.links.is_empty());
+    let mut out = Vec::new();
+    let (a, b) = img.links[0];
+    img.partners(a as usize % img.width, a as usize / img.width, &mut out);
+    assert!(out.contains(&(b as usize % img.width, b as usize / img.width)));
+    // Every margin texel continues a texel that shows the same face (within the span
+    // rasteriser's edge texels and the ½-texel rounding: 1.5 texels; a wrong shift is
+    // off by a whole patch), and after the copy the margins match their partners.
+    assert!(!img.margin_copies.is_empty());
+    for &(g, r, f) in &img.margin_copies {
+        let p = [(r as usize % img.width) as f64 + 0.5, (r as usize / img.width) as f64 + 0.5];
+        let t = img.corner_texel[f as usize];
+        let d = (0..3)
+            .map(|k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let e = [b[0] - a[0], b[1] - a[1]];
+                // Signed distance to the edge's line (positive inside; texel rows go down,
+                // so the triangle is clockwise in texel coordinates).
+                ((p[0] - a[0]) * e[1] - (p[1] - a[1]) * e[0]) / (e[0] * e[0] + e[1] * e[1]).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(d > -1.5, "margin texel {g} → {r} lies {d} texels outside face {f}");
+    }
+    let mut pixels: Vec<u32> = (0..(img.width * img.height) as u32).collect();
+    img.copy_margins(&mut pixels);
+    for &(g, r, _) in &img.margin_copies {
+        assert_eq!(pixels[g as usize], pixels[r as usize]);
+    }
+}
+
+#[test]
+fn a_disk_with_two_holes_is_mapped_through_its_double_cover() {
+    // g = 0, b = 3: the double cover has genus 2.
+    let grid = primitives::grid(24, 12, 2.0, 1.0);
+    let hole = |c: [f64; 2]| {
+        let inside = |x0: f64| (x0..x0 + 0.3).contains(&c[0]) && (0.35..0.65).contains(&c[1]);
+        inside(0.35) || inside(1.35)
+    };
+    let tris: Vec<[u32; 3]> = grid
+        .triangles
+        .iter()
+        .copied()
+        .filter(|t| {
+            let c = t.iter().fold([0.0; 2], |c, &v| {
+                let p = grid.positions[v as usize];
+                [c[0] + p[0] / 3.0, c[1] + p[1] / 3.0]
+            });
+            !hole(c)
+        })
+        .collect();
+    let n = tris.len();
+    let mesh = fieldtex_mesh::TriMesh::new(grid.positions.clone(), tris);
+    let (comps, warnings) = global_conformal(&mesh, &NoProgress).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let c = &comps[0];
+    assert_eq!((c.genus, c.boundaries, c.double_cover_genus), (0, 3, Some(2)));
+    assert_eq!(c.method, ConformalMethod::CriticalTrajectoryPatches);
+    assert_eq!(c.corner_uv.len(), n);
+    assert!(c.local_mesh.n_triangles() >= 2 * n);
+    let all = map_distortion(&c.local_mesh, n, &c.corner_uv, &|_| false);
+    assert_eq!(all.flipped, 0);
+    // A coarse flat grid with sharp corners (conjugate misfit ~26 %), hence the bound.
+    assert!(distortion(c).angle_mean < 1.3, "{}", distortion(c).angle_mean);
+}
+
+#[test]
+fn genus_two_patches_are_the_same_for_one_and_two_threads() {
+    let mesh = genus_two_slab(3);
+    let run = |t: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
+        pool.install(|| {
+            let c = global_conformal(&mesh, &NoProgress).unwrap().0.remove(0);
+            (c.corner_uv, c.map.patch, c.map.ghosts.len())
+        })
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a.1, b.1);
+    assert_eq!(a.2, b.2);
+    assert!(
+        a.0.iter()
+            .flatten()
+            .flatten()
+            .zip(b.0.iter().flatten().flatten())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    );
+}

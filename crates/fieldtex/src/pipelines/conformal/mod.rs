@@ -5,21 +5,27 @@
 //! optional quasi-isometric relaxation → one geometry image per component with its `τ`
 //! map → multi-scale quilting with graph-cut seams and periodic margins
 //! (`fieldtex_synth::quilt`) → images stacked into one texture → `model.glb`,
-//! `preview.png`, `report.json` (+ `--keep` artefacts). Components of genus ≥ 2 (and
-//! failed ones) fall back to a chart atlas (LSCM charts) synthesised the same way
-//! without partners; the report says so.
+//! `preview.png`, `report.json` (+ `--keep` artefacts). A genus ≥ 2 component's image
+//! holds its critical-trajectory patches, linked across the cuts by ghost margins.
+//! Failed components fall back to a chart atlas (LSCM charts) synthesised the same way
+//! without partners; the report says so. Report pieces live in `report.rs`, texture
+//! blocks and `--keep` artefacts in `blocks.rs`.
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, stream_seed};
-use fieldtex_mesh::{CornerUvs, TriMesh};
-use fieldtex_param::conformal::mass_spring::map_distortion;
+use fieldtex_mesh::TriMesh;
 use fieldtex_param::conformal::{
-    ConformalComponent, ConformalMethod, GeometryImage, MassSpringOptions, global_conformal,
+    ConformalComponent, GeometryImage, MassSpringOptions, global_conformal,
 };
 use fieldtex_synth::exemplar_scales::{resample, scale_levels};
 use fieldtex_synth::{QuiltTarget, QuiltingOptions, quilt};
 use serde::Serialize;
+
+mod blocks;
+mod report;
+use blocks::{assemble, fallback_atlas, write_keep};
+use report::{add_notes, component_json, texel_density, weighted_quantile};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -64,12 +70,12 @@ impl Default for ConformalOptions {
 }
 
 /// One synthesised block of the final texture.
-struct Block {
-    image: Image,
+pub(super) struct Block {
+    pub(super) image: Image,
     /// Per global face it textures: canvas texel coordinates of its corners.
-    faces: Vec<(u32, [[f64; 2]; 3])>,
-    tau: Vec<f32>,
-    label: String,
+    pub(super) faces: Vec<(u32, [[f64; 2]; 3])>,
+    pub(super) tau: Vec<f32>,
+    pub(super) label: String,
 }
 
 /// Runs the pipeline (see the module docs).
@@ -241,8 +247,10 @@ pub fn conformal(
             ..qbase
         };
         crate::outputs::check_cancelled(progress)?;
-        let (image, st) = quilt(&levels, &target, &q, progress);
-        quilt_stats.push(json!({"component": c.component, "stats": st}));
+        let (mut image, st) = quilt(&levels, &target, &q, progress);
+        // Margins across patch cuts take their partners' colours (§4.2).
+        img.copy_margins(&mut image.pixels);
+        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len()}));
         let faces = c.faces.iter().copied().zip(img.corner_texel.iter().copied()).collect();
         blocks.push(Block {
             image,
@@ -324,283 +332,4 @@ fn component_area(mesh: &TriMesh, c: &ConformalComponent) -> f64 {
             ))
         })
         .sum()
-}
-
-/// Area-weighted quantile of `(value, weight)` pairs.
-fn weighted_quantile(v: &mut [(f64, f64)], q: f64) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let total: f64 = v.iter().map(|x| x.1).sum();
-    let mut acc = 0.0;
-    for x in v.iter() {
-        acc += x.1;
-        if acc >= q * total {
-            return Some(x.0);
-        }
-    }
-    v.last().map(|x| x.0)
-}
-
-#[derive(Serialize)]
-struct TexelDensity {
-    /// Area-weighted coefficient of variation of texels per surface area (`τ²`).
-    density_cv: f64,
-    tau_min: f64,
-    tau_median: f64,
-    tau_max: f64,
-}
-
-fn texel_density(tau_w: &[(f64, f64)]) -> TexelDensity {
-    let (mut s, mut s2, mut w) = (0.0, 0.0, 0.0);
-    for &(t, a) in tau_w {
-        let d = t * t;
-        s += a * d;
-        s2 += a * d * d;
-        w += a;
-    }
-    let mean = s / w.max(f64::MIN_POSITIVE);
-    let mut v = tau_w.to_vec();
-    TexelDensity {
-        density_cv: (s2 / w.max(f64::MIN_POSITIVE) - mean * mean).max(0.0).sqrt()
-            / mean.max(f64::MIN_POSITIVE),
-        tau_min: tau_w.iter().map(|x| x.0).fold(f64::INFINITY, f64::min),
-        tau_median: weighted_quantile(&mut v, 0.5).unwrap_or(f64::NAN),
-        tau_max: tau_w.iter().map(|x| x.0).fold(0.0, f64::max),
-    }
-}
-
-fn component_json(c: &ConformalComponent, img: Option<&GeometryImage>) -> serde_json::Value {
-    let mut v = json!({
-        "component": c.component,
-        "triangles": c.faces.len(),
-        "genus": c.genus,
-        "boundaries": c.boundaries,
-        "method": c.method,
-        "harmonic_1_forms": c.harmonic_forms,
-        "zero_points": c.zero_points.len(),
-        "zero_point_indices": c.zero_points.iter().map(|z| json!({"vertex": z.0, "index": z.1})).collect::<Vec<_>>(),
-        "conjugate_residual": c.conjugate_residual,
-        "note": c.note,
-    });
-    if c.has_uv() {
-        let near = c.near_singularity.clone();
-        let slit = c.slit.clone();
-        let all = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &move |f| slit[f]);
-        let away = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &move |f| near[f]);
-        v["patches"] = json!(1);
-        v["slit_vertices"] = json!(
-            c.map
-                .slit_vertices
-                .iter()
-                .map(|&l| c.local_to_global.get(l as usize).copied().unwrap_or(u32::MAX))
-                .collect::<Vec<_>>()
-        );
-        v["lattice"] = json!({"a": c.lattice.a, "b": c.lattice.b});
-        v["distortion"] = json!({"angle_mean_away_from_singularities": away.angle_mean, "angle_mean_non_slit": all.angle_mean, "log_area_std": all.log_area_std, "flipped": all.flipped});
-        if let Some(img) = img {
-            v["geometry_image"] = json!({"width": img.width, "height": img.height, "margin": img.margin, "period_x": img.period_x, "period_y": img.period_y});
-        }
-    } else {
-        v["patches"] = json!("fallback atlas");
-    }
-    v
-}
-
-fn add_notes(report: &mut Report, comps: &[ConformalComponent], options: &ConformalOptions) {
-    let n = &mut report.notes;
-    n.push("Open surfaces: holes are capped with fans and the capped closed surface is parameterised (caps dropped afterwards) — a substitute for the paper's double cover; a disk's boundary and an annulus's two boundaries become the ends of the cylinder.".into());
-    if comps.iter().any(|c| c.method == ConformalMethod::SlitCylinder) {
-        n.push("Genus 0 (the paper is silent): two point slits (vertex stars) at extremal vertices; harmonic u = 0/1 on their rings and its conjugate from the annulus's harmonic 1-form give one cylinder image, periodic across one seam.".into());
-    }
-    if comps.iter().any(|c| !c.has_uv()) {
-        n.push("Genus ≥ 2 (or failed) components: holomorphic basis, conjugates and zero points are computed (zero points reported), but critical-trajectory patches are NOT implemented; these components are textured through a chart atlas (LSCM charts) without boundary consistency across chart seams.".into());
-        n.push("The genus ≥ 2 holomorphic form whose zero points are reported is the basis form with the most uniform |φ| — a substitute for the optimisation of Jin et al. 2004.".into());
-    }
-    n.push("τ per texel: barycentric interpolation of per-vertex τ (substitute for the paper's Gaussian RBF).".into());
-    n.push("Quilting: random candidate subset per patch (not exhaustive), old seams not re-cut; colours compared in sRGB.".into());
-    if options.quasi_isometric {
-        n.push("Mass-spring (eq. 2) in a balanced spring form (rest length = 3-D length / mean conformal factor), stopped when the mean angle distortion would exceed 1.25.".into());
-    }
-}
-
-/// The fallback texture block: an LSCM chart atlas of the given faces.
-struct FallbackAtlas {
-    width: usize,
-    height: usize,
-    tau: Vec<f32>,
-    faces: Vec<(u32, [[f64; 2]; 3])>,
-    face_lambda: Vec<f64>,
-    face_area: Vec<f64>,
-}
-
-fn fallback_atlas(
-    mesh: &TriMesh,
-    faces: &[u32],
-    size: usize,
-    progress: &dyn Progress,
-) -> Result<FallbackAtlas> {
-    let sub = TriMesh::new(
-        mesh.positions.clone(),
-        faces.iter().map(|&f| mesh.triangles[f as usize]).collect(),
-    );
-    let opts =
-        fieldtex_param::AtlasOptions { resolution: size as u32, gutter: 4, ..Default::default() };
-    let atlas = fieldtex_param::build_atlas(&sub, &opts, progress)
-        .map_err(|e| Error::Internal(format!("fallback atlas: {e}")))?;
-    let uvs = atlas
-        .mesh
-        .uvs
-        .as_ref()
-        .ok_or_else(|| Error::Internal("fallback atlas has no UVs".into()))?;
-    let map = fieldtex_param::build_texel_map(&atlas.mesh, size, size, 4)
-        .map_err(|e| Error::Internal(format!("fallback texel map: {e}")))?;
-    let s = size as f64;
-    let mut out_faces = Vec::with_capacity(faces.len());
-    let mut face_lambda = Vec::with_capacity(faces.len());
-    let mut face_area = Vec::with_capacity(faces.len());
-    for (k, &f) in faces.iter().enumerate() {
-        let idx = uvs.indices[k];
-        let c = idx.map(|i| {
-            let uv = uvs.values[i as usize];
-            [uv[0] * s, (1.0 - uv[1]) * s]
-        });
-        let p = atlas.mesh.triangle_positions(k);
-        let a3 = 0.5
-            * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
-                fieldtex_core::vec3::sub(p[1], p[0]),
-                fieldtex_core::vec3::sub(p[2], p[0]),
-            ));
-        let at = 0.5
-            * ((c[1][0] - c[0][0]) * (c[2][1] - c[0][1])
-                - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]))
-                .abs();
-        face_lambda.push(if at > 0.0 { (a3 / at).sqrt() } else { f64::NAN });
-        face_area.push(a3);
-        out_faces.push((f, c));
-    }
-    let tau = (0..size * size)
-        .map(|t| match map.entries[t] {
-            Some(e) => {
-                let l = face_lambda[e.triangle as usize];
-                if l.is_finite() && l > 0.0 { (1.0 / l) as f32 } else { f32::NAN }
-            }
-            None => f32::NAN,
-        })
-        .collect();
-    Ok(FallbackAtlas { width: size, height: size, tau, faces: out_faces, face_lambda, face_area })
-}
-
-/// Stacks the blocks into one texture (rows follow increasing canvas y, top to bottom)
-/// and gives the mesh per-corner UVs (one UV per distinct corner position per vertex).
-fn assemble(mesh: &TriMesh, blocks: &[Block]) -> (Image, TriMesh) {
-    let width = blocks.iter().map(|b| b.image.width).max().unwrap_or(1);
-    let height: usize = blocks.iter().map(|b| b.image.height).sum::<usize>().max(1);
-    let mut tex = Image::new(width, height, [0.5, 0.5, 0.5, 1.0]);
-    let mut corner: Vec<[[f64; 2]; 3]> = vec![[[0.0; 2]; 3]; mesh.n_triangles()];
-    let mut y_off = 0usize;
-    for b in blocks {
-        for y in 0..b.image.height {
-            for x in 0..b.image.width {
-                tex.set(x, y + y_off, b.image.get(x, y));
-            }
-        }
-        for &(f, c) in &b.faces {
-            corner[f as usize] =
-                c.map(|p| [p[0] / width as f64, 1.0 - (p[1] + y_off as f64) / height as f64]);
-        }
-        y_off += b.image.height;
-    }
-    // Deduplicate corner UVs per vertex.
-    let mut values: Vec<[f64; 2]> = Vec::new();
-    let mut per_vertex: Vec<Vec<u32>> = vec![Vec::new(); mesh.n_vertices()];
-    let mut indices = Vec::with_capacity(mesh.n_triangles());
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        let mut idx = [0u32; 3];
-        for k in 0..3 {
-            let uv = corner[f][k];
-            let list = &mut per_vertex[t[k] as usize];
-            let found = list.iter().copied().find(|&i| {
-                let v = values[i as usize];
-                (v[0] - uv[0]).abs() < 1e-9 && (v[1] - uv[1]).abs() < 1e-9
-            });
-            idx[k] = match found {
-                Some(i) => i,
-                None => {
-                    values.push(uv);
-                    list.push((values.len() - 1) as u32);
-                    (values.len() - 1) as u32
-                }
-            };
-        }
-        indices.push(idx);
-    }
-    let mut out = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
-    out.uvs = Some(CornerUvs { values, indices });
-    (tex, out)
-}
-
-fn write_keep(
-    out_dir: &Path,
-    mesh: &TriMesh,
-    comps: &[ConformalComponent],
-    blocks: &[Block],
-) -> Result<()> {
-    // patches.ply: per-vertex patch id (one patch per component here; fallback = −1).
-    let mut patch = vec![-1.0f32; mesh.n_vertices()];
-    for c in comps {
-        if c.has_uv() {
-            for &g in &c.local_to_global {
-                patch[g as usize] = c.component as f32;
-            }
-        }
-    }
-    let plain = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
-    fieldtex_io::write_ply(&out_dir.join("patches.ply"), &plain, &[("patch", &patch)], true)?;
-    // trajectories.obj: the cut curves = mesh edges where the corner UVs jump.
-    let mut lines = Vec::new();
-    for c in comps.iter().filter(|c| c.has_uv()) {
-        let topo = fieldtex_mesh::Topology::build(
-            c.local_mesh.n_vertices(),
-            &c.local_mesh.triangles[..c.faces.len()],
-        );
-        for e in 0..topo.n_edges() {
-            let fs = topo.edge_faces(e);
-            if fs.len() != 2 {
-                continue;
-            }
-            let [a, b] = topo.edges[e];
-            let uv = |f: usize, v: u32| {
-                let k = (0..3).find(|&k| c.local_mesh.triangles[f][k] == v).unwrap_or(0);
-                c.corner_uv[f][k]
-            };
-            let (f0, f1) = (fs[0] as usize, fs[1] as usize);
-            let d = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
-            if d(uv(f0, a), uv(f1, a)) > 1e-9 || d(uv(f0, b), uv(f1, b)) > 1e-9 {
-                lines.push(vec![
-                    c.local_mesh.positions[a as usize],
-                    c.local_mesh.positions[b as usize],
-                ]);
-            }
-        }
-    }
-    fieldtex_io::write_obj_polylines(&out_dir.join("trajectories.obj"), &lines)?;
-    for b in blocks {
-        fieldtex_io::write_png(&out_dir.join(format!("geometry_image_{}.png", b.label)), &b.image)?;
-        let (tmin, tmax) = b
-            .tau
-            .iter()
-            .filter(|t| t.is_finite())
-            .fold((f32::INFINITY, 0.0f32), |(a, z), &t| (a.min(t), z.max(t)));
-        let mut im = Image::new(b.image.width, b.image.height, [0.0, 0.0, 0.0, 1.0]);
-        for (i, &t) in b.tau.iter().enumerate() {
-            if t.is_finite() && tmax > tmin {
-                let v = ((t.ln() - tmin.ln()) / (tmax.ln() - tmin.ln())).clamp(0.0, 1.0);
-                im.pixels[i] = [v, v, v, 1.0];
-            }
-        }
-        fieldtex_io::write_png(&out_dir.join(format!("tau_{}.png", b.label)), &im)?;
-    }
-    Ok(())
 }

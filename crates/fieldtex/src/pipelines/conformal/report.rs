@@ -1,0 +1,138 @@
+//! Report pieces of the `conformal` pipeline: per-component JSON, texel density and
+//! the notes naming every substitute.
+
+use super::ConformalOptions;
+use crate::Report;
+use fieldtex_param::conformal::mass_spring::map_distortion;
+use fieldtex_param::conformal::{ConformalComponent, ConformalMethod, GeometryImage};
+use serde::Serialize;
+use serde_json::json;
+
+/// Area-weighted quantile of `(value, weight)` pairs.
+pub(super) fn weighted_quantile(v: &mut [(f64, f64)], q: f64) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: f64 = v.iter().map(|x| x.1).sum();
+    let mut acc = 0.0;
+    for x in v.iter() {
+        acc += x.1;
+        if acc >= q * total {
+            return Some(x.0);
+        }
+    }
+    v.last().map(|x| x.0)
+}
+
+#[derive(Serialize)]
+pub(super) struct TexelDensity {
+    /// Area-weighted coefficient of variation of texels per surface area (`τ²`).
+    density_cv: f64,
+    tau_min: f64,
+    tau_median: f64,
+    tau_max: f64,
+}
+
+pub(super) fn texel_density(tau_w: &[(f64, f64)]) -> TexelDensity {
+    let (mut s, mut s2, mut w) = (0.0, 0.0, 0.0);
+    for &(t, a) in tau_w {
+        let d = t * t;
+        s += a * d;
+        s2 += a * d * d;
+        w += a;
+    }
+    let mean = s / w.max(f64::MIN_POSITIVE);
+    let mut v = tau_w.to_vec();
+    TexelDensity {
+        density_cv: (s2 / w.max(f64::MIN_POSITIVE) - mean * mean).max(0.0).sqrt()
+            / mean.max(f64::MIN_POSITIVE),
+        tau_min: tau_w.iter().map(|x| x.0).fold(f64::INFINITY, f64::min),
+        tau_median: weighted_quantile(&mut v, 0.5).unwrap_or(f64::NAN),
+        tau_max: tau_w.iter().map(|x| x.0).fold(0.0, f64::max),
+    }
+}
+
+pub(super) fn component_json(
+    c: &ConformalComponent,
+    img: Option<&GeometryImage>,
+) -> serde_json::Value {
+    let mut v = json!({
+        "component": c.component,
+        "triangles": c.faces.len(),
+        "genus": c.genus,
+        "boundaries": c.boundaries,
+        "method": c.method,
+        "harmonic_1_forms": c.harmonic_forms,
+        "zero_points": c.zero_points.len(),
+        "zero_point_indices": c.zero_points.iter().map(|z| json!({"vertex": z.0, "index": z.1})).collect::<Vec<_>>(),
+        "conjugate_residual": c.conjugate_residual,
+        "double_cover_genus": c.double_cover_genus,
+        "note": c.note,
+    });
+    if c.has_uv() {
+        let near = c.near_singularity.clone();
+        let slit = c.slit.clone();
+        let all = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &move |f| slit[f]);
+        let away = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &move |f| near[f]);
+        v["patches"] = json!(c.map.n_patches());
+        if c.method == ConformalMethod::CriticalTrajectoryPatches {
+            v["critical_trajectories"] = json!(c.map.cut_curves.len());
+            v["small_patches_from_overlap_guard"] = json!(c.map.small_patches);
+            v["ghost_faces"] = json!(c.map.ghosts.len());
+            v["folded_faces_own_chart"] = json!(c.map.folded_faces);
+            v["stretch_cv_best_basis_form"] = json!(c.map.stretch_cv.map(|x| x[0]));
+            v["stretch_cv_optimised_form"] = json!(c.map.stretch_cv.map(|x| x[1]));
+            if let Some(img) = img {
+                v["margin_links"] = json!(img.links.len() / 2);
+            }
+        }
+        v["slit_vertices"] = json!(
+            c.map
+                .slit_vertices
+                .iter()
+                .map(|&l| c.local_to_global.get(l as usize).copied().unwrap_or(u32::MAX))
+                .collect::<Vec<_>>()
+        );
+        v["lattice"] = json!({"a": c.lattice.a, "b": c.lattice.b});
+        v["distortion"] = json!({"angle_mean_away_from_singularities": away.angle_mean, "angle_mean_non_slit": all.angle_mean, "log_area_std": all.log_area_std, "flipped": all.flipped});
+        if let Some(img) = img {
+            v["geometry_image"] = json!({"width": img.width, "height": img.height, "margin": img.margin, "period_x": img.period_x, "period_y": img.period_y});
+        }
+    } else {
+        v["patches"] = json!("fallback atlas");
+    }
+    v
+}
+
+pub(super) fn add_notes(
+    report: &mut Report,
+    comps: &[ConformalComponent],
+    options: &ConformalOptions,
+) {
+    let n = &mut report.notes;
+    if comps.iter().any(|c| c.double_cover_genus.is_some()) {
+        n.push("Open surfaces whose double cover has genus ≥ 2: the double cover (two copies glued along the boundary, the second reversed; paper §3) is parameterised and the first copy kept; zero points on the double cover are reported at their first-copy vertex (mirror pairs appear twice).".into());
+    }
+    if comps.iter().any(|c| c.boundaries > 0 && c.double_cover_genus.is_none()) {
+        n.push("Open disks and annuli (double cover of genus 0 or 1): holes are capped with fans and the capped closed surface is parameterised (caps dropped afterwards); a disk's boundary and an annulus's two boundaries become the ends of the cylinder, which for an annulus is the map its double cover (a torus) gives.".into());
+    }
+    if comps.iter().any(|c| c.method == ConformalMethod::SlitCylinder) {
+        n.push("Genus 0 (the paper is silent): two point slits (vertex stars) at extremal vertices; harmonic u = 0/1 on their rings and its conjugate from the annulus's harmonic 1-form give one cylinder image, periodic across one seam.".into());
+    }
+    if comps.iter().any(|c| c.method == ConformalMethod::CriticalTrajectoryPatches) {
+        n.push("Genus ≥ 2: the critical horizontal trajectories are traced from every zero point across triangles and snapped to edge paths (cuts lie within one triangle of the exact curves); a trajectory stops at a zero point, at an earlier cut or after √(area) of length, because on a discrete form they spiral instead of closing (the paper picks a form with finite trajectories). Patches grow over faces without crossing cuts and are mapped by integrating the form; a face that would overlap its patch seeds a new patch (overlap guard, counted in small_patches_from_overlap_guard). Patches are packed without rotation into one image; faces up to 2 rings across each cut are drawn as ghosts in the margins, linked texel to texel (nearest texel after the translation, ≤ ½ texel misregistration) for boundary consistency.".into());
+        n.push("The genus ≥ 2 holomorphic form minimises the area-weighted CV of |φ|² over all holomorphic forms by a compass search from the best basis form — a substitute for Jin et al. 2004's own solver (both CVs reported).".into());
+        if options.quasi_isometric {
+            n.push("Mass-spring relaxation is not applied to genus ≥ 2 patch layouts (it would break the translation links across cuts).".into());
+        }
+    }
+    if comps.iter().any(|c| !c.has_uv()) {
+        n.push("Failed components are textured through a chart atlas (LSCM charts) without boundary consistency across chart seams.".into());
+    }
+    n.push("τ per texel: barycentric interpolation of per-vertex τ (substitute for the paper's Gaussian RBF).".into());
+    n.push("Quilting: random candidate subset per patch (not exhaustive), old seams not re-cut; colours compared in sRGB.".into());
+    if options.quasi_isometric {
+        n.push("Mass-spring (eq. 2) in a balanced spring form (rest length = 3-D length / mean conformal factor), stopped when the mean angle distortion would exceed 1.25.".into());
+    }
+}
