@@ -21,7 +21,7 @@ use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::align::{atlas_carriers, carrier_texture};
 use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
-use fieldtex_core::{Image, Warning};
+use fieldtex_core::Image;
 use fieldtex_fields::{FrameField3d, FrameFieldOptions, FrameGrid, Sketch, quaternion};
 use fieldtex_mesh::{Bvh, TriMesh};
 use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
@@ -179,8 +179,12 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
         .bounding_box()
         .ok_or_else(|| Error::bad_input(Some(&options.mesh), "the mesh has no vertex"))?;
     // 1. Sketch and frame field (§3).
-    let (field, curves) = report
-        .time("frame_field", || frame_field(&mesh, bbox.min, bbox.max, options, &mut Vec::new()))?;
+    let (field, curves) = report.time("frame_field", || match &options.sketch {
+        Some(path) => {
+            solid_frame_field(&mesh, path, options.field_cells).map(|(f, c)| (Some(f), c))
+        }
+        None => Ok((None, Vec::new())),
+    })?;
     if let Some(f) = &field {
         let errs = f.constraint_errors_deg();
         let max = errs.iter().cloned().fold(0.0, f64::max);
@@ -193,6 +197,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
                 "constrained_nodes": errs.len(),
                 "alignment_error_max_deg": max,
                 "alignment_error_mean_deg": mean,
+                "factor_entries": f.factor_nnz(),
+                "residual": f.last_residual(),
             }),
         );
         let edit_ms = report.time("frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
@@ -331,15 +337,18 @@ fn transpose(im: &Image) -> Image {
     t
 }
 
-/// The frame field of the sketch (`None` without a sketch) and the placed curves.
-fn frame_field(
+/// The frame field of the sketch at `sketch` over `mesh`'s bounding box (shortest side
+/// `field_cells` cells) and the placed curves, each curve added as an edit of the kept
+/// factor. The returned [`FrameField3d`] stays editable (`add_curve`, `remove_curve`,
+/// `replace_curve`: one factor update and one solve each), for interactive front ends.
+pub fn solid_frame_field(
     mesh: &TriMesh,
-    min: [f64; 3],
-    max: [f64; 3],
-    options: &SolidOptions,
-    _warnings: &mut Vec<Warning>,
-) -> Result<(Option<FrameField3d>, Vec<fieldtex_fields::FrameCurve>)> {
-    let Some(path) = &options.sketch else { return Ok((None, Vec::new())) };
+    sketch: &Path,
+    field_cells: usize,
+) -> Result<(FrameField3d, Vec<fieldtex_fields::FrameCurve>)> {
+    let path = sketch;
+    let bbox =
+        mesh.bounding_box().ok_or_else(|| Error::bad_input(None, "the mesh has no vertex"))?;
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::bad_input(Some(path), format!("cannot read the sketch: {e}")))?;
     let sketch: Sketch = serde_json::from_str(&text).map_err(|e| {
@@ -350,18 +359,19 @@ fn frame_field(
     })?;
     let curves =
         sketch.frame_curves(mesh).map_err(|e| Error::bad_input(Some(path), e.to_string()))?;
-    let grid = FrameGrid::over_box(min, max, options.field_cells)
+    let grid = FrameGrid::over_box(bbox.min, bbox.max, field_cells)
         .map_err(|e| Error::bad_input(None, format!("--field-cells: {e}")))?;
     let mut field = FrameField3d::new(grid, FrameFieldOptions::default())
         .map_err(|e| Error::Internal(e.to_string()))?;
     for (i, c) in curves.iter().enumerate() {
         field.add_curve(c).map_err(|e| Error::bad_input(Some(path), format!("curve {i}: {e}")))?;
     }
-    Ok((Some(field), curves))
+    Ok((field, curves))
 }
 
 /// Interactive edit timings: the curves added one by one into a fresh field (the first
-/// factors), then the last curve removed and added again (downdate + update + solve).
+/// factors), then the last curve removed and added again, and replaced by itself (a
+/// redraw: downdate + update + one solve).
 fn edit_timing(
     grid: FrameGrid,
     curves: &[fieldtex_fields::FrameCurve],
@@ -383,7 +393,18 @@ fn edit_timing(
         field.add_curve(c).map_err(|e| Error::Internal(e.to_string()))?;
     }
     let readd_ms = t.elapsed().as_secs_f64() * 1e3;
-    Ok(serde_json::json!({"add_ms": add_ms, "remove_ms": remove_ms, "re_add_ms": readd_ms}))
+    let ids = field.curve_ids();
+    let t = Instant::now();
+    if let (Some(&id), Some(c)) = (ids.last(), curves.last()) {
+        field.replace_curve(id, c).map_err(|e| Error::Internal(e.to_string()))?;
+    }
+    let replace_ms = t.elapsed().as_secs_f64() * 1e3;
+    Ok(serde_json::json!({
+        "add_ms": add_ms,
+        "remove_ms": remove_ms,
+        "re_add_ms": readd_ms,
+        "replace_ms": replace_ms,
+    }))
 }
 
 /// Eight voxels and trilinear weights around world point `p`.
