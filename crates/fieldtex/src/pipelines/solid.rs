@@ -36,6 +36,9 @@ use std::time::Instant;
 #[path = "solid_outputs.rs"]
 mod extra_outputs;
 use extra_outputs::{write_cut, write_frames, write_volume};
+#[path = "solid_regions.rs"]
+mod regions;
+use regions::{Interior, SolidRegions};
 
 /// Options of [`solid`].
 #[derive(Debug, Clone, Serialize)]
@@ -56,6 +59,13 @@ pub struct SolidOptions {
     pub volume: bool,
     /// Write `frames.ply`.
     pub keep: bool,
+    /// Exemplar of the interior region (all three planes), `None` = one region.
+    pub interior: Option<PathBuf>,
+    /// Depth below the surface (mesh units) where the interior starts (middle of the
+    /// blend band). 0 = default: 15 % of the bounding box's shortest side.
+    pub interior_depth: f64,
+    /// Width of the blend band (mesh units). 0 = default: three voxels.
+    pub interior_band: f64,
     /// Atlas size of `model.glb` and the cut meshes, texels. Default 1024.
     pub atlas_size: usize,
     /// Frame-field cells along the bounding box's shortest side. Default 20 (paper: 20–30).
@@ -78,6 +88,9 @@ impl Default for SolidOptions {
             cuts: Vec::new(),
             volume: false,
             keep: false,
+            interior: None,
+            interior_depth: 0.0,
+            interior_band: 0.0,
             atlas_size: 1024,
             field_cells: 20,
             analysis: SolidAnalysisOptions::default(),
@@ -214,8 +227,47 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     report.metric("grid", grid);
     let frames = FieldFrames(field.as_ref());
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
-    let mut synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
+    let synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
         .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?;
+    let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+    // The interior region (paper E Fig. 15): its own analysis, same lattice and field.
+    let ex_inner = match &options.interior {
+        Some(path) => {
+            let im = fieldtex_io::read_image(path)?;
+            let images = [im.clone(), transpose(&im), im];
+            let mut a = options.analysis.clone();
+            a.plane_weights = [1.0, 1.0, 0.0];
+            Some(
+                report
+                    .time("interior_exemplar_analysis", || {
+                        SolidExemplar::new([&images[0], &images[1], &images[2]], &a, progress)
+                    })
+                    .map_err(|e| Error::bad_input(Some(path), format!("interior exemplar: {e}")))?,
+            )
+        }
+        None => None,
+    };
+    let shortest = (0..3).map(|a| bbox.max[a] - bbox.min[a]).fold(f64::INFINITY, f64::min);
+    let depth = if options.interior_depth > 0.0 { options.interior_depth } else { 0.15 * shortest };
+    let band = if options.interior_band > 0.0 { options.interior_band } else { 3.0 * grid.spacing };
+    if !(depth.is_finite() && band.is_finite()) {
+        return Err(Error::bad_input(None, "--interior-depth must be a finite number"));
+    }
+    let inner = match &ex_inner {
+        Some(e) => Some(Interior {
+            synth: SolidSynthesizer::new(e, lattice, &frames, options.synthesis.clone())
+                .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?,
+            bvh: &bvh,
+            depth,
+            band,
+            scale: bbox.diagonal(),
+        }),
+        None => None,
+    };
+    if inner.is_some() {
+        report.metric("interior", serde_json::json!({"depth": depth, "band": band}));
+    }
+    let mut synth = SolidRegions { outer: synth, inner, grid };
     // 3. Surface shell → atlas texture → model.glb.
     let (atlas_mesh, texture, shell) =
         report.time("shell", || textured_atlas(&mesh, &aopts, &grid, &mut synth, progress))?;
@@ -229,7 +281,6 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let preview = report.time("preview", || preview_with_curves(&atlas_mesh, &texture, &curves));
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     // 4. Cuts.
-    let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
     let mut cut_reports = Vec::new();
     for (i, cut) in options.cuts.iter().enumerate() {
         let r = report.time(&format!("cut_{}", i + 1), || {
@@ -278,6 +329,7 @@ fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, 
         super::repair_stage::repair_into_report(&loaded.mesh, Some(&options.mesh), None, report)?;
     let mut inputs = vec![options.mesh.clone()];
     inputs.extend(options.sketch.iter().cloned());
+    inputs.extend(options.interior.iter().cloned());
     inputs.extend(
         [&options.exemplar, &options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx]
             .into_iter()
@@ -423,7 +475,7 @@ fn trilinear(grid: &SolidGrid, p: [f64; 3]) -> [([i32; 3], f32); 8] {
 fn surface_colors(
     points: &[[f64; 3]],
     grid: &SolidGrid,
-    synth: &mut SolidSynthesizer<'_>,
+    synth: &mut SolidRegions<'_>,
     progress: &dyn Progress,
     work: &mut Work,
 ) -> Vec<[f32; 4]> {
@@ -455,7 +507,7 @@ fn textured_atlas(
     mesh: &TriMesh,
     aopts: &fieldtex_param::AtlasOptions,
     grid: &SolidGrid,
-    synth: &mut SolidSynthesizer<'_>,
+    synth: &mut SolidRegions<'_>,
     progress: &dyn Progress,
 ) -> Result<(TriMesh, Image, Work)> {
     let atlas = fieldtex_param::build_atlas(mesh, aopts, progress)
@@ -498,9 +550,12 @@ fn notes(options: &SolidOptions) -> Vec<String> {
             options.analysis.neighbourhood, options.analysis.pca_dims
         ),
         "the coarsest level uses the same block (dual-grid) scheme as the others, with more passes, so that every level is lazy; the paper corrects the whole coarsest level without barriers".to_string(),
-        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple; no feature channel (bricks) and no interior regions (--interior) are implemented".to_string(),
+        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple; no feature channel (bricks) is implemented".to_string(),
         "the surface texture interpolates the eight voxels around each texel's surface point (trilinear)".to_string(),
     ];
+    if options.interior.is_some() {
+        n.push("--interior: voxels deeper than the interior depth below the surface (closest-point distance, ray-parity inside test) come from a second synthesizer with the interior exemplar (same lattice and field), blended by a smoothstep across the band; the interior exemplar feeds xy and transposed yz with zx weight 0, as a single --exemplar does".into());
+    }
     if options.sketch.is_none() {
         n.push("no sketch: a constant (identity) frame field, the unguided baseline".into());
     }
