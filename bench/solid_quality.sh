@@ -48,12 +48,12 @@ for name in "${names[@]}"; do
     out="$dir/$name-$tag"
     target/release/fieldtex solid --mesh "$dir/box.obj" "${sk[@]}" --exemplar "$ex" \
       --resolution "$res" --atlas-size 256 --cut="0,0,$z,0,0,1" --keep --out "$out" --quiet
+    # Both runs are measured in their own field's frame (cut-1-field.npy: the sketched
+    # field, or the constant x axis): guided coherence compares the exemplar with the
+    # slice's neighbourhoods taken along the field's planes (issue 15's "slices along
+    # the field's planes"); plain coherence compares axis-aligned patches.
     field="$out/cut-1-field.npy"
-    if [ "$tag" = bent ]; then
-      target/release/fieldtex eval "$out/cut-1.png" --exemplar "$ex" --field "$field" --out "$out/eval.json" > /dev/null
-    else
-      target/release/fieldtex eval "$out/cut-1.png" --exemplar "$ex" --angle 0 --out "$out/eval.json" > /dev/null
-    fi
+    target/release/fieldtex eval "$out/cut-1.png" --exemplar "$ex" --field "$field" --out "$out/eval.json" > /dev/null
   done
   python3 - "$dir/$name-bent/eval.json" "$dir/$name-constant/eval.json" "$name" <<'PY'
 import json, sys
@@ -66,8 +66,10 @@ def g(m, *keys):
 cb, cc = g(b, "coherence", "mean"), g(c, "coherence", "mean")
 sb, sc = g(b, "color_sliced_wasserstein", "distance"), g(c, "color_sliced_wasserstein", "distance")
 ob, oc = g(b, "orientation_error", "mean_error_deg"), g(c, "orientation_error", "mean_error_deg")
-print(f"QUALITY {sys.argv[3]}: coherence bent {cb} constant {cc} ratio {cb / cc if cb and cc else None}")
+gb, gc = g(b, "guided_coherence", "mean"), g(c, "guided_coherence", "mean")
+print(f"QUALITY {sys.argv[3]}: guided coherence (along the field) bent {gb} constant {gc} ratio {gb / gc if gb and gc else None}")
+print(f"  plain coherence (axis-aligned patches) bent {cb} constant {cc} ratio {cb / cc if cb and cc else None}")
 print(f"  colour SW bent {sb} constant {sc} ratio {sb / sc if sb and sc else None}")
-print(f"  orientation error vs the sketched field: bent {ob}°, constant (vs 0°) {oc}°")
+print(f"  orientation error vs the field: bent {ob}°, constant {oc}°")
 PY
 done

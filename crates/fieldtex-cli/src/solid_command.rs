@@ -61,9 +61,14 @@ pub struct SolidArgs {
     /// Synthesis levels.
     #[arg(long, default_value_t = 5)]
     levels: usize,
-    /// Second exemplar for the interior (not implemented yet: refused).
+    /// Exemplar of the interior region (e.g. wood inside bark): voxels deeper than
+    /// --interior-depth below the surface use it, blended across a thin band.
     #[arg(long)]
     interior: Option<PathBuf>,
+    /// Depth of the interior region below the surface, mesh units (default: 15 % of the
+    /// bounding box's shortest side).
+    #[arg(long)]
+    interior_depth: Option<f64>,
 }
 
 fn parse_cut(s: &str) -> Result<[f64; 6], String> {
@@ -86,10 +91,12 @@ pub fn run_solid(
     seed: u64,
     progress: &dyn fieldtex::Progress,
 ) -> Result<fieldtex::Report, Error> {
-    if let Some(p) = &a.interior {
+    if let Some(d) = a.interior_depth
+        && !(d.is_finite() && d > 0.0)
+    {
         return Err(Error::bad_input(
-            Some(p),
-            "--interior (two-region solids) is not implemented yet",
+            None,
+            format!("--interior-depth must be a positive distance in mesh units, got {d}"),
         ));
     }
     let mut opts = fieldtex::SolidOptions {
@@ -103,6 +110,8 @@ pub fn run_solid(
         cuts: a.cuts,
         volume: a.volume,
         keep: a.keep,
+        interior: a.interior,
+        interior_depth: a.interior_depth.unwrap_or(0.0),
         atlas_size: a.atlas_size,
         field_cells: a.field_cells,
         seed,

@@ -187,3 +187,77 @@ fn bad_sketches_name_the_curve_and_point() {
     ]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// `--interior`: a second exemplar below a depth. The cut image still equals the
+/// volume's slice byte for byte (both regions on demand), voxels near the surface keep
+/// the outer solid, and deep voxels change.
+#[test]
+fn interior_region_fills_the_deep_voxels() {
+    let run_one = |name: &str, interior: bool| {
+        let dir = tmp(name);
+        let out = dir.join("out");
+        let mut args = vec![
+            "solid".to_string(),
+            "--mesh".into(),
+            shared().join("meshes/torus.obj").to_str().unwrap().into(),
+            "--exemplar".into(),
+            shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap().into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+            "--resolution".into(),
+            "40".into(),
+            "--atlas-size".into(),
+            "128".into(),
+            "--levels".into(),
+            "3".into(),
+            "--block".into(),
+            "6".into(),
+            "--cut=0,0.03125,0,0,1,0".into(),
+            "--volume".into(),
+            "--quiet".into(),
+        ];
+        if interior {
+            args.push("--interior".into());
+            args.push(shared().join("exemplars/stripes_Fabric071.png").to_str().unwrap().into());
+            args.push("--interior-depth".into());
+            args.push("0.12".into());
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = run(&refs);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    let plain = run_one("interior-off", false);
+    let two = run_one("interior-on", true);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(two.join("report.json")).unwrap()).unwrap();
+    assert!(report["metrics"]["interior"]["depth"].as_f64().unwrap() > 0.0);
+    let read_vol = |d: &Path| {
+        fieldtex::crates::io::decode_nrrd_rgb(&std::fs::read(d.join("volume.nrrd")).unwrap(), "v")
+            .unwrap()
+    };
+    let (va, vb) = (read_vol(&plain), read_vol(&two));
+    let img = fieldtex::crates::io::read_image(&two.join("cut-1.png")).unwrap();
+    let [nx, _, nz] = vb.sizes;
+    // Slice y = 0.03125: voxel index (0.03125 + 0.21875) / 0.0625 = 4.
+    let at = |v: &fieldtex::crates::io::RgbVolume, x: usize, z: usize| {
+        let i = 3 * (x + nx * (4 + vb.sizes[1] * z));
+        [v.data[i], v.data[i + 1], v.data[i + 2]]
+    };
+    let (mut opaque, mut changed) = (0, 0);
+    for z in 0..nz {
+        for x in 0..nx {
+            let p = img.get(x, z).map(|v| (v * 255.0).round() as u8);
+            if p[3] == 0 {
+                continue;
+            }
+            opaque += 1;
+            assert_eq!([p[0], p[1], p[2]], at(&vb, x, z), "cut ≠ volume at ({x}, {z})");
+            if at(&va, x, z) != at(&vb, x, z) {
+                changed += 1;
+            }
+        }
+    }
+    assert!(opaque > 100, "{opaque} opaque pixels");
+    assert!(changed > 0 && changed < opaque, "{changed} of {opaque} slice voxels changed");
+}

@@ -337,7 +337,7 @@ impl<'a> SolidSynthesizer<'a> {
             let d: [f64; 3] = std::array::from_fn(|a| v[a] as f64 - o[a]);
             // Local coordinates Rᵀ d.
             let w: [i32; 3] = std::array::from_fn(|col| {
-                (rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2]).round() as i32
+                round_f64_i32(rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2])
             });
             let layer = floor_div(w[2], n);
             let t = w[2] - layer * n - n / 2;
@@ -368,7 +368,7 @@ impl<'a> SolidSynthesizer<'a> {
         let d: [f64; 3] = std::array::from_fn(|col| {
             rm[col] * delta[0] + rm[3 + col] * delta[1] + rm[6 + col] * delta[2]
         });
-        let di: [i32; 3] = d.map(|x| x.round() as i32);
+        let di: [i32; 3] = d.map(round_f64_i32);
         let mut tr = parent;
         tr[0][0] += di[0];
         tr[0][1] += di[1];
@@ -541,15 +541,25 @@ impl<'a> SolidSynthesizer<'a> {
             let u = [f[a1], f[3 + a1], f[6 + a1]];
             let w = [f[a2], f[3 + a2], f[6 + a2]];
             let lvl = &self.exemplar.planes[p].levels[c];
+            // Region index of every in-plane offset `(s, t)` (the voxel nearest
+            // `at + s·u + t·w`), computed once and shared by the neighbourhood and the
+            // candidate prediction below.
+            let base = idx(at) as isize;
             let mut k = 0;
-            // A zero-weight plane contributes candidates but no neighbourhood.
-            for t in (-half..=half).filter(|_| weights[p] > 0.0) {
+            for t in -half..=half {
                 for ss in -half..=half {
                     let (sf, tf) = (ss as f32, t as f32);
-                    let q: [i32; 3] =
-                        std::array::from_fn(|a| at[a] + (sf * u[a] + tf * w[a]).round() as i32);
-                    scratch.buf[k..k + 3].copy_from_slice(&colors[idx(q)]);
-                    k += 3;
+                    let d: [i32; 3] = std::array::from_fn(|a| round_i32(sf * u[a] + tf * w[a]));
+                    scratch.offsets[k] = base + ((d[2] * s + d[1]) * s + d[0]) as isize;
+                    k += 1;
+                }
+            }
+            let offset =
+                |ss: i32, t: i32| scratch.offsets[((t + half) * n + ss + half) as usize] as usize;
+            // A zero-weight plane contributes candidates but no neighbourhood.
+            if weights[p] > 0.0 {
+                for (j, &o) in scratch.offsets[..(n * n) as usize].iter().enumerate() {
+                    scratch.buf[3 * j..3 * j + 3].copy_from_slice(&colors[o as usize]);
                 }
             }
             let dims = if weights[p] > 0.0 { lvl.dims() } else { 0 };
@@ -573,10 +583,7 @@ impl<'a> SolidSynthesizer<'a> {
                         }
                         continue;
                     }
-                    let (xf, yf) = (dx as f32, dy as f32);
-                    let q: [i32; 3] =
-                        std::array::from_fn(|a| at[a] + (xf * u[a] + yf * w[a]).round() as i32);
-                    let nb = region[idx(q)];
+                    let nb = region[offset(dx, dy)];
                     let pred = [nb[p][0] - h * dx, nb[p][1] - h * dy];
                     for kk in 0..self.options.k {
                         scratch.candidates.push(*table.get(pred[0], pred[1], kk));
@@ -614,6 +621,8 @@ impl<'a> SolidSynthesizer<'a> {
 /// Per-block scratch buffers.
 struct Scratch {
     buf: Vec<f32>,
+    /// Region indices of the `N × N` in-plane offsets of the current plane.
+    offsets: Vec<isize>,
     proj: [[f32; 32]; 3],
     candidates: Vec<Triple>,
 }
@@ -621,7 +630,41 @@ struct Scratch {
 impl Scratch {
     fn new(e: &SolidExemplar) -> Self {
         let n = e.options.neighbourhood;
-        Self { buf: vec![0.0; n * n * 3], proj: [[0.0; 32]; 3], candidates: Vec::with_capacity(64) }
+        Self {
+            buf: vec![0.0; n * n * 3],
+            offsets: vec![0; n * n],
+            proj: [[0.0; 32]; 3],
+            candidates: Vec::with_capacity(64),
+        }
+    }
+}
+
+/// `x` rounded to the nearest integer, halves away from zero (as `f32::round`, without
+/// the library call the baseline x86-64 target makes for it; `x` is a small offset).
+#[inline]
+fn round_i32(x: f32) -> i32 {
+    let t = x as i32;
+    let r = x - t as f32;
+    if r >= 0.5 {
+        t + 1
+    } else if r <= -0.5 {
+        t - 1
+    } else {
+        t
+    }
+}
+
+/// [`round_i32`] for `f64` (as `f64::round` for `|x| < 2³¹`).
+#[inline]
+fn round_f64_i32(x: f64) -> i32 {
+    let t = x as i32;
+    let r = x - t as f64;
+    if r >= 0.5 {
+        t + 1
+    } else if r <= -0.5 {
+        t - 1
+    } else {
+        t
     }
 }
 
@@ -636,6 +679,24 @@ fn for_box(lo: [i32; 3], hi: [i32; 3], mut f: impl FnMut([i32; 3])) {
             for x in lo[0]..=hi[0] {
                 f([x, y, z]);
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod rounding_tests {
+    use super::{round_f64_i32, round_i32};
+
+    #[test]
+    fn fast_rounding_equals_the_library_rounding() {
+        let mut x = -40.0f32;
+        while x < 40.0 {
+            for v in [x, f32::from_bits(x.to_bits() + 1), f32::from_bits(x.to_bits() - 1)] {
+                assert_eq!(round_i32(v), v.round() as i32, "{v}");
+                let w = v as f64 * 1.000_000_1;
+                assert_eq!(round_f64_i32(w), w.round() as i32, "{w}");
+            }
+            x += 0.125;
         }
     }
 }

@@ -21,7 +21,7 @@ use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::align::{atlas_carriers, carrier_texture};
 use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
-use fieldtex_core::{Image, Warning};
+use fieldtex_core::Image;
 use fieldtex_fields::{FrameField3d, FrameFieldOptions, FrameGrid, Sketch, quaternion};
 use fieldtex_mesh::{Bvh, TriMesh};
 use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
@@ -36,6 +36,9 @@ use std::time::Instant;
 #[path = "solid_outputs.rs"]
 mod extra_outputs;
 use extra_outputs::{write_cut, write_frames, write_volume};
+#[path = "solid_regions.rs"]
+mod regions;
+use regions::{Interior, SolidRegions};
 
 /// Options of [`solid`].
 #[derive(Debug, Clone, Serialize)]
@@ -56,6 +59,13 @@ pub struct SolidOptions {
     pub volume: bool,
     /// Write `frames.ply`.
     pub keep: bool,
+    /// Exemplar of the interior region (all three planes), `None` = one region.
+    pub interior: Option<PathBuf>,
+    /// Depth below the surface (mesh units) where the interior starts (middle of the
+    /// blend band). 0 = default: 15 % of the bounding box's shortest side.
+    pub interior_depth: f64,
+    /// Width of the blend band (mesh units). 0 = default: three voxels.
+    pub interior_band: f64,
     /// Atlas size of `model.glb` and the cut meshes, texels. Default 1024.
     pub atlas_size: usize,
     /// Frame-field cells along the bounding box's shortest side. Default 20 (paper: 20–30).
@@ -78,6 +88,9 @@ impl Default for SolidOptions {
             cuts: Vec::new(),
             volume: false,
             keep: false,
+            interior: None,
+            interior_depth: 0.0,
+            interior_band: 0.0,
             atlas_size: 1024,
             field_cells: 20,
             analysis: SolidAnalysisOptions::default(),
@@ -179,8 +192,12 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
         .bounding_box()
         .ok_or_else(|| Error::bad_input(Some(&options.mesh), "the mesh has no vertex"))?;
     // 1. Sketch and frame field (§3).
-    let (field, curves) = report
-        .time("frame_field", || frame_field(&mesh, bbox.min, bbox.max, options, &mut Vec::new()))?;
+    let (field, curves) = report.time("frame_field", || match &options.sketch {
+        Some(path) => {
+            solid_frame_field(&mesh, path, options.field_cells).map(|(f, c)| (Some(f), c))
+        }
+        None => Ok((None, Vec::new())),
+    })?;
     if let Some(f) = &field {
         let errs = f.constraint_errors_deg();
         let max = errs.iter().cloned().fold(0.0, f64::max);
@@ -193,6 +210,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
                 "constrained_nodes": errs.len(),
                 "alignment_error_max_deg": max,
                 "alignment_error_mean_deg": mean,
+                "factor_entries": f.factor_nnz(),
+                "residual": f.last_residual(),
             }),
         );
         let edit_ms = report.time("frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
@@ -209,8 +228,47 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     report.metric("grid", grid);
     let frames = FieldFrames(field.as_ref());
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
-    let mut synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
+    let synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
         .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?;
+    let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+    // The interior region (paper E Fig. 15): its own analysis, same lattice and field.
+    let ex_inner = match &options.interior {
+        Some(path) => {
+            let im = fieldtex_io::read_image(path)?;
+            let images = [im.clone(), transpose(&im), im];
+            let mut a = options.analysis.clone();
+            a.plane_weights = [1.0, 1.0, 0.0];
+            Some(
+                report
+                    .time("interior_exemplar_analysis", || {
+                        SolidExemplar::new([&images[0], &images[1], &images[2]], &a, progress)
+                    })
+                    .map_err(|e| Error::bad_input(Some(path), format!("interior exemplar: {e}")))?,
+            )
+        }
+        None => None,
+    };
+    let shortest = (0..3).map(|a| bbox.max[a] - bbox.min[a]).fold(f64::INFINITY, f64::min);
+    let depth = if options.interior_depth > 0.0 { options.interior_depth } else { 0.15 * shortest };
+    let band = if options.interior_band > 0.0 { options.interior_band } else { 3.0 * grid.spacing };
+    if !(depth.is_finite() && band.is_finite()) {
+        return Err(Error::bad_input(None, "--interior-depth must be a finite number"));
+    }
+    let inner = match &ex_inner {
+        Some(e) => Some(Interior {
+            synth: SolidSynthesizer::new(e, lattice, &frames, options.synthesis.clone())
+                .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?,
+            bvh: &bvh,
+            depth,
+            band,
+            scale: bbox.diagonal(),
+        }),
+        None => None,
+    };
+    if inner.is_some() {
+        report.metric("interior", serde_json::json!({"depth": depth, "band": band}));
+    }
+    let mut synth = SolidRegions { outer: synth, inner, grid };
     crate::outputs::check_cancelled(progress)?;
     // 3. Surface shell → atlas texture → model.glb.
     let (atlas_mesh, texture, shell) =
@@ -226,7 +284,6 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     crate::outputs::check_cancelled(progress)?;
     // 4. Cuts.
-    let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
     let mut cut_reports = Vec::new();
     for (i, cut) in options.cuts.iter().enumerate() {
         let r = report.time(&format!("cut_{}", i + 1), || {
@@ -275,6 +332,7 @@ fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, 
         super::repair_stage::repair_into_report(&loaded.mesh, Some(&options.mesh), None, report)?;
     let mut inputs = vec![options.mesh.clone()];
     inputs.extend(options.sketch.iter().cloned());
+    inputs.extend(options.interior.iter().cloned());
     inputs.extend(
         [&options.exemplar, &options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx]
             .into_iter()
@@ -334,15 +392,18 @@ fn transpose(im: &Image) -> Image {
     t
 }
 
-/// The frame field of the sketch (`None` without a sketch) and the placed curves.
-fn frame_field(
+/// The frame field of the sketch at `sketch` over `mesh`'s bounding box (shortest side
+/// `field_cells` cells) and the placed curves, each curve added as an edit of the kept
+/// factor. The returned [`FrameField3d`] stays editable (`add_curve`, `remove_curve`,
+/// `replace_curve`: one factor update and one solve each), for interactive front ends.
+pub fn solid_frame_field(
     mesh: &TriMesh,
-    min: [f64; 3],
-    max: [f64; 3],
-    options: &SolidOptions,
-    _warnings: &mut Vec<Warning>,
-) -> Result<(Option<FrameField3d>, Vec<fieldtex_fields::FrameCurve>)> {
-    let Some(path) = &options.sketch else { return Ok((None, Vec::new())) };
+    sketch: &Path,
+    field_cells: usize,
+) -> Result<(FrameField3d, Vec<fieldtex_fields::FrameCurve>)> {
+    let path = sketch;
+    let bbox =
+        mesh.bounding_box().ok_or_else(|| Error::bad_input(None, "the mesh has no vertex"))?;
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::bad_input(Some(path), format!("cannot read the sketch: {e}")))?;
     let sketch: Sketch = serde_json::from_str(&text).map_err(|e| {
@@ -353,18 +414,19 @@ fn frame_field(
     })?;
     let curves =
         sketch.frame_curves(mesh).map_err(|e| Error::bad_input(Some(path), e.to_string()))?;
-    let grid = FrameGrid::over_box(min, max, options.field_cells)
+    let grid = FrameGrid::over_box(bbox.min, bbox.max, field_cells)
         .map_err(|e| Error::bad_input(None, format!("--field-cells: {e}")))?;
     let mut field = FrameField3d::new(grid, FrameFieldOptions::default())
         .map_err(|e| Error::Internal(e.to_string()))?;
     for (i, c) in curves.iter().enumerate() {
         field.add_curve(c).map_err(|e| Error::bad_input(Some(path), format!("curve {i}: {e}")))?;
     }
-    Ok((Some(field), curves))
+    Ok((field, curves))
 }
 
 /// Interactive edit timings: the curves added one by one into a fresh field (the first
-/// factors), then the last curve removed and added again (downdate + update + solve).
+/// factors), then the last curve removed and added again, and replaced by itself (a
+/// redraw: downdate + update + one solve).
 fn edit_timing(
     grid: FrameGrid,
     curves: &[fieldtex_fields::FrameCurve],
@@ -386,7 +448,18 @@ fn edit_timing(
         field.add_curve(c).map_err(|e| Error::Internal(e.to_string()))?;
     }
     let readd_ms = t.elapsed().as_secs_f64() * 1e3;
-    Ok(serde_json::json!({"add_ms": add_ms, "remove_ms": remove_ms, "re_add_ms": readd_ms}))
+    let ids = field.curve_ids();
+    let t = Instant::now();
+    if let (Some(&id), Some(c)) = (ids.last(), curves.last()) {
+        field.replace_curve(id, c).map_err(|e| Error::Internal(e.to_string()))?;
+    }
+    let replace_ms = t.elapsed().as_secs_f64() * 1e3;
+    Ok(serde_json::json!({
+        "add_ms": add_ms,
+        "remove_ms": remove_ms,
+        "re_add_ms": readd_ms,
+        "replace_ms": replace_ms,
+    }))
 }
 
 /// Eight voxels and trilinear weights around world point `p`.
@@ -405,7 +478,7 @@ fn trilinear(grid: &SolidGrid, p: [f64; 3]) -> [([i32; 3], f32); 8] {
 fn surface_colors(
     points: &[[f64; 3]],
     grid: &SolidGrid,
-    synth: &mut SolidSynthesizer<'_>,
+    synth: &mut SolidRegions<'_>,
     progress: &dyn Progress,
     work: &mut Work,
 ) -> Vec<[f32; 4]> {
@@ -437,7 +510,7 @@ fn textured_atlas(
     mesh: &TriMesh,
     aopts: &fieldtex_param::AtlasOptions,
     grid: &SolidGrid,
-    synth: &mut SolidSynthesizer<'_>,
+    synth: &mut SolidRegions<'_>,
     progress: &dyn Progress,
 ) -> Result<(TriMesh, Image, Work)> {
     let atlas = fieldtex_param::build_atlas(mesh, aopts, progress)
@@ -480,9 +553,12 @@ fn notes(options: &SolidOptions) -> Vec<String> {
             options.analysis.neighbourhood, options.analysis.pca_dims
         ),
         "the coarsest level uses the same block (dual-grid) scheme as the others, with more passes, so that every level is lazy; the paper corrects the whole coarsest level without barriers".to_string(),
-        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple; no feature channel (bricks) and no interior regions (--interior) are implemented".to_string(),
+        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple; no feature channel (bricks) is implemented".to_string(),
         "the surface texture interpolates the eight voxels around each texel's surface point (trilinear)".to_string(),
     ];
+    if options.interior.is_some() {
+        n.push("--interior: voxels deeper than the interior depth below the surface (closest-point distance, ray-parity inside test) come from a second synthesizer with the interior exemplar (same lattice and field), blended by a smoothstep across the band; the interior exemplar feeds xy and transposed yz with zx weight 0, as a single --exemplar does".into());
+    }
     if options.sketch.is_none() {
         n.push("no sketch: a constant (identity) frame field, the unguided baseline".into());
     }

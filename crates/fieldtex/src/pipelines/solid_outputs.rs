@@ -30,7 +30,7 @@ pub(super) fn write_cut(
     bvh: &Bvh,
     aopts: &fieldtex_param::AtlasOptions,
     grid: &SolidGrid,
-    synth: &mut SolidSynthesizer<'_>,
+    synth: &mut SolidRegions<'_>,
     keep_field: Option<&FieldFrames<'_>>,
     progress: &dyn Progress,
 ) -> Result<serde_json::Value> {
@@ -151,7 +151,7 @@ fn slice_image(
     grid: &SolidGrid,
     bvh: &Bvh,
     scale: f64,
-    synth: &mut SolidSynthesizer<'_>,
+    synth: &mut SolidRegions<'_>,
     progress: &dyn Progress,
     work: &mut Work,
 ) -> Image {
@@ -180,7 +180,7 @@ fn slice_image(
 pub(super) fn write_volume(
     out_dir: &Path,
     grid: &SolidGrid,
-    synth: &mut SolidSynthesizer<'_>,
+    synth: &mut SolidRegions<'_>,
     progress: &dyn Progress,
 ) -> Result<Work> {
     let [nx, ny, nz] = grid.sizes;
