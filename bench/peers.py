@@ -6,7 +6,8 @@ Peers: libigl (cotan Laplacian + mass), CHOLMOD via scikit-sparse (penalty syste
 factorisation), xatlas (atlas on the bunny, and the atlas size sweep).
 
 `--atlas-sweep NAME=MESH ...` runs only the xatlas size sweep: for each mesh, the median
-time of `xatlas.Atlas.generate` (3 runs below 50K triangles, 1 above) with the padding
+time of `xatlas.Atlas.generate` (3 runs below 50K triangles, 1 above) and its mean CPU
+time (all threads; compare with `atlas_NAME_cpu` when the machine is loaded) with the padding
 and resolution of our defaults (4 texels, 1024), its chart count, and its packing
 efficiency (UV triangle area over the atlas rectangle, the definition of
 `AtlasStats::packing_efficiency`), as `peer_xatlas_atlas_NAME*` lines.
@@ -129,6 +130,7 @@ def bench_xatlas_sweep(specs, quick):
         v, f = igl.read_triangle_mesh(path)
         runs = 1 if quick or len(f) > 50_000 else 3
         ts = []
+        cpu = []
         atlas = None
         for _ in range(runs):
             atlas = xatlas.Atlas()
@@ -137,8 +139,10 @@ def bench_xatlas_sweep(specs, quick):
             po.padding = 4
             po.resolution = 1024
             t0 = time.perf_counter()
+            c0 = time.process_time()
             atlas.generate(pack_options=po)
             ts.append((time.perf_counter() - t0) * 1e3)
+            cpu.append((time.process_time() - c0) * 1e3)
         vmap, idx, uvs = atlas[0]
         d1 = uvs[idx[:, 1]] - uvs[idx[:, 0]]
         d2 = uvs[idx[:, 2]] - uvs[idx[:, 0]]
@@ -147,6 +151,7 @@ def bench_xatlas_sweep(specs, quick):
         print(f"# xatlas {name}: {len(f)} triangles, {atlas.width}x{atlas.height}, "
               f"{atlas.atlas_count} atlas(es)", flush=True)
         emit(f"peer_xatlas_atlas_{name}", "median_ms", statistics.median(ts))
+        emit(f"peer_xatlas_atlas_{name}_cpu", "value", statistics.mean(cpu))
         emit(f"peer_xatlas_atlas_{name}_charts", "value", atlas.chart_count)
         emit(f"peer_xatlas_atlas_{name}_packing", "value", eff / max(atlas.atlas_count, 1))
 
