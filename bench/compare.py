@@ -25,6 +25,16 @@ rows = [
     ("atlas packing efficiency", "atlas_bunny_packing", "peer_xatlas_bunny_packing", "vs_peer>=", None),
     ("atlas angle distortion mean", "atlas_bunny_angle_mean", "peer_xatlas_bunny_angle_mean", "vs_peer<=", None),
     ("atlas flipped triangles", "atlas_bunny_flips", None, "value<=", 0),
+] + [
+    row
+    for name in ["avocado", "spot", "fandisk", "armadillo", "bunny", "horse", "bunny_x4", "horse_x4"]
+    for row in [
+        (f"atlas sweep {name} (ms)", f"atlas_sw_{name}", f"peer_xatlas_atlas_sw_{name}", "ratio<=", 0.25),
+        (f"atlas sweep {name} charts", f"atlas_sw_{name}_charts", f"peer_xatlas_atlas_sw_{name}_charts", "vs_peer<=", None),
+        (f"atlas sweep {name} packing", f"atlas_sw_{name}_packing", f"peer_xatlas_atlas_sw_{name}_packing", "vs_peer>=", None),
+        (f"atlas sweep {name} flipped triangles", f"atlas_sw_{name}_flips", None, "value<=", 0),
+    ]
+] + [
     ("ray casting closest hit (rays/s)", "rays_per_s", None, "value>=", 2e6),
     ("ray casting any hit (rays/s)", "any_hit_rays_per_s", None, "value>=", 2e6),
     ("binary PLY read, 1M triangles (ms)", "ply_read_1m", None, "value<=", 500),

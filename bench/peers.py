@@ -3,7 +3,14 @@
 Prints one line per measurement, `BENCH <name> median_ms=<x>` or `BENCH <name> value=<x>`,
 the same format as the Rust bench binaries, so bench/run.sh can print ratios.
 Peers: libigl (cotan Laplacian + mass), CHOLMOD via scikit-sparse (penalty system
-factorisation), xatlas (atlas on the bunny).
+factorisation), xatlas (atlas on the bunny, and the atlas size sweep).
+
+`--atlas-sweep NAME=MESH ...` runs only the xatlas size sweep: for each mesh, the median
+time of `xatlas.Atlas.generate` (3 runs below 50K triangles, 1 above) and its mean CPU
+time (all threads; compare with `atlas_NAME_cpu` when the machine is loaded) with the padding
+and resolution of our defaults (4 texels, 1024), its chart count, and its packing
+efficiency (UV triangle area over the atlas rectangle, the definition of
+`AtlasStats::packing_efficiency`), as `peer_xatlas_atlas_NAME*` lines.
 """
 import statistics
 import sys
@@ -114,8 +121,47 @@ def bench_xatlas(quick):
     emit("peer_xatlas_bunny_angle_p95", "value", p95)
 
 
+def bench_xatlas_sweep(specs, quick):
+    import igl
+    import xatlas
+
+    for spec in specs:
+        name, path = spec.split("=", 1)
+        v, f = igl.read_triangle_mesh(path)
+        runs = 1 if quick or len(f) > 50_000 else 3
+        ts = []
+        cpu = []
+        atlas = None
+        for _ in range(runs):
+            atlas = xatlas.Atlas()
+            atlas.add_mesh(v, f)
+            po = xatlas.PackOptions()
+            po.padding = 4
+            po.resolution = 1024
+            t0 = time.perf_counter()
+            c0 = time.process_time()
+            atlas.generate(pack_options=po)
+            ts.append((time.perf_counter() - t0) * 1e3)
+            cpu.append((time.process_time() - c0) * 1e3)
+        vmap, idx, uvs = atlas[0]
+        d1 = uvs[idx[:, 1]] - uvs[idx[:, 0]]
+        d2 = uvs[idx[:, 2]] - uvs[idx[:, 0]]
+        # UVs are normalised by the atlas width and height: area over the rectangle.
+        eff = float(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]).sum())
+        print(f"# xatlas {name}: {len(f)} triangles, {atlas.width}x{atlas.height}, "
+              f"{atlas.atlas_count} atlas(es)", flush=True)
+        emit(f"peer_xatlas_atlas_{name}", "median_ms", statistics.median(ts))
+        emit(f"peer_xatlas_atlas_{name}_cpu", "value", statistics.mean(cpu))
+        emit(f"peer_xatlas_atlas_{name}_charts", "value", atlas.chart_count)
+        emit(f"peer_xatlas_atlas_{name}_packing", "value", eff / max(atlas.atlas_count, 1))
+
+
 if __name__ == "__main__":
     quick = "--quick" in sys.argv
+    if "--atlas-sweep" in sys.argv:
+        k = sys.argv.index("--atlas-sweep")
+        bench_xatlas_sweep([a for a in sys.argv[k + 1:] if "=" in a], quick)
+        sys.exit(0)
     bench_igl_cholmod(quick)
     if "--no-xatlas" not in sys.argv:
         bench_xatlas(quick)

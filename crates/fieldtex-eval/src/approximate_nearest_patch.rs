@@ -42,7 +42,8 @@ pub struct ApproximateSearchOptions {
     pub pca_dims: usize,
     /// Candidates re-ranked in full dimension. Default 12.
     pub rerank: usize,
-    /// Most database points examined per query. Default 640.
+    /// Most database points examined per query. Default 256 (the metrics add a
+    /// coherent candidate per query, see `nearest_patch_metrics`).
     pub max_checks: usize,
     /// Query patches are taken every `query_stride` positions along x and y (the
     /// mean over a regular sub-grid estimates the mean over all). Applies to the
@@ -52,7 +53,7 @@ pub struct ApproximateSearchOptions {
 
 impl Default for ApproximateSearchOptions {
     fn default() -> Self {
-        Self { pca_dims: 12, rerank: 12, max_checks: 640, query_stride: 3 }
+        Self { pca_dims: 12, rerank: 12, max_checks: 256, query_stride: 3 }
     }
 }
 

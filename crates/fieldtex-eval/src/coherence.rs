@@ -9,7 +9,9 @@
 
 use crate::EvalError;
 use crate::image_view::ImageView;
-use crate::nearest_patch::{PatchDistanceOptions, PatchDistanceReport, coherence_distances};
+use crate::nearest_patch_metrics::{
+    PatchDistanceOptions, PatchDistanceReport, coherence_distances,
+};
 
 /// Coherence of `output` with respect to `exemplar` (same channel count; values
 /// usually sRGB in `[0, 1]`). Errors when either image is smaller than the patch. To

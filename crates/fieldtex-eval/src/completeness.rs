@@ -8,7 +8,9 @@
 
 use crate::EvalError;
 use crate::image_view::ImageView;
-use crate::nearest_patch::{PatchDistanceOptions, PatchDistanceReport, completeness_distances};
+use crate::nearest_patch_metrics::{
+    PatchDistanceOptions, PatchDistanceReport, completeness_distances,
+};
 
 /// Completeness of `output` with respect to `exemplar`; `wrap_exemplar` makes the
 /// exemplar's patches wrap around its edges. To get coherence as well,

@@ -30,6 +30,7 @@ mod filters;
 pub mod guided_coherence;
 pub mod image_view;
 pub mod nearest_patch;
+pub mod nearest_patch_metrics;
 pub mod orientation;
 pub mod phase_defects;
 pub mod seam_metrics;
@@ -49,7 +50,7 @@ pub use contrast_sharpness::{
 pub use error::EvalError;
 pub use guided_coherence::{GuidedCoherenceOptions, GuidedCoherenceReport, guided_coherence};
 pub use image_view::{FieldView, ImageView, rgb_buffer};
-pub use nearest_patch::{
+pub use nearest_patch_metrics::{
     PatchDistanceOptions, PatchDistanceReport, coherence_and_completeness, coherence_map,
 };
 pub use orientation::{

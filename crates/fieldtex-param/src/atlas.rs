@@ -90,6 +90,8 @@ pub struct Atlas {
 struct FlatChart {
     chart: ChartMesh,
     uv: Vec<[f64; 2]>,
+    /// No flipped or collapsed triangle and no boundary crossing in UV.
+    clean: bool,
 }
 
 enum Flattened {
@@ -135,11 +137,11 @@ fn flatten(faces: Vec<u32>, mesh: &TriMesh, graph: &FaceGraph) -> Flattened {
         Err(_) => planar_projection(&chart, mesh, graph),
     };
     if flattening_defects(&chart, &uv, graph).is_clean() {
-        return Flattened::Done(FlatChart { chart, uv }, false);
+        return Flattened::Done(FlatChart { chart, uv, clean: true }, false);
     }
     match split_in_two(&chart.faces, graph) {
         Some(parts) => Flattened::Split(parts),
-        None => Flattened::Done(FlatChart { chart, uv }, true),
+        None => Flattened::Done(FlatChart { chart, uv, clean: false }, true),
     }
 }
 
@@ -242,7 +244,7 @@ pub fn build_atlas(
                 .iter()
                 .map(|p| [s * (c * p[0] + sn * p[1]), s * (-sn * p[0] + c * p[1])])
                 .collect();
-            PackChart { points, triangles: fc.chart.corners.clone() }
+            PackChart { points, triangles: fc.chart.corners.clone(), simple_outline: fc.clean }
         })
         .collect();
     let packing = pack_charts(&pack_charts_in, &pack_opts)?;

@@ -95,7 +95,9 @@ impl Footprint {
     }
 
     /// Rasterises the triangles of `points` mapped by `p ↦ (p − origin)·scale + inset`;
-    /// `None` when the footprint would be wider or taller than `max_size`.
+    /// `None` when the footprint would be wider or taller than `max_size` (tests only:
+    /// the packer maps the points itself and sizes with [`Self::extent`]).
+    #[cfg(test)]
     pub fn rasterize(
         points: &[[f64; 2]],
         triangles: &[[u32; 3]],
@@ -109,6 +111,18 @@ impl Footprint {
             .iter()
             .map(|p| [(p[0] - origin[0]) * scale + inset, (p[1] - origin[1]) * scale + inset])
             .collect();
+        let (w, h) = Self::extent(&pts, triangles, eps, max_size)?;
+        Some(Self::rasterize_texels(&pts, triangles, w, h, eps))
+    }
+
+    /// Width and height of the footprint of `triangles` over points already in texel
+    /// units (as [`Self::rasterize`] sizes it); `None` beyond `max_size` or non-finite.
+    pub fn extent(
+        pts: &[[f64; 2]],
+        triangles: &[[u32; 3]],
+        eps: f64,
+        max_size: i64,
+    ) -> Option<(i64, i64)> {
         let mut hi = [0.0f64; 2];
         for t in triangles {
             for &i in t {
@@ -121,9 +135,18 @@ impl Footprint {
         }
         let w = ((hi[0] + eps).floor() as i64 + 1).max(1);
         let h = ((hi[1] + eps).floor() as i64 + 1).max(1);
-        if w > max_size || h > max_size {
-            return None;
-        }
+        (w <= max_size && h <= max_size).then_some((w, h))
+    }
+
+    /// Rasterises triangles whose points are already in texel units into a `w × h`
+    /// footprint (coverage outside it is clamped to the border texels).
+    pub fn rasterize_texels(
+        pts: &[[f64; 2]],
+        triangles: &[[u32; 3]],
+        w: i64,
+        h: i64,
+        eps: f64,
+    ) -> Self {
         let mut f = Self::empty(w, h);
         let stride = f.stride;
         for t in triangles {
@@ -139,10 +162,80 @@ impl Footprint {
         if f.bits.iter().all(|&x| x == 0) {
             f.bits[0] = 1; // a chart always reserves at least one texel
         }
-        Some(f)
+        f
     }
 
-    /// Quarter turn counter-clockwise: texel `(x, y)` → `(h − 1 − y, x)`.
+    /// The footprint of a region given by its outline: `segments` (index pairs into
+    /// `pts`, texel units) are the boundary edges of a set of triangles without
+    /// overlaps (a flip-free chart whose boundary does not cross itself). A texel
+    /// meets the closed region exactly when it meets the outline or lies inside, so the
+    /// result equals [`Self::rasterize_texels`] of the triangles, at a cost that grows
+    /// with the outline instead of the triangle count: the segments are rasterised as
+    /// degenerate triangles and the inside is filled between crossings of the texel-row
+    /// centre lines (even–odd rule).
+    pub fn rasterize_outline(
+        pts: &[[f64; 2]],
+        segments: &[[u32; 2]],
+        w: i64,
+        h: i64,
+        eps: f64,
+        crossings: &mut Vec<(i64, f64)>,
+    ) -> Self {
+        let mut f = Self::empty(w, h);
+        let stride = f.stride;
+        crossings.clear();
+        for s in segments {
+            let (p, q) = (pts[s[0] as usize], pts[s[1] as usize]);
+            triangle_row_spans([p, q, q], eps, |r, a, b| {
+                let r = r.clamp(0, h - 1) as usize;
+                let (a, b) = (a.clamp(0, w - 1) as usize, b.clamp(0, w - 1) as usize);
+                if a <= b {
+                    set_bits(&mut f.bits[r * stride..(r + 1) * stride], a, b);
+                }
+            });
+            if p[1] == q[1] || !(p[1].is_finite() && q[1].is_finite()) {
+                continue;
+            }
+            let (lo, hi) = if p[1] < q[1] { (p, q) } else { (q, p) };
+            let dxdy = (hi[0] - lo[0]) / (hi[1] - lo[1]);
+            // Rows whose centre line y = r + ½ satisfies lo.y ≤ y < hi.y.
+            let r0 = (lo[1] - 0.5).ceil() as i64;
+            let r1 = (hi[1] - 0.5).ceil() as i64;
+            for r in r0.max(0)..r1.min(h) {
+                let y = r as f64 + 0.5;
+                crossings.push((r, lo[0] + (y - lo[1]) * dxdy));
+            }
+        }
+        crossings.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        // Closed outlines cross every centre line an even number of times (the count
+        // depends only on comparisons of corner heights); pair them within each row.
+        let mut i = 0;
+        while i < crossings.len() {
+            let r = crossings[i].0;
+            let mut j = i;
+            while j < crossings.len() && crossings[j].0 == r {
+                j += 1;
+            }
+            let row = &mut f.bits[r as usize * stride..(r as usize + 1) * stride];
+            for pair in crossings[i..j].chunks_exact(2) {
+                // Texels whose centre c + ½ lies in [x0, x1].
+                let a = ((pair[0].1 - 0.5).ceil() as i64).max(0);
+                let b = ((pair[1].1 - 0.5).floor() as i64).min(w - 1);
+                if a <= b {
+                    set_bits(row, a as usize, b as usize);
+                }
+            }
+            i = j;
+        }
+        if f.bits.iter().all(|&x| x == 0) {
+            f.bits[0] = 1;
+        }
+        f
+    }
+
+    /// Quarter turn counter-clockwise: texel `(x, y)` → `(h − 1 − y, x)` (the packer
+    /// rasterises rotated points instead; this is the test oracle).
+    #[cfg(test)]
     pub fn rotate90(&self) -> Self {
         let mut out = Self::empty(self.h, self.w);
         let mut spans = Vec::new();
@@ -164,10 +257,14 @@ impl Footprint {
         row_runs(self.row(y), self.w as usize, shift, out);
     }
 
-    /// The footprint grown by a disk of radius `g` texels (centre distances ≤ `g`).
-    pub fn grow(&self, g: i64) -> Grown {
-        let ext: Vec<i64> =
-            (0..=g).map(|d| (((g * g - d * d) as f64).sqrt() + 1e-9).floor() as i64).collect();
+    /// The footprint grown by a disk of radius `radius` texels (centre distances
+    /// ≤ `radius`; the radius need not be a whole number).
+    pub fn grow(&self, radius: f64) -> Grown {
+        let radius = radius.max(0.0);
+        let g = (radius + 1e-9).floor() as i64;
+        let ext: Vec<i64> = (0..=g)
+            .map(|d| ((radius * radius - (d * d) as f64).max(0.0).sqrt() + 1e-9).floor() as i64)
+            .collect();
         let wg = (self.w + 2 * g) as usize;
         let sg = wg.div_ceil(64);
         // Horizontally grown rows, one set per distinct extension.
@@ -246,10 +343,38 @@ mod tests {
         let f = Footprint::rasterize(&pts, &tris, [0.0, 0.0], 2.0, 0.5, 1e-3, 100).unwrap();
         let r = f.rotate90();
         assert_eq!((r.w, r.h), (f.h, f.w));
+        // The packer's way: rasterise the turned points `q ↦ (h − q_y, q_x)`.
+        let q: Vec<[f64; 2]> = pts.iter().map(|p| [p[0] * 2.0 + 0.5, p[1] * 2.0 + 0.5]).collect();
+        let turned: Vec<[f64; 2]> = q.iter().map(|p| [f.h as f64 - p[1], p[0]]).collect();
+        assert_eq!(Footprint::rasterize_texels(&turned, &tris, f.h, f.w, 1e-3), r);
         let rot: Vec<[f64; 2]> = pts.iter().map(|p| [-p[1], p[0]]).collect();
         let g = Footprint::rasterize(&rot, &tris, [-1.0, 0.0], 2.0, 0.5, 1e-3, 100).unwrap();
         assert_eq!(g, r);
         assert_eq!(r.rotate90().rotate90().rotate90(), f);
+    }
+
+    #[test]
+    fn outline_fill_equals_triangle_union() {
+        // A fan around a centre with a wiggly, non-convex rim (a flip-free disk).
+        let n = 23;
+        let mut pts = vec![[20.3, 19.7]];
+        for k in 0..n {
+            let a = k as f64 / n as f64 * std::f64::consts::TAU;
+            let r = 12.0 + 6.0 * (3.0 * a).sin() + if k % 2 == 0 { 2.5 } else { 0.0 };
+            pts.push([20.3 + r * a.cos(), 19.7 + r * a.sin()]);
+        }
+        let tris: Vec<[u32; 3]> =
+            (0..n as u32).map(|k| [0, 1 + k, 1 + (k + 1) % n as u32]).collect();
+        let mut segs = Vec::new();
+        for t in &tris {
+            segs.push([t[1], t[2]]);
+        }
+        let mut scratch = Vec::new();
+        for eps in [0.0, 1e-3] {
+            let a = Footprint::rasterize_texels(&pts, &tris, 42, 41, eps);
+            let b = Footprint::rasterize_outline(&pts, &segs, 42, 41, eps, &mut scratch);
+            assert_eq!(a, b, "eps {eps}");
+        }
     }
 
     #[test]
@@ -258,7 +383,7 @@ mod tests {
         let f = Footprint::rasterize(&[[0.2, 0.2]; 3], &[[0, 1, 2]], [0.0, 0.0], 1.0, 0.0, 0.0, 10)
             .unwrap();
         assert_eq!((f.w, f.h), (1, 1));
-        let g = f.grow(2);
+        let g = f.grow(2.0);
         assert_eq!(g.y0, -2);
         assert_eq!(
             g.rows,

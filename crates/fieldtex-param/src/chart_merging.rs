@@ -5,8 +5,14 @@
 //! Charts are visited from the smallest; a chart with less than `small_fraction` of
 //! the mean chart area, or sharing at least half of its perimeter with one neighbour,
 //! merges into the neighbour with the longest shared boundary when
-//! - the union's normal cone (bounded from the two charts' cones) stays within the
-//!   limit (80° for tiny charts, under 5 % of the mean area), and
+//! - the union's normal cone stays within the limit (80° for tiny charts, under 5 % of
+//!   the mean area): first bounded from the two charts' cones, and, when that bound
+//!   fails for a chart below the mean area, measured over the union's faces around
+//!   its mean normal;
+//! - unless the chart is tiny, at most 80 % of the shared boundary is a crease (a
+//!   dihedral turn above 60°): charts folded over sharp edges flatten into awkward
+//!   shapes that pack badly (xatlas weighs such "normal seams" in its chart cost for
+//!   the same reason); and
 //! - the union is still a disk: with corners joined across interior edges in a global
 //!   union-find, `χ(c ∪ d) = χ(c) + χ(d) + I_cd − k`, where `I_cd` counts the shared
 //!   edges and `k` the vertex classes the shared edges join (found with a small
@@ -19,6 +25,9 @@
 use crate::face_graph::{FaceGraph, NONE};
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_mesh::UnionFind;
+
+/// Cosine of the dihedral turn above which a shared edge counts as a crease (60°).
+const SHARP_COS: f64 = 0.5;
 
 /// Per-chart bookkeeping of the merge step.
 #[derive(Debug, Clone)]
@@ -129,15 +138,25 @@ pub(crate) fn merge_small_charts(
         shared.sort_unstable();
         // Pair groups: (a, b, start, end, length).
         let mut pairs: Vec<(u32, u32, usize, usize, f64)> = Vec::new();
+        // Per pair: the length of shared edges across which the surface bends sharply.
+        let mut sharp_len: Vec<f64> = Vec::new();
         let mut s = 0;
         while s < shared.len() {
             let mut e = s;
             let mut len = 0.0;
+            let mut sharp = 0.0;
             while e < shared.len() && shared[e].0 == shared[s].0 && shared[e].1 == shared[s].1 {
-                len += graph.edge_len[shared[e].2 as usize][shared[e].3 as usize];
+                let (f, i) = (shared[e].2 as usize, shared[e].3 as usize);
+                let l = graph.edge_len[f][i];
+                len += l;
+                let g = graph.adj[f][i] as usize;
+                if vec3::dot(graph.normals[f], graph.normals[g]) < SHARP_COS {
+                    sharp += l;
+                }
                 e += 1;
             }
             pairs.push((shared[s].0, shared[s].1, s, e, len));
+            sharp_len.push(sharp);
             s = e;
         }
         let mut nbrs: Vec<Vec<usize>> = vec![Vec::new(); stats.len()];
@@ -165,6 +184,10 @@ pub(crate) fn merge_small_charts(
             let limit = if tiny { tiny_theta } else { theta };
             for &k in &cand {
                 let (a, b, s0, s1, len) = pairs[k];
+                // Charts that are not tiny do not merge across a mostly sharp crease.
+                if !tiny && sharp_len[k] > 0.8 * len {
+                    continue;
+                }
                 let d = if a as usize == c { b as usize } else { a as usize };
                 if locked[d] {
                     continue;
@@ -175,7 +198,21 @@ pub(crate) fn merge_small_charts(
                 let ang =
                     |s: &ChartStat| vec3::dot(axis, s.axis).clamp(-1.0, 1.0).acos() + s.half_angle;
                 if ang(&stats[c]).max(ang(&stats[d])) > limit {
-                    continue;
+                    // The bound is loose: for charts below the mean area, measure the
+                    // union's cone around its axis.
+                    if stats[c].area >= mean_area {
+                        continue;
+                    }
+                    let cos_limit = limit.cos();
+                    let within = |s: &ChartStat| {
+                        s.faces.iter().all(|&f| {
+                            graph.degenerate[f as usize]
+                                || vec3::dot(graph.normals[f as usize], axis) >= cos_limit
+                        })
+                    };
+                    if !(within(&stats[c]) && within(&stats[d])) {
+                        continue;
+                    }
                 }
                 // Euler characteristic of the union.
                 let mut roots: Vec<(usize, usize)> = Vec::new();

@@ -26,9 +26,10 @@
 //!    most one in its own) moves there when that chart's cone allows it (this never
 //!    disconnects a chart).
 //! 5. **Merging.** Charts smaller than [`SegmentationOptions::small_chart_fraction`] of
-//!    the mean chart area, or nearly enclosed by a neighbour, merge into the neighbour
-//!    with the longest shared boundary when the union stays a disk and its normal cone
-//!    stays within the limit (tiny charts: within 80°).
+//!    the mean chart area (by default every chart), or nearly enclosed by a neighbour,
+//!    merge into the neighbour with the longest shared boundary when the union stays a
+//!    disk, its normal cone stays within the limit and the shared boundary is not
+//!    mostly a sharp crease ([`crate::chart_merging`]).
 //! 6. **Disk guarantee.** Every chart whose Euler characteristic is not 1 (see
 //!    [`crate::chart_topology`]) is split in two by a farthest-pair flood, repeatedly.
 //!
@@ -49,14 +50,15 @@ use std::collections::BinaryHeap;
 #[serde(default)]
 pub struct SegmentationOptions {
     /// Largest angle in degrees between a triangle's normal and its chart's normal
-    /// while growing. Default 70.
+    /// while growing, and of the merged charts' normal cones. Default 80.
     pub max_normal_angle_deg: f64,
     /// Weight of the compactness term of the growing cost. Default 0.15.
     pub compactness_weight: f64,
     /// Lloyd relaxation rounds once every triangle is covered. Default 4.
     pub lloyd_iterations: usize,
     /// Charts with less than this fraction of the mean chart area try to merge into a
-    /// neighbour. Default 0.35.
+    /// neighbour. Default 10: in effect every chart; merging is then limited by the
+    /// normal cone, the disk condition and creases (see [`crate::chart_merging`]).
     pub small_chart_fraction: f64,
     /// Boundary smoothing passes. Default 2.
     pub smoothing_passes: usize,
@@ -68,10 +70,10 @@ pub struct SegmentationOptions {
 impl Default for SegmentationOptions {
     fn default() -> Self {
         Self {
-            max_normal_angle_deg: 70.0,
+            max_normal_angle_deg: 80.0,
             compactness_weight: 0.15,
             lloyd_iterations: 4,
-            small_chart_fraction: 0.35,
+            small_chart_fraction: 10.0,
             smoothing_passes: 2,
             boundary_weight: 0.3,
         }

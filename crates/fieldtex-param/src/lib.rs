@@ -43,6 +43,7 @@ pub mod face_graph;
 pub mod lscm;
 pub mod min_area_rectangle;
 pub mod packing;
+mod packing_grid;
 pub mod raster;
 pub mod texel_map;
 

@@ -11,12 +11,26 @@
 //! per row, so a position test costs a few interval subtractions per chart row; rows
 //! whose longest free run is too short are skipped at once.
 //!
+//! **Cells.** Placement works on a grid of `k × k`-texel cells
+//! ([`PackingOptions::cell`]; `k = 2` for the default 1024² atlas): a chart reserves
+//! every cell that one of its texels touches, and the gutter test uses the radius
+//! `(G + (k − 1)·√2) / k` cells, since two texels in cells `a` and `b` are at least
+//! `k·|a − b| − (k − 1)·√2` texels apart. Placements are exact in texels; the cost of a
+//! trial drops with the number of cell rows, at the price of up to a cell of extra
+//! space around each chart. Charts without overlaps are rasterised from their outline
+//! (boundary segments plus an even–odd fill between crossings of the row centres),
+//! which equals the union of their triangles' coverage at a cost that grows with the
+//! boundary, not the triangle count.
+//!
 //! The scale is the largest one (within [`PackingOptions::tolerance`]) at which every
 //! chart fits. Each trial packs into a grid twice as tall as the atlas and reports the
 //! height it used; the height grows roughly like the square of the scale, which gives
 //! the next guess, and the bracket between the best fitting and the smallest failing
 //! scale is then narrowed with three trial scales per round, evaluated in parallel.
-//! Results do not depend on the thread count.
+//! The search runs first on cells twice as large (a quarter of the work per trial)
+//! and then, from just above the scale found there, for at most three rounds on the
+//! final cells; the coarse packing is valid as it stands and is kept if no finer one
+//! fits. Results do not depend on the thread count.
 //!
 //! **Packing efficiency** (reported by the atlas) is the charts' UV triangle area in
 //! texels over the atlas area; gutters and the conservative coverage of boundary
@@ -30,6 +44,7 @@
 
 use crate::ParamError;
 use crate::chart_footprint::{Footprint, Grown};
+use crate::packing_grid::Grid;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -39,6 +54,31 @@ use std::collections::HashMap;
 pub struct PackChart {
     pub points: Vec<[f64; 2]>,
     pub triangles: Vec<[u32; 3]>,
+    /// The triangles do not overlap (no flips, a boundary that does not cross itself),
+    /// so the chart can be rasterised from its outline (faster for large charts).
+    /// `false` rasterises every triangle. Default false.
+    pub simple_outline: bool,
+}
+
+/// The edges of `triangles` used by one triangle only (in its direction).
+fn outline_segments(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * triangles.len());
+    for t in triangles {
+        for k in 0..3 {
+            edges.push((t[k], t[(k + 1) % 3]));
+        }
+    }
+    let mut keys: Vec<(u32, u32)> = edges.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    keys.sort_unstable();
+    edges
+        .into_iter()
+        .filter(|&(a, b)| {
+            let k = (a.min(b), a.max(b));
+            let i = keys.partition_point(|x| *x < k);
+            keys.get(i + 1) != Some(&k)
+        })
+        .map(|(a, b)| [a, b])
+        .collect()
 }
 
 /// Options of [`pack_charts`].
@@ -53,11 +93,27 @@ pub struct PackingOptions {
     pub rotate: bool,
     /// Relative precision of the scale search. Default 0.004.
     pub tolerance: f64,
+    /// Texels per side of a packing cell (charts are placed on a grid of
+    /// `cell × cell`-texel cells; see the module docs); 0 picks it from the resolution:
+    /// 1 up to 512 texels, 2 up to 2048, 4 above. Default 0.
+    pub cell: u32,
 }
 
 impl Default for PackingOptions {
     fn default() -> Self {
-        Self { resolution: 1024, gutter: 4, rotate: true, tolerance: 0.004 }
+        Self { resolution: 1024, gutter: 4, rotate: true, tolerance: 0.004, cell: 0 }
+    }
+}
+
+impl PackingOptions {
+    /// The cell size in texels actually used (module docs).
+    pub fn cell_texels(&self) -> u32 {
+        match self.cell {
+            0 if self.resolution <= 512 => 1,
+            0 if self.resolution <= 2048 => 2,
+            0 => 4,
+            c => c.clamp(1, (self.resolution / 8).max(1)),
+        }
     }
 }
 
@@ -83,6 +139,8 @@ pub struct Packing {
     pub texels_per_unit: f64,
     /// One placement per chart, in input order.
     pub placements: Vec<Placement>,
+    /// Offset in texels of chart points inside their footprint (half a cell).
+    pub inset: f64,
 }
 
 /// Offset of chart points inside their footprint, in texels (keeps columns ≥ 0).
@@ -95,7 +153,8 @@ impl Packing {
     pub fn atlas_texel(&self, chart: usize, p: [f64; 2]) -> [f64; 2] {
         let pl = &self.placements[chart];
         let s = self.texels_per_unit;
-        let mut q = [(p[0] - pl.origin[0]) * s + INSET, (p[1] - pl.origin[1]) * s + INSET];
+        let mut q =
+            [(p[0] - pl.origin[0]) * s + self.inset, (p[1] - pl.origin[1]) * s + self.inset];
         // Footprint (width, height) before each quarter turn; they swap every turn.
         let mut wh = pl.size;
         for _ in 0..pl.rotation {
@@ -113,220 +172,98 @@ impl Packing {
     }
 }
 
-fn merge_spans(spans: &mut Vec<(i64, i64)>) {
-    spans.sort_unstable();
-    let mut out: Vec<(i64, i64)> = Vec::with_capacity(spans.len());
-    for &(a, b) in spans.iter() {
-        match out.last_mut() {
-            Some(last) if a <= last.1 + 1 => last.1 = last.1.max(b),
-            _ => out.push((a, b)),
-        }
-    }
-    *spans = out;
-}
-
-/// Occupied spans per atlas row and the longest free run of each row.
-struct Grid {
-    /// Width in texels (the atlas resolution).
-    size: i64,
-    /// Height in texels: twice the atlas, so that a failed fit still measures how
-    /// tall the packing would be.
-    height: i64,
-    gutter: i64,
-    margin: i64,
-    rows: Vec<Vec<(i64, i64)>>,
-    max_free: Vec<i64>,
-}
-
-impl Grid {
-    fn new(size: i64, height: i64, gutter: i64) -> Self {
-        let margin = (gutter as u64).div_ceil(2) as i64;
-        let free = size + 2 * gutter;
-        Self {
-            size,
-            height,
-            gutter,
-            margin,
-            rows: vec![Vec::new(); height as usize],
-            max_free: vec![free; height as usize],
-        }
-    }
-
-    fn update_free(&mut self, y: usize) {
-        let lo = -self.gutter;
-        let hi = self.size - 1 + self.gutter;
-        let mut cur = lo;
-        let mut best = 0;
-        for &(a, b) in &self.rows[y] {
-            best = best.max(a - cur);
-            cur = cur.max(b + 1);
-        }
-        best = best.max(hi + 1 - cur);
-        self.max_free[y] = best;
-    }
-
-    /// Rows an offset of a footprint `fh` texels tall may take, at least `oy_min` and at
-    /// most `oy_max`.
-    fn offset_rows(&self, fh: i64, oy_min: i64, oy_max: i64) -> (i64, i64) {
-        (self.margin.max(oy_min), (self.height - self.margin - fh).min(oy_max))
-    }
-
-    /// Lowest-then-leftmost offset where `grown` (of a `fw × fh` footprint) fits, with
-    /// the offset's row between `oy_min` and `oy_max`.
-    fn find(
-        &self,
-        grown: &Grown,
-        fw: i64,
-        fh: i64,
-        oy_min: i64,
-        oy_max: i64,
-    ) -> Option<(i64, i64)> {
-        let (ox_lo, ox_hi) = (self.margin, self.size - self.margin - fw);
-        let (oy_lo, oy_hi) = self.offset_rows(fh, oy_min, oy_max);
-        if ox_lo > ox_hi || oy_lo > oy_hi {
-            return None;
-        }
-        let nrows = grown.rows.len() as i64;
-        let mut feasible: Vec<(i64, i64)> = Vec::with_capacity(16);
-        let mut scratch: Vec<(i64, i64)> = Vec::with_capacity(16);
-        // Atlas row where the last test failed: the obstacle there usually blocks the
-        // next offset too, one chart row lower.
-        let mut hint_y = i64::MIN;
-        let mut oy = oy_lo - 1;
-        'oy: loop {
-            oy += 1;
-            if oy > oy_hi {
-                break;
-            }
-            feasible.clear();
-            feasible.push((ox_lo, ox_hi));
-            // Rows in any order give the same set; start at the last obstacle.
-            let r0 = hint_y - (oy + grown.y0);
-            let first = if (0..nrows).contains(&r0) { Some(r0) } else { None };
-            // Then the widest rows: in a fragmented atlas they are the likeliest to fail.
-            let widest = grown.by_need.iter().map(|&r| r as i64).filter(|&r| Some(r) != first);
-            for r in first.into_iter().chain(widest) {
-                let y = oy + grown.y0 + r;
-                if y < 0 || y >= self.height {
-                    continue;
-                }
-                let need = grown.need[r as usize];
-                if need > self.max_free[y as usize] {
-                    // Skip to the next offset where this row has a long enough run.
-                    let mut y2 = y + 1;
-                    while y2 < self.height && need > self.max_free[y2 as usize] {
-                        y2 += 1;
-                    }
-                    oy += y2 - y - 1;
-                    hint_y = y2;
-                    continue 'oy;
-                }
-                let occ = &self.rows[y as usize];
-                if occ.is_empty() {
-                    continue;
-                }
-                for &(a, b) in &grown.rows[r as usize] {
-                    // Offsets where span [a, b] meets occupied span [p, q]: [p - b, q - a].
-                    scratch.clear();
-                    for &(s, e) in &feasible {
-                        let mut cur = s;
-                        let start = occ.partition_point(|&(_, q)| q - a < s);
-                        for &(p, q) in &occ[start..] {
-                            let (fs, fe) = (p - b, q - a);
-                            if fs > e {
-                                break;
-                            }
-                            if fs > cur {
-                                scratch.push((cur, fs - 1));
-                            }
-                            cur = cur.max(fe + 1);
-                            if cur > e {
-                                break;
-                            }
-                        }
-                        if cur <= e {
-                            scratch.push((cur, e));
-                        }
-                    }
-                    std::mem::swap(&mut feasible, &mut scratch);
-                    if feasible.is_empty() {
-                        hint_y = y;
-                        continue 'oy;
-                    }
-                }
-            }
-            return Some((feasible[0].0, oy));
-        }
-        None
-    }
-
-    fn place(&mut self, f: &Footprint, ox: i64, oy: i64) {
-        for r in 0..f.h {
-            let y = (oy + r) as usize;
-            let before = self.rows[y].len();
-            f.row_spans(r, ox, &mut self.rows[y]);
-            if self.rows[y].len() > before {
-                merge_spans(&mut self.rows[y]);
-                self.update_free(y);
-            }
-        }
-    }
-}
-
 /// A packing at one scale: placements and the top row used (exclusive).
 struct Trial {
     placements: Vec<Placement>,
     top: i64,
 }
 
-/// Packs all charts at scale `scale` into a grid twice as tall as the atlas; `None`
-/// when a chart is wider than the atlas or the grid overflows.
+/// The packing grid of one trial: `k × k`-texel cells.
+#[derive(Debug, Clone, Copy)]
+struct CellGrid {
+    /// Texels per cell side.
+    k: i64,
+    /// Cells per atlas side.
+    size: i64,
+    /// Gutter radius in cells (see the module docs).
+    gutter: f64,
+    /// Free cells along the border.
+    margin: i64,
+}
+
+impl CellGrid {
+    fn new(opts: &PackingOptions, k: i64) -> Self {
+        let g = opts.gutter as f64;
+        // Two texels in cells `a` and `b` are at least k·|a − b| − (k − 1)·√2 apart.
+        let gutter =
+            if k == 1 { g } else { (g + (k - 1) as f64 * std::f64::consts::SQRT_2) / k as f64 };
+        let margin = (opts.gutter as i64 + 1) / 2;
+        Self { k, size: opts.resolution as i64 / k, gutter, margin: (margin + k - 1) / k }
+    }
+}
+
+/// Packs all charts at scale `scale` (texels per unit) into a grid twice as tall as
+/// the atlas; `None` when a chart is wider than the atlas or the grid overflows.
 fn try_pack(
     charts: &[PackChart],
+    outlines: &[Option<Vec<[u32; 2]>>],
     origins: &[[f64; 2]],
     order: &[usize],
     scale: f64,
     opts: &PackingOptions,
+    cells: CellGrid,
 ) -> Option<Trial> {
-    let g = opts.gutter as i64;
-    let size = opts.resolution as i64;
+    let size = cells.size;
     let rots = if opts.rotate { 4 } else { 1 };
-    let mut grid = Grid::new(size, 2 * size, g);
+    let gi = (cells.gutter + 1e-9).floor() as i64;
+    let mut grid = Grid::new(size, 2 * size, gi, cells.margin);
     let mut out = vec![
         Placement { offset: [0, 0], rotation: 0, origin: [0.0; 2], size: [0, 0] };
         charts.len()
     ];
+    let cell_scale = scale / cells.k as f64;
     let mut top = 0;
     // Occupancy only grows, so a footprint that did not fit below some row never will:
     // remember, per footprint shape, the lowest row still worth testing. Every chart
-    // contains a texel of its bottom row, so no chart fits below the lowest row where a
-    // single grown texel fits (`floor`).
+    // contains a cell of its bottom row, so no chart fits below the lowest row where a
+    // single grown cell fits (`floor`).
     let mut lowest: HashMap<Footprint, (std::rc::Rc<Grown>, i64)> = HashMap::new();
     let probe = Footprint::single();
-    let probe_grown = probe.grow(g);
+    let probe_grown = probe.grow(cells.gutter);
     let mut floor = 0;
+    let mut pts: Vec<[f64; 2]> = Vec::new();
+    let mut crossings = Vec::new();
     for &c in order {
         let ch = &charts[c];
-        let base = Footprint::rasterize(
-            &ch.points,
-            &ch.triangles,
-            origins[c],
-            scale,
-            INSET,
-            PACK_EPS,
-            size,
-        )?;
+        pts.clear();
+        pts.extend(ch.points.iter().map(|p| {
+            [
+                (p[0] - origins[c][0]) * cell_scale + INSET,
+                (p[1] - origins[c][1]) * cell_scale + INSET,
+            ]
+        }));
+        let mut raster = |pts: &[[f64; 2]], w: i64, h: i64| match &outlines[c] {
+            Some(seg) => Footprint::rasterize_outline(pts, seg, w, h, PACK_EPS, &mut crossings),
+            None => Footprint::rasterize_texels(pts, &ch.triangles, w, h, PACK_EPS),
+        };
+        let (w, h) = Footprint::extent(&pts, &ch.triangles, PACK_EPS, size)?;
+        let base = raster(&pts, w, h);
         let mut best: Option<((i64, i64, i64, u8), Footprint)> = None;
         let mut fp = base.clone();
         for k in 0..rots {
             if k > 0 {
-                fp = fp.rotate90();
+                // Quarter turn of the points, as `Packing::atlas_texel` does it.
+                let h = fp.h as f64;
+                for q in pts.iter_mut() {
+                    *q = [h - q[1], q[0]];
+                }
+                fp = raster(&pts, fp.h, fp.w);
             }
             // Only rows that could beat the best top edge so far.
             let oy_max = best.as_ref().map_or(i64::MAX, |(bk, _)| bk.0 - fp.h);
             let (grown, seen) = match lowest.get(&fp) {
                 Some((gr, row)) => (gr.clone(), *row),
-                None => (std::rc::Rc::new(fp.grow(g)), 0),
+                None => (std::rc::Rc::new(fp.grow(cells.gutter)), 0),
             };
             let oy_min = floor.max(seen);
             let (lo, hi) = grid.offset_rows(fp.h, oy_min, oy_max);
@@ -348,8 +285,13 @@ fn try_pack(
         grid.place(&f, ox, oy);
         top = top.max(t);
         floor = grid.find(&probe_grown, 1, 1, floor, i64::MAX).map_or(grid.height, |(_, y)| y);
-        out[c] =
-            Placement { offset: [ox, oy], rotation: k, origin: origins[c], size: [base.w, base.h] };
+        let kk = cells.k;
+        out[c] = Placement {
+            offset: [kk * ox, kk * oy],
+            rotation: k,
+            origin: origins[c],
+            size: [kk * base.w, kk * base.h],
+        };
     }
     Some(Trial { placements: out, top })
 }
@@ -406,7 +348,6 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
     if !upper.is_finite() {
         upper = 1.0;
     }
-    let limit = res - options.gutter.div_ceil(2) as f64;
     let tol = options.tolerance.clamp(1e-6, 0.5);
     let fail = |s: f64| ParamError::PackingFailed {
         charts: charts.len(),
@@ -414,68 +355,138 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
         gutter: options.gutter,
         texels_per_unit: s,
     };
-    // Scale search: `lo` fits, `hi` does not (or is the upper bound). Each trial's
-    // packing height h(s) ∝ s² roughly, so `s·√(limit / h)` estimates the best scale.
-    let mut lo: Option<(f64, Vec<Placement>)> = None;
-    let mut hi = upper * (1.0 + 1e-9);
-    let mut guess = 0.8 * upper;
-    for _round in 0..40 {
-        let lo_s = lo.as_ref().map_or(0.0, |l| l.0);
-        if lo.is_some() && hi <= lo_s * (1.0 + tol) {
+    let fine = CellGrid::new(options, options.cell_texels() as i64);
+    let outlines: Vec<Option<Vec<[u32; 2]>>> = charts
+        .par_iter()
+        .map(|ch| ch.simple_outline.then(|| outline_segments(&ch.triangles)))
+        .collect();
+    let mut state = SearchState { lo: None, hi: upper * (1.0 + 1e-9), guess: 0.8 * upper };
+    // Coarse to fine: the scale is first bracketed on cells twice as large (a quarter
+    // of the work per trial); its packing is valid as it stands, so it is kept as the
+    // fallback, and the search then goes on at full precision on the final cells from
+    // just above it, for a few rounds at most.
+    let coarse_k = 2 * fine.k;
+    if options.resolution as i64 / coarse_k >= 64 {
+        let coarse = CellGrid::new(options, coarse_k);
+        search_scale(
+            charts,
+            &outlines,
+            &origins,
+            &order,
+            options,
+            coarse,
+            &mut state,
+            tol.max(0.01),
+            40,
+        );
+        if let Some(lo) = &state.lo {
+            state.hi = upper * (1.0 + 1e-9);
+            state.guess = lo.scale * 1.03;
+        }
+        search_scale(charts, &outlines, &origins, &order, options, fine, &mut state, tol, 3);
+    } else {
+        search_scale(charts, &outlines, &origins, &order, options, fine, &mut state, tol, 40);
+    }
+    let Some(found) = state.lo else { return Err(fail(state.guess)) };
+    if found.scale < upper * 1e-9 {
+        return Err(fail(found.scale));
+    }
+    Ok(Packing {
+        resolution: options.resolution,
+        gutter: options.gutter,
+        texels_per_unit: found.scale,
+        placements: found.placements,
+        inset: found.inset,
+    })
+}
+
+/// The best packing found so far.
+struct Found {
+    scale: f64,
+    placements: Vec<Placement>,
+    inset: f64,
+}
+
+/// Scale search state: `lo` fits, `hi` does not (or is the upper bound).
+struct SearchState {
+    lo: Option<Found>,
+    hi: f64,
+    guess: f64,
+}
+
+/// Narrows the scale on `cells` until `hi ≤ lo·(1 + tol)` or `max_rounds` rounds.
+/// Each trial's packing height h(s) ∝ s² roughly, so `s·√(limit / h)` estimates the
+/// best scale.
+#[allow(clippy::too_many_arguments)]
+fn search_scale(
+    charts: &[PackChart],
+    outlines: &[Option<Vec<[u32; 2]>>],
+    origins: &[[f64; 2]],
+    order: &[usize],
+    options: &PackingOptions,
+    cells: CellGrid,
+    st: &mut SearchState,
+    tol: f64,
+    max_rounds: usize,
+) {
+    let limit = (cells.size - cells.margin) as f64;
+    let upper = st.hi;
+    for _round in 0..max_rounds {
+        let lo_s = st.lo.as_ref().map_or(0.0, |l| l.scale);
+        if st.lo.is_some() && st.hi <= lo_s * (1.0 + tol) {
             break;
         }
-        let trials: Vec<f64> = if lo.is_some() && hi <= lo_s * 1.05 {
-            let r = hi / lo_s;
+        let trials: Vec<f64> = if st.lo.is_some() && st.hi <= lo_s * 1.05 {
+            let r = st.hi / lo_s;
             (1..=3).map(|k| lo_s * r.powf(k as f64 / 4.0)).collect()
         } else {
-            let c = guess.min(hi / (1.0 + 0.25 * tol)).max(lo_s * (1.0 + 0.25 * tol));
-            [c, c * 0.99, c * 0.98].into_iter().filter(|&t| t > lo_s && t < hi).collect()
+            let c = st.guess.min(st.hi / (1.0 + 0.25 * tol)).max(lo_s * (1.0 + 0.25 * tol));
+            [c, c * 0.99, c * 0.98].into_iter().filter(|&t| t > lo_s && t < st.hi).collect()
         };
         if trials.is_empty() {
             break;
         }
-        let results: Vec<Option<Trial>> =
-            trials.par_iter().map(|&t| try_pack(charts, &origins, &order, t, options)).collect();
+        let results: Vec<Option<Trial>> = trials
+            .par_iter()
+            .map(|&t| try_pack(charts, outlines, origins, order, t, options, cells))
+            .collect();
         let mut estimate: Option<f64> = None;
         let mut smallest_failed: Option<f64> = None;
         for (&t, r) in trials.iter().zip(results) {
             match r {
                 Some(trial) if trial.top as f64 <= limit => {
-                    if t > lo.as_ref().map_or(0.0, |l| l.0) {
+                    if t > st.lo.as_ref().map_or(0.0, |l| l.scale) {
                         let est = t * (limit / trial.top.max(1) as f64).sqrt();
                         estimate = Some(estimate.map_or(est, |e: f64| e.max(est)));
-                        lo = Some((t, trial.placements));
+                        st.lo = Some(Found {
+                            scale: t,
+                            placements: trial.placements,
+                            inset: cells.k as f64 * INSET,
+                        });
                     }
                 }
                 Some(trial) => {
-                    hi = hi.min(t);
-                    if lo.is_none() {
+                    st.hi = st.hi.min(t);
+                    if st.lo.is_none() {
                         let est = t * (limit / trial.top as f64).sqrt() * 0.995;
                         estimate = Some(estimate.map_or(est, |e: f64| e.min(est)));
                     }
                 }
                 None => {
-                    hi = hi.min(t);
+                    st.hi = st.hi.min(t);
                     smallest_failed = Some(smallest_failed.map_or(t, |m: f64| m.min(t)));
                 }
             }
         }
-        guess = match (estimate, smallest_failed) {
+        st.guess = match (estimate, smallest_failed) {
             (Some(e), _) => e,
             (None, Some(m)) => m * 0.6,
-            (None, None) => guess,
+            (None, None) => st.guess,
         };
-        if lo.is_none() && guess < upper * 1e-9 {
-            return Err(fail(guess));
+        if st.lo.is_none() && st.guess < upper * 1e-9 {
+            return;
         }
     }
-    let Some((scale, placements)) = lo else { return Err(fail(guess)) };
-    Ok(Packing {
-        resolution: options.resolution,
-        gutter: options.gutter,
-        texels_per_unit: scale,
-        placements,
-    })
 }
 
 #[cfg(test)]
@@ -487,6 +498,7 @@ mod tests {
         PackChart {
             points: vec![[0.0, 0.0], [side, 0.0], [side, side], [0.0, side]],
             triangles: vec![[0, 1, 2], [0, 2, 3]],
+            simple_outline: side > 2.5,
         }
     }
 

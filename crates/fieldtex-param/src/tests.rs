@@ -249,6 +249,22 @@ fn fertility_genus_4() {
     assert!(a.stats.angle_distortion_mean < 1.07, "{:?}", a.stats);
 }
 
+/// Issue 17: the atlas was more fragmented than xatlas (140 charts on the 5.9K-triangle
+/// spot cow where xatlas makes 39; 17 on the fandisk where it makes 15). The bounds are
+/// xatlas's chart counts and packing efficiencies on these meshes at padding 4
+/// (`bench/peers.py --atlas-sweep`).
+#[test]
+fn no_more_charts_than_xatlas_at_its_packing() {
+    for (file, xatlas_charts, xatlas_packing) in
+        [("textured/spot/spot_triangulated.obj", 39, 0.598), ("meshes/fandisk.obj", 15, 0.589)]
+    {
+        let mesh = load_obj(file);
+        let a = check_atlas(&mesh, &AtlasOptions::default());
+        assert!(a.stats.charts <= xatlas_charts, "{file}: {:?}", a.stats);
+        assert!(a.stats.packing_efficiency >= xatlas_packing, "{file}: {:?}", a.stats);
+    }
+}
+
 #[test]
 fn bunny_with_holes() {
     let mesh = load_obj("meshes/stanford-bunny.obj");
