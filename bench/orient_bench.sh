@@ -22,13 +22,18 @@
 #   and the ratio; CPU time (user+sys) medians too. Run on a quiet machine: `uptime` is
 #   printed with the numbers.
 # Usage: bench/orient_bench.sh [--size N] [--runs R] [--presets "whorl left-loop"]
-#        [--exemplars "stripes_Fabric071 ..."] [--no-speed]
+#        [--exemplars "stripes_Fabric071 ..."] [--no-speed] [--keep-embark]
+# --summary-only prints the tables from the outputs of earlier runs (e.g. one run per
+# exemplar in parallel, then one summary). --keep-embark reuses an Embark output and its first timing from an earlier run (Embark
+# takes minutes per exemplar on a loaded 2-core machine).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
 size=512
 runs=3
 speed=1
+keep_embark=0
+summary_only=0
 presets="arch tented-arch left-loop right-loop whorl"
 exemplars="stripes_Fabric071 bands-fingerprint-like_Onyx013 woodgrain_Wood022 weave-diagonal_Fabric015"
 while [ $# -gt 0 ]; do
@@ -38,6 +43,8 @@ while [ $# -gt 0 ]; do
     --presets) presets="$2"; shift 2 ;;
     --exemplars) exemplars="$2"; shift 2 ;;
     --no-speed) speed=0; shift ;;
+    --keep-embark) keep_embark=1; shift ;;
+    --summary-only) summary_only=1; shift ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -69,11 +76,15 @@ timed() {
   /usr/bin/time -f '%e %U %S' -a -o "$log" "$@" >/dev/null
 }
 for e in $exemplars; do
+  [ "$summary_only" = 1 ] && break
   d="$out/$e"
   mkdir -p "$d"
   # Embark, unguided, same exemplar and size; scored in the 0° frame.
-  rm -f "$d/embark-times.txt" "$d/orient-times.txt"
-  timed "$d/embark-times.txt" "$embark" --no-progress --out-size "$size" --seed 1 --out "$d/embark.png" generate "$ex/$e.png"
+  rm -f "$d/orient-times.txt"
+  if [ "$keep_embark" = 0 ] || [ ! -s "$d/embark-times.txt" ] || [ ! -f "$d/embark.png" ]; then
+    rm -f "$d/embark-times.txt"
+    timed "$d/embark-times.txt" "$embark" --no-progress --out-size "$size" --seed 1 --out "$d/embark.png" generate "$ex/$e.png"
+  fi
   "$bin" eval "$d/embark.png" --exemplar "$ex/$e.png" --field "$out/zero-field-$size.npy" --quiet --out "$d/embark-eval.json" >/dev/null
   # fieldtex with a constant 0° field design.
   "$bin" orient --field "$out/zero-field-$size.npy" --exemplar "$ex/$e.png" --size "$size" --out "$d/const0" --quiet
