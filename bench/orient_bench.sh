@@ -48,10 +48,12 @@ while [ $# -gt 0 ]; do
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
-cargo build --release -q -p fieldtex-cli
-cargo build --release -q -p fieldtex-synth --example orient_probe
-if [ ! -x bench/.tools/bin/texture-synthesis ]; then
-  cargo install --root bench/.tools texture-synthesis-cli --locked
+if [ "$summary_only" = 0 ]; then
+  cargo build --release -q -p fieldtex-cli
+  cargo build --release -q -p fieldtex-synth --example orient_probe
+  if [ ! -x bench/.tools/bin/texture-synthesis ]; then
+    cargo install --root bench/.tools texture-synthesis-cli --locked
+  fi
 fi
 bin=target/release/fieldtex
 probe=target/release/examples/orient_probe
@@ -127,6 +129,9 @@ for e in exemplars:
               for a in (10, 20, 30, 45) if os.path.exists(os.path.join(d, f"ideal-{a}-eval.json"))]
     floor = sum(floors) / len(floors) if floors else float("nan")
     for p in presets:
+        if not all(os.path.exists(os.path.join(d, q, "report.json")) for q in (p, p + "-nofix")):
+            print(f"{e:32} {p:12} (not run)")
+            continue
         r = load(os.path.join(d, p, "report.json"))["metrics"]
         n = load(os.path.join(d, p + "-nofix", "report.json"))["metrics"]
         t, tn = r["texture"], n["texture"]
@@ -160,7 +165,7 @@ for e in exemplars:
     misses += c > k
     line = f"{e:32} {c:10.5f} {k:10.5f} {ok(c <= k):4} {floor:8.5f}"
     entry = {"const0_coherence": c, "embark_coherence": k, "rotated_copy_floor": floor}
-    if speed:
+    if speed and os.path.exists(os.path.join(d, "orient-times.txt")):
         def med(path):
             rows = [list(map(float, l.split())) for l in open(path) if l.strip() and l[0].isdigit()]
             return statistics.median(r[0] for r in rows), statistics.median(r[1] + r[2] for r in rows), len(rows)
