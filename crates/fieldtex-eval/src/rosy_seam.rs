@@ -136,7 +136,7 @@ pub fn rosy_seam_coherence(
         let v = field.at(x, y);
         let (a, b) = (v[0] as f64, v[1] as f64);
         let len = (a * a + b * b).sqrt();
-        (len.is_finite() && len > 1e-12).then(|| [a / len, b / len])
+        (len.is_finite() && len > 1e-12).then_some([a / len, b / len])
     };
     let coord = |x: usize, y: usize| {
         let i = 2 * (y * w + x);
