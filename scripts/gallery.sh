@@ -20,6 +20,32 @@ if [ "$only" = all ] || [ "$only" = align ]; then
   done
   [ "$only" = align ] && { echo "gallery (align) written to docs/gallery/"; exit 0; }
 fi
+# align on photo exemplars (issue 16): bricks and wood are 512² photos, stone wall and
+# gravel 124² photo thumbnails enlarged 4× (as bench/align_quality.sh does, so their
+# structures span as many pixels as in a 512² photo); fandisk and koala, 1024² atlas
+# (`gallery.sh photos` for these only).
+if [ "$only" = all ] || [ "$only" = photos ]; then
+  cargo build --release -q -p fieldtex-texopt --example resize_exemplar
+  mkdir -p out/gallery/photos
+  for src in stone-wall_Rocks001 gravel_Gravel005; do
+    [ -f "out/gallery/photos/$src-512.png" ] ||
+      target/release/examples/resize_exemplar "$ex/$src.png" 512 "out/gallery/photos/$src-512.png"
+  done
+  for m in fandisk koala-lowres; do
+    for e in bricks stone-wall gravel wood; do
+      case "$e" in
+        bricks) p="$ex/bricks-gray-large_MaterialX-brick_base_gray.png" ;;
+        stone-wall) p=out/gallery/photos/stone-wall_Rocks001-512.png ;;
+        gravel) p=out/gallery/photos/gravel_Gravel005-512.png ;;
+        wood) p="$ex/woodgrain-large_MaterialX-wood_color.png" ;;
+      esac
+      "$bin" align --mesh "../shared/data/meshes/$m.obj" --exemplar "$p" --size 1024 \
+        --out "out/gallery/photo-$m-$e" --quiet
+      cp "out/gallery/photo-$m-$e/preview.png" "docs/gallery/photo-$m-$e.png"
+    done
+  done
+  [ "$only" = photos ] && { echo "gallery (photos) written to docs/gallery/"; exit 0; }
+fi
 # orient (paper D): the five fingerprint presets and a curved patch (`gallery.sh orient`
 # for these only).
 "$bin" orient --preset whorl --exemplar "$ex/stripes_Fabric071.png" --mesh ../shared/data/meshes/demosthenes-bust-open.obj \

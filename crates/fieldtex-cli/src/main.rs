@@ -139,7 +139,8 @@ enum Command {
         #[arg(long, value_name = "X,Y,Z,R", value_delimiter = ',', allow_hyphen_values = true)]
         patch: Option<Vec<f64>>,
         /// Output directory (created if missing): texture.png, field.npy, preview.png,
-        /// report.json (and model.glb with --mesh).
+        /// report.json, and coords.npy (each pixel's exemplar coordinate, for
+        /// `eval --coords`) on the plane or model.glb with --mesh.
         #[arg(long)]
         out: PathBuf,
     },
@@ -272,6 +273,14 @@ enum Command {
         /// Constant guidance direction in degrees (counter-clockwise from +x on screen).
         #[arg(long)]
         angle: Option<f64>,
+        /// The image's exemplar-coordinate map (orient's coords.npy, with --field): adds
+        /// `rosy_seam`, the coherent share of neighbour pairs across the field's 2-RoSy
+        /// representation jumps against the image-wide share.
+        #[arg(long, requires = "field")]
+        coords: Option<PathBuf>,
+        /// With --coords: the pattern size the image was made with (orient's --scale).
+        #[arg(long, default_value_t = 1.0, requires = "coords")]
+        scale: f64,
         /// Exhaustive nearest-patch searches instead of the default approximate ones
         /// (PCA + kd-tree, within a few per cent; see docs/first-hour.md); minutes at
         /// 1024².
@@ -423,7 +432,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             opts.metrics = !no_metrics;
             opts.exact_metrics = exact_metrics;
             opts.seed = g.seed;
-            let model = if mesh.is_some() { "model.glb, " } else { "" };
+            let model = if mesh.is_some() { "model.glb, " } else { "coords.npy, " };
             opts.mesh = mesh;
             opts.patch = match patch.as_deref() {
                 None => None,
@@ -518,7 +527,9 @@ fn run(cli: Cli) -> Result<(), Error> {
             }
             print_stdout(&text);
         }
-        Command::Eval { image, exemplar, field, angle, exact_metrics, out, .. } => {
+        Command::Eval {
+            image, exemplar, field, angle, coords, scale, exact_metrics, out, ..
+        } => {
             let (Some(image), Some(exemplar)) = (image, exemplar) else {
                 return Err(Error::bad_input(
                     None,
@@ -530,10 +541,12 @@ fn run(cli: Cli) -> Result<(), Error> {
                 (None, Some(a)) => Some(fieldtex::Guidance::Angle(a)),
                 (None, None) => None,
             };
+            let seam = coords.map(|path| fieldtex::SeamCoordinates { path, scale });
             let metrics = fieldtex::eval_files(
                 &image,
                 &exemplar,
                 guide.as_ref(),
+                seam.as_ref(),
                 g.seed,
                 exact_metrics,
                 &progress,

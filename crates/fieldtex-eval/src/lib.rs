@@ -10,6 +10,8 @@
 //! - [`orientation_error`]: structure-tensor feature direction vs a guidance field;
 //! - [`singularities()`]: ±1/2 singularities of an orientation map;
 //! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px;
+//! - [`rosy_seam_coherence`]: coherent exemplar coordinates across a 2-RoSy field's
+//!   representation jumps vs image-wide (paper D's seams);
 //! - [`surface_orientation_error`]: orientation error on a textured mesh by
 //!   tangent-plane resampling; [`feature_line_coverage`]: salient-curve length on
 //!   which an exemplar feature line lies.
@@ -33,6 +35,7 @@ pub mod nearest_patch;
 pub mod nearest_patch_metrics;
 pub mod orientation;
 pub mod phase_defects;
+pub mod rosy_seam;
 pub mod seam_metrics;
 pub mod singularities;
 pub mod surface_metrics;
@@ -62,6 +65,7 @@ pub use phase_defects::{
     PhaseDefect, PhaseDefectOptions, PhaseDefectReport, count_defects_near, estimate_stripe_period,
     phase_defects,
 };
+pub use rosy_seam::{RosySeamOptions, RosySeamReport, rosy_seam_coherence};
 pub use singularities::{
     ExpectedSingularity, Singularity, SingularityCluster, SingularityMatch, SingularityOptions,
     SingularityReport, match_singularities, singularities,

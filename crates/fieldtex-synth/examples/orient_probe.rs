@@ -19,7 +19,8 @@
 //! neighbour pairs, the effective-frame seams (`(−1)^I J` turning by more than 90°
 //! between neighbours) and the flipped share. `--const DEG` adds a constant-field
 //! case (no singularities); `--ideal DEG` scores the exemplar itself rotated to a
-//! constant field (the resampling floor of the metric). `--both` runs with and without the 2-RoSy fix. `--png DIR`
+//! constant field (the resampling floor of the metric; with `--png DIR` also written as
+//! `ideal-DEG.png` and its field `ideal-DEG.npy`). `--both` runs with and without the 2-RoSy fix. `--png DIR`
 //! writes the texture, the texture with the defects marked (red: within 3 periods of a
 //! designed singularity), 3× crops around the singularities and the flip map.
 
@@ -170,6 +171,14 @@ fn main() {
         let gopts = ev::GuidedCoherenceOptions { stride, ..Default::default() };
         let gc = ev::guided_coherence(&out, &ev_ex, &fv, &gopts).unwrap();
         println!("ideal rotated copy {deg:5.1}°: gc={:.6} (median {:.6})", gc.mean, gc.median);
+        if let Some(dir) = &png {
+            // The copy itself and its field, for scoring with `fieldtex eval` (the
+            // approximate search of orient's reports).
+            std::fs::create_dir_all(dir).unwrap();
+            fieldtex_io::write_png(&dir.join(format!("ideal-{deg}.png")), &img).unwrap();
+            fieldtex_io::write_npy_f32(&dir.join(format!("ideal-{deg}.npy")), &[n, n, 2], &field)
+                .unwrap();
+        }
     }
     let fixes: Vec<bool> = if both { vec![true, false] } else { vec![opts.rosy_fix] };
     let mut cases: Vec<Case> = consts

@@ -64,7 +64,8 @@
 //!   characteristic_scale`). The surface side stays at one resolution (carriers), with
 //!   coarse levels iterating on a subset (above).
 //! - Crisp final pass ([`TexOptOptions::crisp`]): each carrier shows one covering
-//!   patch's exemplar colour, the one nearest the blend (see [`robust_blend`]).
+//!   patch's exemplar pixel: by default the best-matching one near its centre
+//!   ([`CrispChoice`], see [`robust_blend`]).
 
 mod error;
 mod exemplar_patches;
@@ -79,7 +80,7 @@ pub mod texture_optimisation;
 pub use error::TexOptError;
 /// The workspace's one spatial grid, under its former texopt name.
 pub use fieldtex_mesh::SpatialGrid as UniformGrid;
-pub use options::{FeatureAlignment, TexOptOptions, pyramid_patch_sizes};
+pub use options::{CrispChoice, FeatureAlignment, TexOptOptions, pyramid_patch_sizes};
 pub use sample_set::sample_set;
 pub use surface_domain::{Carrier, SurfaceDomain, vertex_carriers};
 pub use surface_samples::{Neighbour, SurfaceSamples};

@@ -72,8 +72,28 @@ pub struct TexOptOptions {
     /// the average ([`robust_blend`](crate::robust_blend)). Default true; false keeps
     /// the softer least-squares blend.
     pub crisp: bool,
+    /// Which covering patch a carrier shows in the crisp pass. Default
+    /// [`CrispChoice::BestMatch`].
+    pub crisp_choice: CrispChoice,
     /// Seed of all random streams. Default 0.
     pub seed: u64,
+}
+
+/// How the crisp final pass ([`TexOptOptions::crisp`]) picks, per carrier, the covering
+/// patch whose exemplar pixel it shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum CrispChoice {
+    /// The best-matching patch: the largest blend weight (robust IRLS weight of its
+    /// match times the centre falloff), i.e. the patch that matches best near its
+    /// centre. Neighbouring carriers mostly share a patch, so each region is a whole
+    /// exemplar copy (a Voronoi-like mosaic of the matches). Measured on fandisk with
+    /// the photo exemplars: see docs/real-exemplars.md.
+    #[default]
+    BestMatch,
+    /// The patch whose colour is closest to the weighted average among those with at
+    /// least half the largest weight (ties: the larger weight). Picks the consensus
+    /// per carrier, which pulls fine grain towards the mean (softer).
+    Consensus,
 }
 
 impl Default for TexOptOptions {
@@ -98,6 +118,7 @@ impl Default for TexOptOptions {
             blend_falloff: Some(1.5),
             coherence_bias: 1.0,
             crisp: true,
+            crisp_choice: CrispChoice::BestMatch,
             seed: 0,
         }
     }

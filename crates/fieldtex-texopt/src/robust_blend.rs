@@ -24,6 +24,7 @@
 //! itself, the usual cure for the softness of least-squares blending (a texel shows an
 //! exemplar pixel; seams between patches stay where the average put its transitions).
 
+use crate::CrispChoice;
 use crate::exemplar_patches::{GRID, HALF};
 use crate::texture_optimisation::LevelContext;
 use fieldtex_core::vec3::{dot, sub};
@@ -43,9 +44,8 @@ pub(crate) enum BlendMode {
     /// The robust weighted average (Kwatra et al. 2005 eq. 3).
     Average,
     /// The crisp final pass: the exemplar pixel (nearest to the coordinate) that one
-    /// covering patch assigns, namely the patch whose colour is closest to the weighted
-    /// average among those with at least half the largest weight (ties: the larger),
-    /// with its exemplar coordinate as source. Every
+    /// covering patch assigns, with its exemplar coordinate as source; which patch is
+    /// [`TexOptOptions::crisp_choice`](crate::TexOptOptions::crisp_choice). Every
     /// carrier then shows an exemplar pixel, not a mix.
     Crisp,
     /// The colour of the covering patch with the largest weight (the one whose centre
@@ -148,7 +148,10 @@ fn blend_carrier(
             win = (w, [ex, ey]);
             win_color = z;
         }
-        if mode == BlendMode::Crisp && n_cands < MAX_CRISP_CANDIDATES {
+        if mode == BlendMode::Crisp
+            && ctx.crisp_choice == CrispChoice::Consensus
+            && n_cands < MAX_CRISP_CANDIDATES
+        {
             cands[n_cands] = (w, z, [ex, ey]);
             n_cands += 1;
         }
@@ -160,7 +163,11 @@ fn blend_carrier(
     if mode == BlendMode::Winner {
         col = win_color;
     }
-    if mode == BlendMode::Crisp {
+    if mode == BlendMode::Crisp && ctx.crisp_choice == CrispChoice::BestMatch {
+        // The exemplar pixel under the best-matching covering patch (largest robust
+        // weight times falloff), nearest, not bilinear.
+        col = lvl.sample(win.1[0].round(), win.1[1].round());
+    } else if mode == BlendMode::Crisp {
         let mut best = (f32::INFINITY, f64::NEG_INFINITY, usize::MAX);
         for (i, (w, z, _)) in cands[..n_cands].iter().enumerate() {
             // Only patches near their centre here (weight at least half the largest):

@@ -114,6 +114,8 @@ pub(crate) struct LevelContext<'a> {
     pub falloff: f64,
     /// [`TexOptOptions::coherence_bias`].
     pub coherence_bias: f64,
+    /// [`TexOptOptions::crisp_choice`].
+    pub crisp_choice: crate::CrispChoice,
 }
 
 fn validate_inputs(
@@ -299,6 +301,7 @@ pub fn optimise(
             seed: options.seed,
             falloff: options.blend_falloff.map_or(0.0, |sigma| 0.5 / (sigma * sigma)),
             coherence_bias: options.coherence_bias,
+            crisp_choice: options.crisp_choice,
         };
         let m = level.len() as u64;
         let half = crate::exemplar_patches::HALF * s;

@@ -7,7 +7,7 @@
 use fieldtex_core::{Image, NoProgress};
 use fieldtex_eval::{ImageView, PatchDistanceOptions, coherence, contrast_sharpness};
 use fieldtex_mesh::primitives::grid;
-use fieldtex_texopt::{SurfaceDomain, TexOptOptions, optimise, pyramid_patch_sizes};
+use fieldtex_texopt::{CrispChoice, SurfaceDomain, TexOptOptions, optimise, pyramid_patch_sizes};
 
 /// Integer hash → `[0, 1)`.
 fn hash(mut x: u64) -> f32 {
@@ -69,7 +69,11 @@ fn pyramid_and_crisp_pass_keep_contrast_crispness_and_structure() {
     let ev = ImageView::new(&ebuf, 512, 512, 3).unwrap();
     let size = 128;
     let base = TexOptOptions::default().with_pixel_size(1.0).with_max_iterations(3);
-    let new = run(&exemplar, size, &base.clone().with_patch_sizes(sizes));
+    let new = run(&exemplar, size, &base.clone().with_patch_sizes(sizes.clone()));
+    // The crisp pass's previous choice (the covering patch closest to the average).
+    let mut consensus_opts = base.clone().with_patch_sizes(sizes);
+    consensus_opts.crisp_choice = CrispChoice::Consensus;
+    let consensus = run(&exemplar, size, &consensus_opts);
     let mut old_opts = base.with_patch_sizes(vec![32, 16, 8]);
     old_opts.crisp = false;
     let old = run(&exemplar, size, &old_opts);
@@ -108,6 +112,10 @@ fn pyramid_and_crisp_pass_keep_contrast_crispness_and_structure() {
     let coh_blur = coh(&blurred);
     let (c_new, g_new, coh_new) = measure(&new);
     let (c_old, g_old, coh_old) = measure(&old);
+    let (c_con, g_con, coh_con) = measure(&consensus);
+    eprintln!(
+        "consensus crisp choice: contrast {c_con:.3} gradient {g_con:.3} coherence {coh_con:.5}"
+    );
     eprintln!("new: contrast {c_new:.3} gradient {g_new:.3} coherence {coh_new:.5}");
     eprintln!("old: contrast {c_old:.3} gradient {g_old:.3} coherence {coh_old:.5}");
     eprintln!("exemplar blurred 3×3: coherence {coh_blur:.5}");
@@ -118,4 +126,6 @@ fn pyramid_and_crisp_pass_keep_contrast_crispness_and_structure() {
     assert!(c_new > c_old + 0.3, "contrast {c_new:.3} vs fixed 32-px start {c_old:.3}");
     assert!(g_new > g_old + 0.15, "gradient {g_new:.3} vs {g_old:.3}");
     assert!(coh_new < 0.5 * coh_blur, "coherence {coh_new:.5} vs blurred exemplar {coh_blur:.5}");
+    // The best-matching patch keeps more of the exemplar's grain than the consensus.
+    assert!(g_new >= g_con, "gradient best match {g_new:.3} vs consensus {g_con:.3}");
 }

@@ -32,7 +32,7 @@ pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
 pub use pipelines::conformal::{ConformalOptions, conformal};
 pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};
-pub use pipelines::eval::{Guidance, ImageMetrics, eval_files};
+pub use pipelines::eval::{Guidance, ImageMetrics, SeamCoordinates, eval_files};
 pub use pipelines::field::{FieldCommandOptions, FieldSummary, field_file};
 pub use pipelines::field_texture::{
     FieldTextureOptions, synthesize_field_texture, synthesize_field_texture_with,

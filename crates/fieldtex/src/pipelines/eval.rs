@@ -30,6 +30,11 @@ pub struct ImageMetrics {
     /// ±1/2 singularities of the output's own orientation (structure tensor).
     pub singularities: Option<SingularitySummary>,
     pub phase_defects: Option<ev::PhaseDefectReport>,
+    /// Coherent exemplar coordinates across the field's 2-RoSy representation jumps
+    /// against image-wide (`fieldtex_eval::rosy_seam`); only with the texture's
+    /// coordinate map (`orient`, or `eval --coords`) and a field.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rosy_seam: Option<ev::RosySeamReport>,
     /// Metrics that could not be computed, with the reason.
     pub skipped: Vec<String>,
 }
@@ -143,8 +148,37 @@ pub(crate) fn image_metrics(
         orientation_error,
         singularities,
         phase_defects,
+        rosy_seam: None,
         skipped,
     })
+}
+
+/// The exemplar-coordinate map of a synthesised image, for the seam measure of
+/// [`ImageMetrics::rosy_seam`] in [`eval_files`].
+#[derive(Debug, Clone)]
+pub struct SeamCoordinates {
+    /// `.npy` H×W×2 float32 exemplar coordinates `(x, y)` of each pixel (`coords.npy`
+    /// of `fieldtex orient`), in pixels of the exemplar as the synthesis used it (after
+    /// the exemplar policy's reduction).
+    pub path: PathBuf,
+    /// The pattern size the texture was made with (`orient --scale`: output pixels per
+    /// exemplar file pixel).
+    pub scale: f64,
+}
+
+/// The seam measure of a coordinate map `coords` (H×W×2, exemplar pixels) made with
+/// `field` (H×W×2) on an exemplar of `exemplar_size` pixels at `step` exemplar pixels
+/// per output pixel.
+pub(crate) fn rosy_seam_metric(
+    coords: &[f32],
+    field: &[f32],
+    width: usize,
+    height: usize,
+    exemplar_size: [usize; 2],
+    step: f64,
+) -> std::result::Result<ev::RosySeamReport, ev::EvalError> {
+    let fv = ev::FieldView::new(field, width, height)?;
+    ev::rosy_seam_coherence(coords, &fv, exemplar_size, step, &ev::RosySeamOptions::default())
 }
 
 /// Reads the images (and field) and computes [`ImageMetrics`]; `exact` replaces the
@@ -153,6 +187,7 @@ pub fn eval_files(
     image: &Path,
     exemplar: &Path,
     guidance: Option<&Guidance>,
+    coordinates: Option<&SeamCoordinates>,
     seed: u64,
     exact: bool,
     progress: &dyn Progress,
@@ -196,13 +231,50 @@ pub fn eval_files(
         }
         None => (None, None),
     };
-    image_metrics(&out, &ex, field.as_deref(), angle, 0.0, seed, exact, progress).map_err(|e| {
-        let about_exemplar = match &e {
-            ev::EvalError::TooSmall { what, .. }
-            | ev::EvalError::NonFinite { what, .. }
-            | ev::EvalError::BufferSize { what, .. } => what.starts_with("exemplar"),
-            _ => false,
-        };
-        bad(e, if about_exemplar { exemplar } else { image })
-    })
+    let seam = match (coordinates, &field) {
+        (None, _) => None,
+        (Some(c), None) => {
+            return Err(Error::bad_input(
+                Some(&c.path),
+                "--coords needs the guidance field the texture was made with (--field)",
+            ));
+        }
+        (Some(c), Some(f)) => {
+            if !(c.scale.is_finite() && c.scale > 0.0) {
+                return Err(Error::bad_input(None, "--scale must be a positive number"));
+            }
+            let (shape, data) = fieldtex_io::read_npy_f32(&c.path)?;
+            if shape != [out.height, out.width, 2] {
+                return Err(Error::bad_input(
+                    Some(&c.path),
+                    format!(
+                        "the coordinate map has shape {shape:?} but the image needs [{}, {}, 2] \
+                         (H×W×2 float32 exemplar coordinates, orient's coords.npy)",
+                        out.height, out.width
+                    ),
+                ));
+            }
+            // The synthesis saw the exemplar as reduced by the exemplar policy; its
+            // coordinates are in those pixels.
+            let fitted =
+                fieldtex_synth::fit_exemplar(ex.clone(), fieldtex_synth::MAX_EXEMPLAR_SIDE);
+            let size = [fitted.image.width, fitted.image.height];
+            let step = 1.0 / (c.scale * fitted.factor as f64);
+            let r = rosy_seam_metric(&data, f, out.width, out.height, size, step)
+                .map_err(|e| bad(e, &c.path))?;
+            Some(r)
+        }
+    };
+    let mut metrics = image_metrics(&out, &ex, field.as_deref(), angle, 0.0, seed, exact, progress)
+        .map_err(|e| {
+            let about_exemplar = match &e {
+                ev::EvalError::TooSmall { what, .. }
+                | ev::EvalError::NonFinite { what, .. }
+                | ev::EvalError::BufferSize { what, .. } => what.starts_with("exemplar"),
+                _ => false,
+            };
+            bad(e, if about_exemplar { exemplar } else { image })
+        })?;
+    metrics.rosy_seam = seam;
+    Ok(metrics)
 }

@@ -3,8 +3,9 @@
 //! Design (TOML file or fingerprint preset) → DEC field on a triangulated grid
 //! (`fieldtex-fields`) → per-pixel 2-RoSy field → parallel appearance-space synthesis
 //! guided by the field's Jacobian with the 2-RoSy fix (`fieldtex-synth`) → texture,
-//! `field.npy`, a preview with the designed singularities marked, and a report with
-//! the metrics of `eval` plus singularity and phase-defect comparisons.
+//! `field.npy`, `coords.npy` (each pixel's exemplar coordinate), a preview with the
+//! designed singularities marked, and a report with the metrics of `eval` plus
+//! singularity and phase-defect comparisons and the seam measure of the 2-RoSy fix.
 //!
 //! With [`OrientOptions::mesh`] (a disk-topology patch) the work moves to
 //! [`super::orient_patch`]: the patch is parameterised, the field is designed on the
@@ -216,10 +217,13 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         "exemplar_reduction": fitted.factor,
     });
     let (field, designed) = build_field(options, &mut report)?;
-    let out = begin_outputs(out_dir, &["texture.png", "field.npy", "preview.png", "report.json"])?;
+    let out = begin_outputs(
+        out_dir,
+        &["texture.png", "field.npy", "coords.npy", "preview.png", "report.json"],
+    )?;
     let stage = out.staging();
     let n = options.size;
-    let synth = super::synthesis::synthesize_image(
+    let result = super::synthesis::synthesize_image_result(
         &exemplar,
         &field,
         n,
@@ -231,19 +235,25 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         progress,
     )
     .map_err(|e| e.with_path(&options.exemplar))?;
+    let synth = &result.colors;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
-    fieldtex_io::write_png(&stage.join("texture.png"), &synth)?;
+    // Exemplar coordinates of each pixel, in pixels of the exemplar as synthesised
+    // (after the exemplar policy's reduction): what `eval --coords` reads.
+    let coords: Vec<f32> = result.coords.iter().flat_map(|c| [c[0], c[1]]).collect();
+    fieldtex_io::write_png(&stage.join("texture.png"), synth)?;
     fieldtex_io::write_npy_f32(&stage.join("field.npy"), &[n, n, 2], &flat)?;
+    fieldtex_io::write_npy_f32(&stage.join("coords.npy"), &[n, n, 2], &coords)?;
     report.metric("designed_singularities", &designed);
     if options.metrics {
         let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-        let (metrics, _) =
-            texture_metrics(&mut report, &synth, &exemplar, &flat, &pts, options, progress)?;
+        let (mut metrics, _) =
+            texture_metrics(&mut report, synth, &exemplar, &flat, &pts, options, progress)?;
+        metrics.rosy_seam = Some(seam_metric(&coords, &flat, n, &exemplar, per_pixel)?);
         report.metric("texture", &metrics);
     } else {
         report.notes.push("image metrics skipped (--no-metrics)".into());
     }
-    let preview = preview_with_singularities(&synth, &designed);
+    let preview = preview_with_singularities(synth, &designed);
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     commit_outputs(out, &mut report)?;
     Ok(report)
@@ -263,18 +273,36 @@ pub(crate) fn orient_in_memory(
     // In-memory exemplars (the demo's procedural ones) are never reduced.
     let per_pixel = options.exemplar_pixels_per_output_pixel(1);
     let cache = super::synthesis::AnalysisCache::process();
-    let synth = super::synthesis::synthesize_image(
+    let result = super::synthesis::synthesize_image_result(
         exemplar, &field, n, n, per_pixel, options, cache, report, progress,
     )?;
+    let synth = &result.colors;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     report.metric("designed_singularities", &designed);
     if options.metrics {
         let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-        let (metrics, _) =
-            texture_metrics(report, &synth, exemplar, &flat, &pts, options, progress)?;
+        let (mut metrics, _) =
+            texture_metrics(report, synth, exemplar, &flat, &pts, options, progress)?;
+        let coords: Vec<f32> = result.coords.iter().flat_map(|c| [c[0], c[1]]).collect();
+        metrics.rosy_seam = Some(seam_metric(&coords, &flat, n, exemplar, per_pixel)?);
         report.metric("texture", &metrics);
     }
-    Ok(preview_with_singularities(&synth, &designed))
+    Ok(preview_with_singularities(synth, &designed))
+}
+
+/// The seam measure (`fieldtex_eval::rosy_seam`) of an `n × n` synthesis: its exemplar
+/// coordinates `coords` against its field `flat`, at `per_pixel` exemplar pixels per
+/// output pixel.
+fn seam_metric(
+    coords: &[f32],
+    flat: &[f32],
+    n: usize,
+    exemplar: &Image,
+    per_pixel: f64,
+) -> Result<fieldtex_eval::RosySeamReport> {
+    let size = [exemplar.width, exemplar.height];
+    super::eval::rosy_seam_metric(coords, flat, n, n, size, per_pixel)
+        .map_err(|e| Error::Internal(format!("seam metric: {e}")))
 }
 
 /// The image metrics of an orient texture (`flat`: its `H×W×2` field) against the field

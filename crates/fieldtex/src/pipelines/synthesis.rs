@@ -89,6 +89,26 @@ pub(crate) fn synthesize_image(
     report: &mut Report,
     progress: &dyn Progress,
 ) -> Result<Image> {
+    synthesize_image_result(
+        exemplar, field, width, height, per_pixel, options, cache, report, progress,
+    )
+    .map(|r| r.colors)
+}
+
+/// [`synthesize_image`] with the whole synthesis result: colours, the exemplar
+/// coordinate of every pixel (exemplar pixels) and the flip indicators.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn synthesize_image_result(
+    exemplar: &Image,
+    field: &[[f32; 2]],
+    width: usize,
+    height: usize,
+    per_pixel: f64,
+    options: &OrientOptions,
+    cache: &AnalysisCache,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<fieldtex_synth::SynthesisResult> {
     let aopts = AnalysisOptions::default();
     let (analysis, cached) = report
         .time("analysis", || cache.analysis(exemplar, &aopts, progress))
@@ -102,5 +122,5 @@ pub(crate) fn synthesize_image(
     let result = report
         .time("synthesis", || synthesize(&analysis, &domain, &sopts, progress))
         .map_err(|e| Error::Internal(format!("synthesis: {e}")))?;
-    Ok(result.colors)
+    Ok(result)
 }

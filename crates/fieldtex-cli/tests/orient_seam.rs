@@ -1,0 +1,125 @@
+//! The seam measure of the 2-RoSy fix (issue 16 point 4) end to end: `orient` writes
+//! `coords.npy` and reports `metrics.texture.rosy_seam`; the fix keeps the exemplar
+//! coordinates coherent across the field's representation jumps, its ablation does
+//! not; `eval --coords` recomputes the same numbers from the files.
+
+mod common;
+
+use common::{code, run_limited, shared, stderr, tmp_in};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+const LIMIT: Duration = Duration::from_secs(300);
+
+fn tmp(name: &str) -> PathBuf {
+    tmp_in("orient_seam", name)
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// A whorl on the stripes exemplar at 128², with `extra` flags; returns the report.
+fn orient(dir: &Path, extra: &[&str]) -> serde_json::Value {
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let mut args = vec![
+        "orient",
+        "--preset",
+        "whorl",
+        "--exemplar",
+        ex.to_str().unwrap(),
+        "--size",
+        "128",
+        "--grid",
+        "32",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    let o = run_limited(&args, LIMIT);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    json(&dir.join("report.json"))
+}
+
+#[test]
+fn rosy_fix_keeps_seams_coherent_and_eval_agrees() {
+    let fix = tmp("fix");
+    let nofix = tmp("nofix");
+    let r = orient(&fix, &[]);
+    let n = orient(&nofix, &["--no-rosy-fix"]);
+    let s = &r["metrics"]["texture"]["rosy_seam"];
+    let sn = &n["metrics"]["texture"]["rosy_seam"];
+    // The whorl's representative field jumps somewhere (two wedges).
+    let jumps = s["jump_pairs"].as_u64().unwrap();
+    assert!(jumps > 20, "{s}");
+    assert_eq!(jumps, sn["jump_pairs"].as_u64().unwrap(), "same field, same jumps");
+    let ratio = s["seam_ratio"].as_f64().unwrap();
+    let ratio_nofix = sn["seam_ratio"].as_f64().unwrap();
+    assert!(ratio >= 0.8, "with the fix the seams are about as coherent as the image: {s}");
+    assert!(ratio_nofix < 0.5 * ratio, "without it they break: {sn} vs {s}");
+
+    // coords.npy: H × W × 2 float32, and `eval --coords` gives the same numbers.
+    let npy = std::fs::read(fix.join("coords.npy")).unwrap();
+    assert!(String::from_utf8_lossy(&npy[..128]).contains("(128, 128, 2)"));
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let (texture, field, coords) =
+        (fix.join("texture.png"), fix.join("field.npy"), fix.join("coords.npy"));
+    let o = run_limited(
+        &[
+            "eval",
+            texture.to_str().unwrap(),
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--field",
+            field.to_str().unwrap(),
+            "--coords",
+            coords.to_str().unwrap(),
+            "--quiet",
+        ],
+        LIMIT,
+    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(&v["rosy_seam"], s, "eval --coords reproduces orient's seam measure");
+
+    // --coords without --field, and a coordinate map of the wrong shape: exit 2.
+    let o = run_limited(
+        &[
+            "eval",
+            texture.to_str().unwrap(),
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--coords",
+            coords.to_str().unwrap(),
+        ],
+        LIMIT,
+    );
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    let wrong = tmp("wrong");
+    let small = wrong.join("coords.npy");
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (4, 4, 2), }";
+    let pad = 64 - (10 + header.len() + 1) % 64;
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&((header.len() + pad + 1) as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    bytes.extend(std::iter::repeat_n(b' ', pad));
+    bytes.push(b'\n');
+    bytes.extend(std::iter::repeat_n(0u8, 4 * 4 * 2 * 4));
+    std::fs::write(&small, bytes).unwrap();
+    let o = run_limited(
+        &[
+            "eval",
+            texture.to_str().unwrap(),
+            "--exemplar",
+            ex.to_str().unwrap(),
+            "--field",
+            field.to_str().unwrap(),
+            "--coords",
+            small.to_str().unwrap(),
+        ],
+        LIMIT,
+    );
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("coords.npy"), "names the file: {}", stderr(&o));
+}
