@@ -29,7 +29,8 @@ pub struct TransferArgs {
     /// Up axis for the height descriptor: x, y or z.
     #[arg(long, default_value = "y")]
     up: String,
-    /// Dimensionality reduction: cca (default) or pca (ablation).
+    /// Dimensionality reduction: cca (default), cca-weighted (canonical variates weighted
+    /// by their correlations; experimental) or pca (ablation).
     #[arg(long, default_value = "cca")]
     reduce: String,
     /// Feature matching: none, marginals or multiscale.
@@ -83,8 +84,8 @@ pub fn run(
     };
     let tr = &mut opts.transfer;
     tr.descriptors.up = t::parse_up_axis(&args.up).ok_or_else(|| bad("up", &args.up, "x, y, z"))?;
-    tr.reduction =
-        t::parse_reduction(&args.reduce).ok_or_else(|| bad("reduce", &args.reduce, "cca, pca"))?;
+    tr.reduction = t::parse_reduction(&args.reduce)
+        .ok_or_else(|| bad("reduce", &args.reduce, "cca, cca-weighted, pca"))?;
     tr.matching = t::parse_match_mode(&args.matching)
         .ok_or_else(|| bad("match", &args.matching, "none, marginals, multiscale"))?;
     tr.engine = t::parse_engine(&args.engine)

@@ -13,12 +13,13 @@
 //! parametric engine, then the non-parametric engine with CCA + multiscale and CCA +
 //! none. `--engines parametric|nonparametric|all` (default all) selects.
 //!
-//! `--mask-below H` masks the source texels of triangles whose normalised height is below
-//! `H` (an incomplete source, like the half-scanned bagel of paper B Fig. 8): the
-//! case feature matching is meant for.
+//! `--with-weighted` adds the parametric runs with `cca-weighted` guidance (canonical
+//! variates weighted by their correlations). `--mask-below H` masks the source texels
+//! of triangles whose normalised height is below `H` (an incomplete source, like the
+//! half-scanned bagel of paper B Fig. 8): the case feature matching is meant for.
 //!
 //! Usage: `transfer_fidelity OUT_DIR SOURCE_MESH TARGET_MESH... [--samples N] [--engines E]
-//! [--mask-below H]`
+//! [--mask-below H] [--with-weighted]`
 //! Prints one line per (target, configuration): r, wall seconds.
 
 use fieldtex::crates::{core::Image, io, mesh};
@@ -113,12 +114,16 @@ fn main() {
     let mut samples = 200_000usize;
     let mut engines = "all".to_string();
     let mut mask_below: Option<f64> = None;
+    let mut weighted = false;
     let mut pos = Vec::new();
     let mut i = 0;
     while i < args.len() {
         if args[i] == "--samples" {
             samples = args[i + 1].parse().expect("--samples N");
             i += 2;
+        } else if args[i] == "--with-weighted" {
+            weighted = true;
+            i += 1;
         } else if args[i] == "--mask-below" {
             mask_below = Some(args[i + 1].parse().expect("--mask-below H"));
             i += 2;
@@ -160,9 +165,12 @@ fn main() {
         ("pca", "multiscale", "parametric"),
         ("cca", "multiscale", "nonparametric"),
         ("cca", "none", "nonparametric"),
+        ("cca-weighted", "multiscale", "parametric"),
+        ("cca-weighted", "marginals", "parametric"),
+        ("cca-weighted", "none", "parametric"),
     ]
     .into_iter()
-    .filter(|c| engines == "all" || engines == c.2)
+    .filter(|c| (engines == "all" || engines == c.2) && (weighted || c.0 != "cca-weighted"))
     .collect();
     for tpath in &pos[2..] {
         let name = Path::new(tpath).file_stem().unwrap().to_string_lossy().to_string();

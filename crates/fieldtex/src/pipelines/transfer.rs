@@ -79,10 +79,11 @@ pub fn parse_match_mode(s: &str) -> Option<MatchMode> {
     }
 }
 
-/// Parses `cca|pca`.
+/// Parses `cca|cca-weighted|pca`.
 pub fn parse_reduction(s: &str) -> Option<Reduction> {
     match s {
         "cca" => Some(Reduction::Cca),
+        "cca-weighted" => Some(Reduction::CcaWeighted),
         "pca" => Some(Reduction::Pca),
         _ => None,
     }
@@ -237,7 +238,7 @@ pub fn transfer_files(
     let named = |w: &[f64]| -> serde_json::Map<String, serde_json::Value> {
         DESCRIPTOR_NAMES.iter().zip(w).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect()
     };
-    let cca = options.transfer.reduction == Reduction::Cca;
+    let cca = options.transfer.reduction != Reduction::Pca;
     report.metric(
         "samples",
         serde_json::json!({
