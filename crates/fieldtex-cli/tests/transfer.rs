@@ -54,9 +54,9 @@ fn small(out: &Path, threads: &str, extra: &[&str]) -> Output {
 fn transfer_writes_outputs_and_is_identical_for_one_and_two_threads() {
     let a = tmp("t1");
     let b = tmp("t2");
-    let oa = small(&a, "1", &["--keep"]);
+    let oa = small(&a, "1", &["--keep", "--match", "multiscale"]);
     assert!(oa.status.success(), "{}", String::from_utf8_lossy(&oa.stderr));
-    let ob = small(&b, "2", &["--keep"]);
+    let ob = small(&b, "2", &["--keep", "--match", "multiscale"]);
     assert!(ob.status.success(), "{}", String::from_utf8_lossy(&ob.stderr));
     for f in ["model.glb", "preview.png", "guidance.ply"] {
         let x = std::fs::read(a.join(f)).unwrap();

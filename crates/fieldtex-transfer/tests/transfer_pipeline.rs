@@ -34,6 +34,18 @@ fn colour_that_follows_the_normal_transfers_to_another_shape() {
     let got: Vec<f64> = r.target_colors.chunks_exact(3).map(|c| c[0]).collect();
     let corr = pearson(&truth, &got);
     assert!(corr > 0.8, "Pearson r {corr}");
+    // Without feature matching the torus's guidance falls outside what the sphere
+    // taught (height and normal y are one function on a sphere, two on a torus): the
+    // dependence is lost. This is why multiscale matching stays the default
+    // (docs/transfer.md, "Where matching is needed").
+    let mut plain = opts.clone();
+    plain.matching = MatchMode::None;
+    let u = transfer(&src, &tex, None, &tgt, &plain, &NoProgress).unwrap();
+    let got_u: Vec<f64> = u.target_colors.chunks_exact(3).map(|c| c[0]).collect();
+    let truth_u: Vec<f64> =
+        u.target_samples.normals.iter().map(|n| up_shade(n[1]) as f64).collect();
+    let corr_u = pearson(&truth_u, &got_u);
+    assert!(corr_u < corr - 0.3, "no matching r {corr_u} vs multiscale r {corr}");
     // On the source sphere height = (n_y + 1) / 2, so the two collinear descriptors
     // share the weight; together they carry almost all of it.
     let w = &r.descriptor_weights;
