@@ -13,6 +13,10 @@ pub struct TransferArgs {
     /// Textured source mesh (OBJ+MTL+image, glTF/GLB with a base-colour texture).
     #[arg(long)]
     source: PathBuf,
+    /// Base-colour image for the source's UVs, replacing its material's texture (use it
+    /// for an OBJ with UVs but no MTL file).
+    #[arg(long)]
+    source_texture: Option<PathBuf>,
     /// Target mesh (any format the readers take).
     #[arg(long)]
     target: PathBuf,
@@ -25,15 +29,23 @@ pub struct TransferArgs {
     /// Up axis for the height descriptor: x, y or z.
     #[arg(long, default_value = "y")]
     up: String,
-    /// Dimensionality reduction: cca (default) or pca (ablation).
+    /// Dimensionality reduction: cca (default), cca-weighted (canonical variates weighted
+    /// by their correlations; experimental) or pca (ablation).
     #[arg(long, default_value = "cca")]
     reduce: String,
     /// Feature matching: none, marginals or multiscale.
     #[arg(long = "match", default_value = "multiscale")]
     matching: String,
-    /// Synthesis engine: parametric (nonparametric is not implemented yet).
+    /// Synthesis engine: parametric (constrained Heeger–Bergen) or nonparametric (image
+    /// analogies with Ashikhmin coherence).
     #[arg(long, default_value = "parametric")]
     engine: String,
+    /// Non-parametric engine: Ashikhmin coherence parameter κ (0 = best match only).
+    #[arg(long, default_value_t = 1.0)]
+    coherence: f64,
+    /// Non-parametric engine: side of the tangent-plane neighbourhood (odd).
+    #[arg(long, default_value_t = 5)]
+    neighbourhood: usize,
     /// Surface samples at the finest level on each mesh.
     #[arg(long, default_value_t = 512_000)]
     samples: usize,
@@ -63,6 +75,7 @@ pub fn run(
 ) -> Result<(), Error> {
     let mut opts = fieldtex::TransferCommandOptions {
         source: args.source,
+        source_texture: args.source_texture,
         target: args.target,
         mask: args.mask,
         size: args.size,
@@ -71,8 +84,8 @@ pub fn run(
     };
     let tr = &mut opts.transfer;
     tr.descriptors.up = t::parse_up_axis(&args.up).ok_or_else(|| bad("up", &args.up, "x, y, z"))?;
-    tr.reduction =
-        t::parse_reduction(&args.reduce).ok_or_else(|| bad("reduce", &args.reduce, "cca, pca"))?;
+    tr.reduction = t::parse_reduction(&args.reduce)
+        .ok_or_else(|| bad("reduce", &args.reduce, "cca, cca-weighted, pca"))?;
     tr.matching = t::parse_match_mode(&args.matching)
         .ok_or_else(|| bad("match", &args.matching, "none, marginals, multiscale"))?;
     tr.engine = t::parse_engine(&args.engine)
@@ -80,6 +93,8 @@ pub fn run(
     tr.samples = args.samples;
     tr.descriptors.samples = args.descriptor_samples;
     tr.parametric.clusters = args.clusters;
+    tr.nonparametric.coherence = args.coherence;
+    tr.nonparametric.neighbourhood = args.neighbourhood;
     tr.seed = g.seed;
     let report = fieldtex::transfer_files(&args.out, &opts, progress)?;
     if !g.quiet {

@@ -6,7 +6,18 @@
 //! Descriptors are first standardised with the source's mean and standard deviation
 //! (usable samples only), so that the reported weights are comparable across
 //! descriptors: `descriptor_weights[d]` is `|a₁[d]| / Σ|a₁|` for the first canonical
-//! direction `a₁` (paper Fig. 4). Guidance dimensions have unit variance on the source.
+//! direction `a₁` (paper Fig. 4).
+//!
+//! **Correlation weighting** (`Reduction::CcaWeighted`, opt-in): guidance dimension `k` is the
+//! canonical variate scaled by its canonical correlation `ρ_k`, i.e. `√Λ W_xᵀ x` of the
+//! paper's relation `√Λ W_xᵀ x ≈ W_yᵀ y` (§3.3): the guidance then predicts the colour's
+//! canonical variates, and a direction that explains nothing (`ρ ≈ 0`) shrinks to
+//! nothing instead of weighing as much as the informative one in k-means, in feature
+//! matching (whose random rotations would otherwise mix it into the informative axis)
+//! and in neighbourhood distances (the analysis is in `docs/transfer.md`; not yet
+//! measured, so not the default). `Reduction::Cca` (default) keeps unit-variance
+//! canonical variates; PCA dimensions are the principal components scaled to unit
+//! variance.
 
 use crate::TransferError;
 use crate::descriptors::N_DESCRIPTORS;
@@ -18,8 +29,12 @@ use serde::Serialize;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Reduction {
-    /// Canonical correlation analysis with the colours (default).
+    /// Canonical correlation analysis with the colours: unit-variance canonical variates
+    /// (default).
     Cca,
+    /// Canonical variates weighted by their canonical correlations (module docs).
+    #[serde(rename = "cca-weighted")]
+    CcaWeighted,
     /// Principal components of the descriptors (ablation).
     Pca,
 }
@@ -75,17 +90,24 @@ pub fn build_guidance(
     let fit_x: Vec<f64> =
         rows.iter().flat_map(|&i| zs[i * d..(i + 1) * d].iter().copied()).collect();
     let (directions, offsets, strengths) = match reduction {
-        Reduction::Cca => {
+        Reduction::Cca | Reduction::CcaWeighted => {
             let fit_y: Vec<f64> =
                 rows.iter().flat_map(|&i| ys[i * 3..i * 3 + 3].iter().copied()).collect();
             let c = cca(&fit_x, d, &fit_y, 3, &CcaOptions::default())
                 .map_err(|e| TransferError::numeric("CCA", e))?;
-            let offsets: Vec<f64> = c
+            let weighted = reduction == Reduction::CcaWeighted;
+            let dirs: Vec<Vec<f64>> = c
                 .x_weights
                 .iter()
-                .map(|w| w.iter().zip(&c.x_mean).map(|(a, m)| a * m).sum())
+                .zip(&c.correlations)
+                .map(|(w, &rho)| {
+                    let f = if weighted { rho.max(0.0) } else { 1.0 };
+                    w.iter().map(|v| v * f).collect()
+                })
                 .collect();
-            (c.x_weights, offsets, c.correlations)
+            let offsets: Vec<f64> =
+                dirs.iter().map(|w| w.iter().zip(&c.x_mean).map(|(a, m)| a * m).sum()).collect();
+            (dirs, offsets, c.correlations)
         }
         Reduction::Pca => {
             let f32s: Vec<f32> = fit_x.iter().map(|&v| v as f32).collect();
@@ -115,8 +137,55 @@ pub fn build_guidance(
     };
     let source = project(&zs);
     let target = project(&zt);
+    // Weights from the unscaled first direction (a positive factor does not change them).
     let first = &directions[0];
     let total: f64 = first.iter().map(|v| v.abs()).sum::<f64>().max(1e-300);
     let descriptor_weights = first.iter().map(|v| v.abs() / total).collect();
     Ok(Guidance { source, target, strengths, directions, descriptor_weights })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fieldtex_core::rng::hash_unit;
+
+    /// Colour depends on descriptor 0 only: weighting by the canonical correlations keeps
+    /// the first guidance dimension and shrinks the two uninformative ones; unweighted
+    /// CCA gives all three unit variance.
+    #[test]
+    fn correlation_weighting_shrinks_uninformative_directions() {
+        let n = 4000;
+        let d = N_DESCRIPTORS;
+        let xs: Vec<f64> =
+            (0..n * d).map(|i| hash_unit(11, "guidance-test", i as u64) - 0.5).collect();
+        let ys: Vec<f64> = (0..n)
+            .flat_map(|i| {
+                let v = 0.5 + 0.8 * xs[i * d];
+                // Independent noise per channel: the colours have full rank.
+                let e = |c: u64| 0.1 * (hash_unit(12, "noise", 3 * i as u64 + c) - 0.5);
+                [v + e(0), 0.7 * v + e(1), 0.4 * v + e(2)]
+            })
+            .collect();
+        let valid = vec![true; n];
+        let var = |g: &[f64], k: usize| {
+            let m = g.iter().skip(k).step_by(3).sum::<f64>() / n as f64;
+            g.iter().skip(k).step_by(3).map(|v| (v - m).powi(2)).sum::<f64>() / n as f64
+        };
+        let plain = build_guidance(&xs, &ys, &valid, &xs, Reduction::Cca).unwrap();
+        let weighted = build_guidance(&xs, &ys, &valid, &xs, Reduction::CcaWeighted).unwrap();
+        assert!(plain.strengths[0] > 0.99 && plain.strengths[1] < 0.2, "{:?}", plain.strengths);
+        for k in 0..3 {
+            assert!(
+                (var(&plain.source, k) - 1.0).abs() < 0.05,
+                "unweighted dim {k}: {}",
+                var(&plain.source, k)
+            );
+        }
+        assert!(var(&weighted.source, 0) > 0.95);
+        assert!(var(&weighted.source, 1) < 0.05 && var(&weighted.source, 2) < 0.05);
+        for (a, b) in plain.descriptor_weights.iter().zip(&weighted.descriptor_weights) {
+            assert!((a - b).abs() < 1e-12, "weights {a} vs {b}");
+        }
+        assert!(weighted.descriptor_weights[0] > 0.5);
+    }
 }

@@ -14,11 +14,10 @@
 //!    on every Laplacian level (Pitié et al. 2005).
 //! 6. [`parametric_synthesis`]: k-means segmentation, feathering, per-cluster linear
 //!    regression and Heeger–Bergen histograms with interpolated inverse CDFs.
-//! 7. [`transfer()`]: all of the above; the caller bakes `target_colors` into an atlas
+//! 7. [`nonparametric_synthesis`]: image analogies over tangent-plane neighbourhoods
+//!    ([`surface_stencils`]) with Ashikhmin coherence, coarse to fine.
+//! 8. [`transfer()`]: all of the above; the caller bakes `target_colors` into an atlas
 //!    with [`values_at_surface_points`].
-//!
-//! Not implemented: the non-parametric engine (image analogies with Ashikhmin
-//! coherence); [`Engine::Nonparametric`] is refused with an error.
 //!
 //! Layer rules: no file I/O, no printing; progress through `fieldtex_core::Progress`,
 //! randomness from `fieldtex_core::rng` streams, results identical for any thread count.
@@ -30,10 +29,12 @@ pub mod descriptors;
 mod error;
 pub mod feature_matching;
 pub mod guidance;
+pub mod nonparametric_synthesis;
 pub mod parametric_synthesis;
 pub mod scattered_interpolation;
 pub mod source_colors;
 pub mod surface_samples;
+pub mod surface_stencils;
 mod transfer;
 
 pub use descriptors::{
@@ -42,6 +43,9 @@ pub use descriptors::{
 pub use error::TransferError;
 pub use feature_matching::{MatchMode, MatchStep, match_features};
 pub use guidance::{Guidance, Reduction, build_guidance};
+pub use nonparametric_synthesis::{
+    NonparametricLevel, NonparametricOptions, NonparametricStats, nonparametric_synthesis,
+};
 pub use parametric_synthesis::{ParametricOptions, ParametricStats, parametric_synthesis};
 pub use scattered_interpolation::Interpolator;
 pub use source_colors::{source_sample_colors, surface_colors};

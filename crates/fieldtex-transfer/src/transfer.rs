@@ -6,6 +6,9 @@ use crate::TransferError;
 use crate::descriptors::{DescriptorOptions, compute_descriptors};
 use crate::feature_matching::{MatchMode, MatchStep, match_features};
 use crate::guidance::{Reduction, build_guidance};
+use crate::nonparametric_synthesis::{
+    NonparametricInput, NonparametricOptions, NonparametricStats, nonparametric_synthesis,
+};
 use crate::parametric_synthesis::{
     ParametricInput, ParametricOptions, ParametricStats, parametric_synthesis,
 };
@@ -24,7 +27,7 @@ use std::time::Instant;
 pub enum Engine {
     /// Constrained Heeger–Bergen (default).
     Parametric,
-    /// Image analogies on surface samples (not implemented yet: an error).
+    /// Image analogies on surface samples with Ashikhmin coherence.
     Nonparametric,
 }
 
@@ -43,6 +46,7 @@ pub struct TransferOptions {
     /// Default parametric.
     pub engine: Engine,
     pub parametric: ParametricOptions,
+    pub nonparametric: NonparametricOptions,
     pub seed: u64,
 }
 
@@ -56,6 +60,7 @@ impl Default for TransferOptions {
             matching: MatchMode::Multiscale,
             engine: Engine::Parametric,
             parametric: ParametricOptions::default(),
+            nonparametric: NonparametricOptions::default(),
             seed: 1,
         }
     }
@@ -83,7 +88,9 @@ pub struct TransferResult {
     pub directions: Vec<Vec<f64>>,
     pub descriptor_weights: Vec<f64>,
     pub matching: Vec<MatchStep>,
-    pub parametric: ParametricStats,
+    /// Statistics of the engine that ran.
+    pub parametric: Option<ParametricStats>,
+    pub nonparametric: Option<NonparametricStats>,
     /// Wall time per stage, milliseconds (not deterministic).
     pub timings_ms: Vec<(String, f64)>,
     pub warnings: Vec<Warning>,
@@ -107,10 +114,7 @@ pub fn transfer(
     progress: &dyn Progress,
 ) -> Result<TransferResult, TransferError> {
     if options.engine == Engine::Nonparametric {
-        return Err(TransferError::InvalidOption {
-            what: "engine",
-            message: "the non-parametric engine (image analogies) is not implemented in this build; use --engine parametric".into(),
-        });
+        options.nonparametric.validate()?;
     }
     if !(256..=8_000_000).contains(&options.samples) {
         return Err(TransferError::InvalidOption {
@@ -205,20 +209,35 @@ pub fn transfer(
         match_features(&mut gt, &g.source, &sp, &tp, options.matching, seed)
     })?;
     progress.stage("synthesis", 1);
-    let (target_colors, parametric) = timed(&mut t, "synthesis", || {
-        parametric_synthesis(
-            &ParametricInput {
-                source: &sp,
-                source_guidance: &g.source,
-                source_colors: &source_colors,
-                source_valid: &source_valid,
-                target: &tp,
-                target_guidance: &gt,
-            },
-            &options.parametric,
-            seed,
-        )
-    })?;
+    let (target_colors, parametric, nonparametric) =
+        timed(&mut t, "synthesis", || match options.engine {
+            Engine::Parametric => parametric_synthesis(
+                &ParametricInput {
+                    source: &sp,
+                    source_guidance: &g.source,
+                    source_colors: &source_colors,
+                    source_valid: &source_valid,
+                    target: &tp,
+                    target_guidance: &gt,
+                },
+                &options.parametric,
+                seed,
+            )
+            .map(|(c, s)| (c, Some(s), None)),
+            Engine::Nonparametric => nonparametric_synthesis(
+                &NonparametricInput {
+                    source: &sp,
+                    source_guidance: &g.source,
+                    source_colors: &source_colors,
+                    source_valid: &source_valid,
+                    target: &tp,
+                    target_guidance: &gt,
+                    up: options.descriptors.up.index(),
+                },
+                &options.nonparametric,
+            )
+            .map(|(c, s)| (c, None, Some(s))),
+        })?;
     progress.advance(1);
     progress.finish_stage();
     let SamplePyramid { levels, .. } = sp;
@@ -239,6 +258,7 @@ pub fn transfer(
         descriptor_weights: g.descriptor_weights,
         matching,
         parametric,
+        nonparametric,
         timings_ms: t,
         warnings,
     })

@@ -1,54 +1,11 @@
 //! End-to-end tests of the transfer crate on procedural meshes (no files).
 
 use fieldtex_core::{Image, NoProgress};
-use fieldtex_mesh::{CornerUvs, TriMesh, primitives};
-use fieldtex_transfer::{
-    DescriptorOptions, MatchMode, ParametricOptions, TransferError, TransferOptions, transfer,
-};
+use fieldtex_mesh::{TriMesh, primitives};
+use fieldtex_transfer::{MatchMode, TransferError, transfer};
 
-/// `mesh` with a texture holding one texel per triangle, coloured by `f(centroid)`,
-/// and UVs that put all corners of a triangle at its texel's centre.
-fn textured(mesh: &TriMesh, f: impl Fn([f64; 3]) -> [f32; 3]) -> (TriMesh, Image) {
-    let nf = mesh.n_triangles();
-    let w = (nf as f64).sqrt().ceil() as usize;
-    let h = nf.div_ceil(w);
-    let mut img = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-    let mut values = Vec::with_capacity(nf);
-    for t in 0..nf {
-        let [a, b, c] = mesh.triangle_positions(t);
-        let p =
-            [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0];
-        let col = f(p);
-        let (x, y) = (t % w, t / w);
-        img.set(x, y, [col[0], col[1], col[2], 1.0]);
-        values.push([(x as f64 + 0.5) / w as f64, 1.0 - (y as f64 + 0.5) / h as f64]);
-    }
-    let mut m = mesh.clone();
-    m.uvs = Some(CornerUvs { values, indices: (0..nf as u32).map(|t| [t, t, t]).collect() });
-    (m, img)
-}
-
-fn small_options() -> TransferOptions {
-    TransferOptions {
-        samples: 6000,
-        levels: 3,
-        descriptors: DescriptorOptions { directions: 24, samples: 3000, ..Default::default() },
-        parametric: ParametricOptions { clusters: 12, ..Default::default() },
-        ..Default::default()
-    }
-}
-
-fn pearson(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma).powi(2);
-        sbb += (y - mb).powi(2);
-    }
-    sab / (saa * sbb).sqrt()
-}
+mod common;
+use common::{pearson, small_options, textured};
 
 /// Upward-facing parts are light, downward-facing dark: a function of the normal only.
 fn up_shade(n_y: f64) -> f32 {
@@ -77,6 +34,18 @@ fn colour_that_follows_the_normal_transfers_to_another_shape() {
     let got: Vec<f64> = r.target_colors.chunks_exact(3).map(|c| c[0]).collect();
     let corr = pearson(&truth, &got);
     assert!(corr > 0.8, "Pearson r {corr}");
+    // Without feature matching the torus's guidance falls outside what the sphere
+    // taught (height and normal y are one function on a sphere, two on a torus): the
+    // dependence is lost. This is why multiscale matching stays the default
+    // (docs/transfer.md, "Where matching is needed").
+    let mut plain = opts.clone();
+    plain.matching = MatchMode::None;
+    let u = transfer(&src, &tex, None, &tgt, &plain, &NoProgress).unwrap();
+    let got_u: Vec<f64> = u.target_colors.chunks_exact(3).map(|c| c[0]).collect();
+    let truth_u: Vec<f64> =
+        u.target_samples.normals.iter().map(|n| up_shade(n[1]) as f64).collect();
+    let corr_u = pearson(&truth_u, &got_u);
+    assert!(corr_u < corr - 0.3, "no matching r {corr_u} vs multiscale r {corr}");
     // On the source sphere height = (n_y + 1) / 2, so the two collinear descriptors
     // share the weight; together they carry almost all of it.
     let w = &r.descriptor_weights;

@@ -9,7 +9,17 @@
 //! is evaluated on each target and written as `reference.obj`; every transfer is then
 //! scored with `fieldtex::transfer_fidelity_files` (Pearson r of luma at 100K points).
 //!
-//! Usage: `transfer_fidelity OUT_DIR SOURCE_MESH TARGET_MESH... [--samples N]`
+//! Configurations: CCA with the three `--match` settings and the PCA ablation on the
+//! parametric engine, then the non-parametric engine with CCA + multiscale and CCA +
+//! none. `--engines parametric|nonparametric|all` (default all) selects.
+//!
+//! `--with-weighted` adds the parametric runs with `cca-weighted` guidance (canonical
+//! variates weighted by their correlations). `--mask-below H` masks the source texels
+//! of triangles whose normalised height is below `H` (an incomplete source, like the
+//! half-scanned bagel of paper B Fig. 8): the case feature matching is meant for.
+//!
+//! Usage: `transfer_fidelity OUT_DIR SOURCE_MESH TARGET_MESH... [--samples N] [--engines E]
+//! [--mask-below H] [--with-weighted]`
 //! Prints one line per (target, configuration): r, wall seconds.
 
 use fieldtex::crates::{core::Image, io, mesh};
@@ -102,11 +112,23 @@ fn load(path: &Path) -> TriMesh {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut samples = 200_000usize;
+    let mut engines = "all".to_string();
+    let mut mask_below: Option<f64> = None;
+    let mut weighted = false;
     let mut pos = Vec::new();
     let mut i = 0;
     while i < args.len() {
         if args[i] == "--samples" {
             samples = args[i + 1].parse().expect("--samples N");
+            i += 2;
+        } else if args[i] == "--with-weighted" {
+            weighted = true;
+            i += 1;
+        } else if args[i] == "--mask-below" {
+            mask_below = Some(args[i + 1].parse().expect("--mask-below H"));
+            i += 2;
+        } else if args[i] == "--engines" {
+            engines = args[i + 1].clone();
             i += 2;
         } else {
             pos.push(args[i].clone());
@@ -120,8 +142,36 @@ fn main() {
     let (src_tex_mesh, src_tex) = textured(&src, &ground_truth(&src), 0.03);
     let src_path = out.join("source.obj");
     io::write_obj(&src_path, &src_tex_mesh, Some(&src_tex)).expect("write source");
-    let configs =
-        [("cca", "multiscale"), ("cca", "marginals"), ("cca", "none"), ("pca", "multiscale")];
+    let mask_path = mask_below.map(|hmin| {
+        // Texel t belongs to triangle t (see `textured`); white = ignored.
+        let bbox = src.bounding_box().expect("non-empty");
+        let span = (bbox.max[1] - bbox.min[1]).max(1e-12);
+        let mut mask = Image::new(src_tex.width, src_tex.height, [0.0, 0.0, 0.0, 1.0]);
+        for t in 0..src.n_triangles() {
+            let [a, b, c] = src.triangle_positions(t);
+            let h = ((a[1] + b[1] + c[1]) / 3.0 - bbox.min[1]) / span;
+            if h < hmin {
+                mask.set(t % src_tex.width, t / src_tex.width, [1.0; 4]);
+            }
+        }
+        let p = out.join("source-mask.png");
+        io::write_png(&p, &mask).expect("write mask");
+        p
+    });
+    let configs: Vec<(&str, &str, &str)> = [
+        ("cca", "multiscale", "parametric"),
+        ("cca", "marginals", "parametric"),
+        ("cca", "none", "parametric"),
+        ("pca", "multiscale", "parametric"),
+        ("cca", "multiscale", "nonparametric"),
+        ("cca", "none", "nonparametric"),
+        ("cca-weighted", "multiscale", "parametric"),
+        ("cca-weighted", "marginals", "parametric"),
+        ("cca-weighted", "none", "parametric"),
+    ]
+    .into_iter()
+    .filter(|c| (engines == "all" || engines == c.2) && (weighted || c.0 != "cca-weighted"))
+    .collect();
     for tpath in &pos[2..] {
         let name = Path::new(tpath).file_stem().unwrap().to_string_lossy().to_string();
         let tgt = load(Path::new(tpath));
@@ -132,10 +182,11 @@ fn main() {
         io::write_obj(&ref_path, &ref_mesh, Some(&ref_tex)).expect("write reference");
         let tgt_path = dir.join("target.obj");
         io::write_obj(&tgt_path, &tgt, None).expect("write target");
-        for (reduce, matching) in configs {
+        for &(reduce, matching, engine) in &configs {
             let mut opts = TransferCommandOptions {
                 source: src_path.clone(),
                 target: tgt_path.clone(),
+                mask: mask_path.clone(),
                 ..Default::default()
             };
             opts.transfer.samples = samples;
@@ -143,7 +194,8 @@ fn main() {
                 fieldtex::pipelines_transfer::parse_reduction(reduce).unwrap();
             opts.transfer.matching =
                 fieldtex::pipelines_transfer::parse_match_mode(matching).unwrap();
-            let run_dir = dir.join(format!("{reduce}-{matching}"));
+            opts.transfer.engine = fieldtex::pipelines_transfer::parse_engine(engine).unwrap();
+            let run_dir = dir.join(format!("{engine}-{reduce}-{matching}"));
             let t0 = Instant::now();
             fieldtex::transfer_files(&run_dir, &opts, &NoProgress).expect("transfer");
             let secs = t0.elapsed().as_secs_f64();
@@ -155,7 +207,7 @@ fn main() {
             )
             .expect("fidelity");
             println!(
-                "FIDELITY source={} target={name} reduce={reduce} match={matching} samples={samples} r_luma={:.3} r_rgb=[{:.3},{:.3},{:.3}] wall_s={secs:.1}",
+                "FIDELITY source={} target={name} engine={engine} reduce={reduce} match={matching} samples={samples} mask_below={mask_below:?} r_luma={:.3} r_rgb=[{:.3},{:.3},{:.3}] wall_s={secs:.1}",
                 Path::new(&pos[1]).file_stem().unwrap().to_string_lossy(),
                 f.pearson_luma,
                 f.pearson_rgb[0],

@@ -1,6 +1,7 @@
 //! Statistics on dense data for texture transfer (paper B, Mertens et al. 2006):
-//! canonical correlation analysis, k-means, 1-D and n-D histogram matching and
-//! weighted quantile functions. One algorithm per file.
+//! canonical correlation analysis, k-means, 1-D and n-D histogram matching,
+//! weighted quantile functions and a kd-tree for (approximate) nearest neighbours.
+//! One algorithm per file.
 //!
 //! Conventions: samples are row-major `N × dim` `f64` slices; every reduction over
 //! samples is done per fixed chunk of rows and summed in chunk order, so results are
@@ -12,6 +13,7 @@
 
 mod cca;
 mod histogram_matching;
+mod kd_tree;
 mod kmeans;
 mod quantile_function;
 
@@ -20,6 +22,7 @@ pub use histogram_matching::{
     HistogramMatchOptions, HistogramMatchStats, match_histogram_1d, match_histograms_nd,
     random_rotation,
 };
+pub use kd_tree::{KD_LEAF, KdScratch, KdTree};
 pub use kmeans::{KMeans, KMeansOptions, kmeans};
 pub use quantile_function::QuantileFunction;
 

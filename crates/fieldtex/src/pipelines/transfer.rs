@@ -2,12 +2,16 @@
 //! 2006; algorithms in `fieldtex-transfer`).
 //!
 //! Steps: read the textured source and the target (and the mask); repair both; transfer
-//! on surface samples (descriptors → CCA guidance → feature matching → parametric
-//! synthesis); an atlas of the target and its texel map; bake the synthesised sample
+//! on surface samples (descriptors → CCA guidance → feature matching → parametric or
+//! non-parametric synthesis); an atlas of the target and its texel map; bake the synthesised sample
 //! colours into it (Gaussian-weighted interpolation of the nearest target samples at
 //! every covered texel, gutters dilated); write `model.glb`, `preview.png` (source and
 //! target side by side, same view), `report.json` and, with `keep`, `guidance.ply`
 //! (per-vertex descriptors, guidance and colour of the target).
+//!
+//! The source texture is the mesh's base-colour texture (OBJ `map_Kd`, glTF
+//! `baseColorTexture`) unless `source_texture` names an image, which then replaces it:
+//! that is how an OBJ with UVs but no MTL file (e.g. `spot`) is used.
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::align::{CarrierAtlas, carrier_atlas, carrier_texture};
@@ -27,6 +31,9 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, Serialize)]
 pub struct TransferCommandOptions {
     pub source: PathBuf,
+    /// Base-colour image for the source's UVs, replacing its material's texture (for an
+    /// OBJ with UVs and no MTL file).
+    pub source_texture: Option<PathBuf>,
     pub target: PathBuf,
     /// Texels to ignore (white), same size as the source texture.
     pub mask: Option<PathBuf>,
@@ -42,6 +49,7 @@ impl Default for TransferCommandOptions {
     fn default() -> Self {
         Self {
             source: PathBuf::new(),
+            source_texture: None,
             target: PathBuf::new(),
             mask: None,
             size: 1024,
@@ -71,10 +79,11 @@ pub fn parse_match_mode(s: &str) -> Option<MatchMode> {
     }
 }
 
-/// Parses `cca|pca`.
+/// Parses `cca|cca-weighted|pca`.
 pub fn parse_reduction(s: &str) -> Option<Reduction> {
     match s {
         "cca" => Some(Reduction::Cca),
+        "cca-weighted" => Some(Reduction::CcaWeighted),
         "pca" => Some(Reduction::Pca),
         _ => None,
     }
@@ -136,10 +145,14 @@ pub fn transfer_files(
     begin_command();
     let src = report.time("read_source", || fieldtex_io::read_mesh(&options.source))?;
     report.warnings.extend(src.warnings.iter().cloned());
-    let Some(texture) = src.base_color.as_ref() else {
+    let given_texture = match &options.source_texture {
+        Some(p) => Some(report.time("read_source_texture", || fieldtex_io::read_image(p))?),
+        None => None,
+    };
+    let Some(texture) = given_texture.as_ref().or(src.base_color.as_ref()) else {
         return Err(Error::bad_input(
             Some(&options.source),
-            "the source has no base-colour texture (OBJ map_Kd or glTF baseColorTexture that loads); transfer needs a textured source",
+            "the source has no base-colour texture (OBJ map_Kd or glTF baseColorTexture that loads); transfer needs a textured source. If the mesh has UVs and its texture is a separate image (an OBJ without an MTL file), pass the image with --source-texture IMAGE",
         ));
     };
     if src.mesh.uvs.is_none() {
@@ -187,6 +200,7 @@ pub fn transfer_files(
         "source_vertices": source_mesh.n_vertices(),
         "source_triangles": source_mesh.n_triangles(),
         "source_texture": [texture.width, texture.height],
+        "source_texture_file": options.source_texture.as_ref().map(|p| p.display().to_string()),
         "target": options.target.display().to_string(),
         "target_vertices": target_mesh.n_vertices(),
         "target_triangles": target_mesh.n_triangles(),
@@ -226,7 +240,7 @@ pub fn transfer_files(
     let named = |w: &[f64]| -> serde_json::Map<String, serde_json::Value> {
         DESCRIPTOR_NAMES.iter().zip(w).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect()
     };
-    let cca = options.transfer.reduction == Reduction::Cca;
+    let cca = options.transfer.reduction != Reduction::Pca;
     report.metric(
         "samples",
         serde_json::json!({
@@ -250,7 +264,12 @@ pub fn transfer_files(
         "feature_matching",
         serde_json::json!({ "mode": options.transfer.matching, "steps": result.matching }),
     );
-    report.metric("parametric", &result.parametric);
+    if let Some(p) = &result.parametric {
+        report.metric("parametric", p);
+    }
+    if let Some(n) = &result.nonparametric {
+        report.metric("nonparametric", n);
+    }
     report.notes.push(
         "surface samples: Poisson-disk dart throwing stands in for Turk's point repulsion (same purpose: even blue-noise spread)".into(),
     );
@@ -261,14 +280,20 @@ pub fn transfer_files(
         "ray-cast descriptors (solid angle, SH occlusion) computed on {} samples and interpolated to level 0; height and normal exact per sample",
         options.transfer.descriptors.samples.min(result.target_samples.len())
     ));
-    report.notes.push(
-        "k-means fitted on at most 65 536 strided samples, all samples labelled; feathering over the 4 nearest clusters".into(),
-    );
+    match options.transfer.engine {
+        Engine::Parametric => report.notes.push(
+            "parametric engine: k-means fitted on at most 65 536 strided samples, all samples labelled; feathering over the 4 nearest clusters".into(),
+        ),
+        Engine::Nonparametric => {
+            report.notes.push(
+                "non-parametric engine: every pass recomputes all target samples from the previous pass (parallel, full neighbourhoods) instead of the paper's one-sample-at-a-time sweep with causal neighbourhoods".into(),
+            );
+            report.notes.push(
+                "non-parametric engine: neighbourhood search by PCA projection (16 dimensions) and a best-bin-first kd-tree instead of the ANN library; tangent frames oriented by the up axis".into(),
+            );
+        }
+    }
     report.notes.push("colours are processed as sRGB-encoded values".into());
-    report.notes.push(
-        "not implemented: the non-parametric engine (image analogies with Ashikhmin coherence)"
-            .into(),
-    );
     // Outputs.
     report.time("write", || super::write_model(out_dir, &atlas.mesh, Some(&texture_out)))?;
     let preview = report.time("preview", || {
