@@ -114,7 +114,7 @@ enum Command {
         grid: usize,
         /// Pattern size: output pixels per pixel of the exemplar file (2 = the pattern
         /// twice as large; the same meaning in align and orient), 1/64 to 16.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         scale: f64,
         /// Disable the 2-RoSy fix of paper D §4 (ablation).
         #[arg(long)]
@@ -207,7 +207,7 @@ enum Command {
         size: usize,
         /// Pattern size: output texels per pixel of the exemplar file (2 = the pattern
         /// twice as large; the same meaning in align and orient).
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         scale: f64,
         /// Where no feature curve constrains the field: follow this global direction
         /// projected onto the surface (default: the smoothest field, along curvature
@@ -279,7 +279,7 @@ enum Command {
         #[arg(long, requires = "field")]
         coords: Option<PathBuf>,
         /// With --coords: the pattern size the image was made with (orient's --scale).
-        #[arg(long, default_value_t = 1.0, requires = "coords")]
+        #[arg(long, default_value_t = 1.0, requires = "coords", allow_negative_numbers = true)]
         scale: f64,
         /// Exhaustive nearest-patch searches instead of the default approximate ones
         /// (PCA + kd-tree, within a few per cent; see docs/first-hour.md); minutes at

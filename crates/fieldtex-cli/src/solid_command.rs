@@ -67,7 +67,7 @@ pub struct SolidArgs {
     interior: Option<PathBuf>,
     /// Depth of the interior region below the surface, mesh units (default: 15 % of the
     /// bounding box's shortest side).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     interior_depth: Option<f64>,
 }
 

@@ -415,3 +415,25 @@ fn solid_cut_with_a_negative_first_number_was_rejected_by_the_parser() {
     assert!(!stderr(&o).contains("unexpected argument"), "{}", stderr(&o));
     assert!(stderr(&o).contains("missing.obj"), "{}", stderr(&o));
 }
+
+#[test]
+fn negative_scale_and_depth_were_rejected_by_the_parser_instead_of_validated() {
+    let d = tmp("negative-values");
+    let (e, m) = (d.join("e.png"), d.join("m.obj"));
+    let (o1, o2, o3) = (d.join("o1"), d.join("o2"), d.join("o3"));
+    // Each negative value must reach the command's own validation (a message naming
+    // the option), not clap's "unexpected argument '-1'".
+    let orient =
+        ["orient", "--preset", "whorl", "--exemplar", s(&e), "--out", s(&o1), "--scale", "-1"];
+    let align = ["align", "--mesh", s(&m), "--exemplar", s(&e), "--out", s(&o2), "--scale", "-2"];
+    let solid =
+        ["solid", "--mesh", s(&m), "--exemplar", s(&e), "--out", s(&o3), "--interior-depth", "-5"];
+    for (args, names) in
+        [(&orient[..], "--scale"), (&align[..], ""), (&solid[..], "--interior-depth")]
+    {
+        let o = quick(args);
+        assert_eq!(code(&o), 2, "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("unexpected argument"), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(names), "{args:?}: {}", stderr(&o));
+    }
+}

@@ -30,7 +30,7 @@ pub enum FieldSource {
     Field(PathBuf),
 }
 
-/// Smallest `--scale`: one exemplar pixel spread over 64 output pixels.
+/// Smallest `--scale`: one output pixel per 64 exemplar pixels (the pattern 64× smaller).
 pub const MIN_SCALE: f64 = 1.0 / 64.0;
 
 /// Options of [`orient`].
@@ -192,8 +192,8 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         return Err(Error::bad_input(
             None,
             format!(
-                "--scale must be in [{MIN_SCALE}, 16] exemplar pixels per output pixel (below 1 \
-                 enlarges the pattern), got {}",
+                "--scale must be in [{MIN_SCALE}, 16] output pixels per exemplar pixel (2 = the \
+                 pattern twice as large), got {}",
                 options.scale
             ),
         ));
