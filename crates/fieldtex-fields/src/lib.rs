@@ -59,6 +59,7 @@ pub mod error;
 pub mod field_design;
 pub mod field_design_options;
 pub mod frame_field_3d;
+mod frame_grid;
 pub mod natural_boundary;
 pub mod normal_equations;
 pub mod orientation_field;

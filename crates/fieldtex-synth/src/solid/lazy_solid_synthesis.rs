@@ -641,20 +641,14 @@ impl Scratch {
 
 /// `x` rounded to the nearest integer, halves away from zero (as `f32::round`, without
 /// the library call the baseline x86-64 target makes for it; `x` is a small offset).
+/// Widening to `f64` is exact, so this is [`round_f64_i32`] of the same value.
 #[inline]
 fn round_i32(x: f32) -> i32 {
-    let t = x as i32;
-    let r = x - t as f32;
-    if r >= 0.5 {
-        t + 1
-    } else if r <= -0.5 {
-        t - 1
-    } else {
-        t
-    }
+    round_f64_i32(x as f64)
 }
 
-/// [`round_i32`] for `f64` (as `f64::round` for `|x| < 2³¹`).
+/// `x` rounded to the nearest integer, halves away from zero (as `f64::round` for
+/// `|x| < 2³¹`; the difference `x − trunc(x)` is exact).
 #[inline]
 fn round_f64_i32(x: f64) -> i32 {
     let t = x as i32;
