@@ -27,7 +27,8 @@ pub fn untangle_flips(
 ) -> (usize, usize) {
     let nv = map.base.len();
     let bad = |map: &ComponentMap, f: usize| {
-        map.apex[f].is_none() && !(signed_area(&map.corner[f]) > 0.0)
+        map.apex[f].is_none()
+            && signed_area(&map.corner[f]).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
     };
     let mut flipped: Vec<usize> = (0..n_faces).filter(|&f| bad(map, f)).collect();
     if flipped.is_empty() {

@@ -81,7 +81,10 @@ fn mass_spring_evens_area_without_flips() {
     let st = comps[0].relax_quasi_isometric(&MassSpringOptions::default()).unwrap();
     assert_eq!(st.after.flipped, 0);
     assert!(st.after.log_area_std < 0.95 * st.before.log_area_std, "{st:?}");
-    assert!(st.after.angle_mean <= MassSpringOptions::default().max_angle_distortion + 1e-9, "{st:?}");
+    assert!(
+        st.after.angle_mean <= MassSpringOptions::default().max_angle_distortion + 1e-9,
+        "{st:?}"
+    );
     assert_eq!(distortion(&comps[0]).flipped, 0);
 }
 
