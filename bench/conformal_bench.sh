@@ -2,6 +2,8 @@
 # `fieldtex conformal` (issue 13, paper C) on the shared meshes: wall time, topology,
 # zero points, flips, angle/area distortion, feature-size CV with and without
 # multi-scale, seam length against `fieldtex atlas`, colour jump ratio, mass-spring.
+# Every timed run also records CPU time (user + sys, GNU time) and the load average, so
+# numbers taken on a busy machine can be judged.
 # Usage: bench/conformal_bench.sh [--runs N] [--exemplar NAME] [--meshes "bunny torus ..."]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -26,10 +28,11 @@ for m in $meshes; do
   f=$(ls ../shared/data/meshes/$m.* | head -1)
   walls=()
   for r in $(seq 1 "$runs"); do
-    t0=$(date +%s.%N)
-    $bin conformal --mesh "$f" --exemplar "$ex" --out "$out/$m" --quiet
-    t1=$(date +%s.%N)
-    walls+=("$(python3 -c "print($t1 - $t0)")")
+    /usr/bin/time -f '%e %U %S' -o "$out/$m.time" \
+      $bin conformal --mesh "$f" --exemplar "$ex" --out "$out/$m" --quiet
+    read -r wall user sys < "$out/$m.time"
+    walls+=("$wall")
+    echo "   run $r: $wall s wall, $(python3 -c "print(round($user + $sys, 2))") s CPU, load $(cut -d' ' -f1-3 /proc/loadavg)"
   done
   $bin conformal --mesh "$f" --exemplar "$ex" --out "$out/$m-nomulti" --no-multiscale --quiet
   $bin atlas "$f" --out "$out/$m-atlas" --quiet

@@ -13,10 +13,18 @@ for c in met["components"]:
     print(f"   component {c['component']}: genus {c['genus']} boundaries {c['boundaries']} method {c['method']} "
           f"zero points {c['zero_points']} patches {c['patches']} flips {d.get('flipped')} "
           f"angle(away) {d.get('angle_mean_away_from_singularities')} log-area std {d.get('log_area_std')} "
-          f"conj.res {c['conjugate_residual']:.3g}")
+          f"conj.res {c['conjugate_residual']:.3g} (wedge system {c.get('conjugate_residual_wedge_system')})")
 fs, fn = met["feature_size"], n["metrics"]["feature_size"]
 if fs and fn:
     print(f"   feature-size CV multiscale {fs['cv']:.3f}  no-multiscale {fn['cv']:.3f}  ratio {fs['cv'] / fn['cv']:.2f} (target <= 0.5)")
+    # The no-multiscale texture is statistically uniform in texel space, so its CV in
+    # texels is the estimator's own spread (the floor a perfectly uniform result would
+    # still show on the surface); the part above it is what the conformal factor adds.
+    floor = fn["cv_texels"]
+    ex = lambda cv: max(cv * cv - floor * floor, 0.0) ** 0.5
+    if ex(fn["cv"]) > 0:
+        print(f"   estimator floor (no-multiscale CV in texels) {floor:.3f}; excess over it multiscale {ex(fs['cv']):.3f} "
+              f"no-multiscale {ex(fn['cv']):.3f} ratio {ex(fs['cv']) / ex(fn['cv']):.2f}")
 s = met["seams"]
 atlas_path = os.path.join(out, m + "-atlas", "model.glb")
 sys.path.insert(0, os.path.dirname(__file__))

@@ -97,7 +97,7 @@ pub fn holomorphic_map_with(
         areas[f] = 0.5 * vec3::norm(n2);
         normals[f] = vec3::normalize(n2).unwrap_or([0.0, 0.0, 1.0]);
     }
-    let conj = conjugates(&xs, &areas, &normals)?;
+    let conj = conjugates(&forms, &w, &xs, &areas, &normals)?;
     // Genus 1: the form is unique up to a complex factor (the best basis form, no
     // search). Genus ≥ 2: the combination with the most uniform conformal factor.
     let evals = if genus >= 2 { UNIFORM_FORM_EVALS } else { 0 };
@@ -159,6 +159,7 @@ pub fn holomorphic_map_with(
             apex: vec![None; nf],
             zero_points,
             conjugate_residual: conj.residual,
+            conjugate_residual_wedge_system: conj.residual_wedge_system,
             harmonic_forms: forms.len(),
             patch: layout.patch,
             ghosts: layout.ghosts,
@@ -230,6 +231,7 @@ pub fn holomorphic_map_with(
         lattice,
         zero_points,
         conjugate_residual: conj.residual,
+        conjugate_residual_wedge_system: conj.residual_wedge_system,
         harmonic_forms: forms.len(),
         ..ComponentMap::empty(ConformalMethod::HolomorphicTorus)
     })

@@ -21,6 +21,7 @@
 pub mod cotan_system;
 pub mod critical_trajectories;
 pub mod double_cover;
+pub mod flip_untangle;
 pub mod geometry_image;
 pub mod harmonic_one_forms;
 pub mod hole_caps;
@@ -84,6 +85,9 @@ pub struct ComponentMap {
     pub zero_points: Vec<(u32, i32)>,
     /// Relative misfit of the discrete conjugate (see the constructions).
     pub conjugate_residual: f64,
+    /// The same misfit with Gu & Yau's wedge system instead of the DEC projection
+    /// (genus ≥ 1; `NaN` otherwise), for comparison.
+    pub conjugate_residual_wedge_system: f64,
     /// The slit points (capped-mesh vertex ids).
     pub slit_vertices: Vec<u32>,
     /// Number of harmonic 1-forms computed.
@@ -113,6 +117,7 @@ impl ComponentMap {
             lattice: Lattice { a: None, b: None },
             zero_points: Vec::new(),
             conjugate_residual: f64::NAN,
+            conjugate_residual_wedge_system: f64::NAN,
             slit_vertices: Vec::new(),
             harmonic_forms: 0,
             patch: Vec::new(),
@@ -359,10 +364,27 @@ pub fn global_conformal(
             (capped.mesh, r, false)
         };
         let (map, note) = match result {
-            Ok(m) => {
-                let note = (m.method == ConformalMethod::HolomorphicBasisOnly).then(|| {
+            Ok(mut m) => {
+                let mut note = (m.method == ConformalMethod::HolomorphicBasisOnly).then(|| {
                     format!("genus {genus}: holomorphic basis and zero points computed; critical-trajectory patches not implemented")
                 });
+                if matches!(
+                    m.method,
+                    ConformalMethod::SlitCylinder | ConformalMethod::HolomorphicTorus
+                ) {
+                    let (moved, left) =
+                        flip_untangle::untangle_flips(&capped_mesh.triangles, faces.len(), &mut m);
+                    if moved > 0 || left > 0 {
+                        let text = format!(
+                            "{moved} vertices of triangles the discrete map folded were moved to their one-ring mean (local untangling); {left} triangles still folded"
+                        );
+                        warnings.push(Warning::new(
+                            "conformal-folds-untangled",
+                            format!("component {ci}: {text}"),
+                        ));
+                        note = Some(note.map_or(text.clone(), |n| format!("{n}; {text}")));
+                    }
+                }
                 (m, note)
             }
             Err(e) => {

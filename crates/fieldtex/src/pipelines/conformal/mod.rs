@@ -42,7 +42,7 @@ pub struct ConformalOptions {
     pub multiscale: bool,
     /// Number of exemplar levels. Default 6.
     pub levels: usize,
-    /// Exemplar texels per texture texel where `τ` is at its reference (the 25th
+    /// Exemplar texels per texture texel where `τ` is at its reference (the 5th
     /// area-weighted percentile). Default 1.
     pub scale: f64,
     /// Quilting patch side (paper: 30–50). Default 40.
@@ -195,16 +195,24 @@ pub fn conformal(
             }
         }
     }
-    let tau_ref = weighted_quantile(&mut tau_w.clone(), 0.25).unwrap_or(1.0);
+    // The paper places the original sample "close to the lowest level" (§4.2): the
+    // reference is the 5th area-weighted percentile of τ, so almost every patch takes an
+    // enlarged level and only the 1 % tail below needs a minified one (at least one
+    // patch wide).
+    let tau_ref = weighted_quantile(&mut tau_w.clone(), 0.05).unwrap_or(1.0);
+    let q05 = tau_ref;
+    let q01 = weighted_quantile(&mut tau_w.clone(), 0.01).unwrap_or(1.0);
     let q95 = weighted_quantile(&mut tau_w.clone(), 0.95).unwrap_or(1.0);
-    let q05 = weighted_quantile(&mut tau_w.clone(), 0.05).unwrap_or(1.0);
-    let min_scale =
-        ((options.patch_size as f64 + 8.0) / exemplar.width.min(exemplar.height) as f64).max(0.25);
+    let q99 = weighted_quantile(&mut tau_w.clone(), 0.99).unwrap_or(1.0);
+    let ex_side = exemplar.width.min(exemplar.height) as f64;
+    let min_scale = ((options.patch_size as f64 + 8.0) / ex_side).max(0.25);
+    // Largest enlargement: 12×, and no level over 2048 px on its short side.
+    let max_scale = (2048.0 / (ex_side * options.scale)).clamp(1.0, 12.0);
     let (scales, level_names) = if options.multiscale {
-        let lo = (q05 / tau_ref).clamp(min_scale, 1.0);
-        let hi = (q95 / tau_ref).clamp(1.0, 6.0);
-        // At least one level per factor 1.3 of the range (at most 12).
-        let n = options.levels.max(((hi / lo).ln() / 1.3f64.ln()).ceil() as usize + 1).min(12);
+        let lo = (q01 / tau_ref).clamp(min_scale, 1.0);
+        let hi = (q99 / tau_ref).clamp(1.0, max_scale);
+        // At least one level per factor 1.3 of the range (at most 14).
+        let n = options.levels.max(((hi / lo).ln() / 1.3f64.ln()).ceil() as usize + 1).min(14);
         let s = scale_levels(lo, hi, n);
         (s.clone(), s)
     } else {

@@ -5,6 +5,7 @@ use super::ConformalOptions;
 use crate::Report;
 use fieldtex_param::conformal::mass_spring::map_distortion;
 use fieldtex_param::conformal::{ConformalComponent, ConformalMethod, GeometryImage};
+use fieldtex_param::distortion::triangle_jacobian;
 use serde::Serialize;
 use serde_json::json;
 
@@ -67,6 +68,7 @@ pub(super) fn component_json(
         "zero_points": c.zero_points.len(),
         "zero_point_indices": c.zero_points.iter().map(|z| json!({"vertex": z.0, "index": z.1})).collect::<Vec<_>>(),
         "conjugate_residual": c.conjugate_residual,
+        "conjugate_residual_wedge_system": c.map.conjugate_residual_wedge_system,
         "double_cover_genus": c.double_cover_genus,
         "note": c.note,
     });
@@ -96,6 +98,9 @@ pub(super) fn component_json(
         );
         v["lattice"] = json!({"a": c.lattice.a, "b": c.lattice.b});
         v["distortion"] = json!({"angle_mean_away_from_singularities": away.angle_mean, "angle_mean_non_slit": all.angle_mean, "log_area_std": all.log_area_std, "flipped": all.flipped});
+        if all.flipped > 0 {
+            v["distortion"]["flipped_examples"] = json!(flipped_examples(c, 8));
+        }
         if let Some(img) = img {
             v["geometry_image"] = json!({"width": img.width, "height": img.height, "margin": img.margin, "period_x": img.period_x, "period_y": img.period_y});
         }
@@ -103,6 +108,24 @@ pub(super) fn component_json(
         v["patches"] = json!("fallback atlas");
     }
     v
+}
+
+/// Up to `max` flipped (or collapsed) triangles of `c`'s map: global face, whether it is
+/// a slit face or near a singularity, its UV signed area and its 3-D centroid.
+fn flipped_examples(c: &ConformalComponent, max: usize) -> Vec<serde_json::Value> {
+    let mut out = Vec::new();
+    for f in 0..c.faces.len() {
+        let p = c.local_mesh.triangle_positions(f);
+        let Some((_, _, auv, _)) = triangle_jacobian(p, c.corner_uv[f], 0.0) else { continue };
+        if auv <= 0.0 || auv.is_nan() {
+            let g: Vec<f64> = (0..3).map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0).collect();
+            out.push(json!({"face": c.faces[f], "slit": c.slit[f], "near_singularity": c.near_singularity[f], "uv_area": auv, "centroid": g}));
+            if out.len() == max {
+                break;
+            }
+        }
+    }
+    out
 }
 
 pub(super) fn add_notes(
@@ -133,6 +156,6 @@ pub(super) fn add_notes(
     n.push("τ per texel: barycentric interpolation of per-vertex τ (substitute for the paper's Gaussian RBF).".into());
     n.push("Quilting: random candidate subset per patch (not exhaustive), old seams not re-cut; colours compared in sRGB.".into());
     if options.quasi_isometric {
-        n.push("Mass-spring (eq. 2) in a balanced spring form (rest length = 3-D length / mean conformal factor), stopped when the mean angle distortion would exceed 1.25.".into());
+        n.push("Mass-spring (eq. 2) in a balanced spring form (rest length = 3-D length / mean conformal factor), integrated by implicit steps (one sparse solve of the spring energy per step, stiffness 1/|e|² of the conformal edge, a flip-free backtracking line search) instead of the paper's explicit steps (a substitute for speed), stopped when the mean angle distortion would exceed 1.25 or the area distortion stops falling.".into());
     }
 }
