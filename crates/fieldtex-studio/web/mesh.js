@@ -228,7 +228,7 @@ function onPointerMove(ev) {
   if (Math.hypot(h.p.x - last[0], h.p.y - last[1], h.p.z - last[2]) < diag() * 0.006) return;
   drawing.points.push(h.p.toArray());
   if (drawing.line) groups.drawn.remove(drawing.line);
-  drawing.line = drawing.plane ? polyline(drawing.points, 0xd2691e, 2) : lifted(drawing.points, 0x0b8f3a);
+  drawing.line = drawing.plane ? planeCurve(drawing.points) : lifted(drawing.points, 0x0b8f3a);
   groups.drawn.add(drawing.line);
   render();
 }
@@ -246,6 +246,13 @@ function onPointerUp() {
     if (mode === 'solid') sketchChanged();
   } else if (d.line) groups.drawn.remove(d.line);
   render();
+}
+/** A reference-plane curve: magenta, drawn over everything (it may run inside the mesh). */
+function planeCurve(points) {
+  const line = polyline(points, 0xc0148c, 2);
+  line.material.depthTest = false;
+  line.renderOrder = 10;
+  return line;
 }
 /** A curve drawn a little off the surface (along the view) so it is not hidden. */
 function lifted(points, color) {
