@@ -71,6 +71,15 @@ fn open_solid_cuts_on_demand_and_edits_its_sketch() {
     assert_eq!(status, 200);
     assert!(computed3 > 0);
     assert_ne!(png, png3, "the edit did not change the cut");
+    // Clearing the sketch: the constant field, both curves removed.
+    let r = request(
+        addr,
+        "POST",
+        &format!("/api/solid/sketch?solid={id}"),
+        br#"{"sketch": {"curves": []}, "samples": 20}"#,
+    );
+    assert_eq!(r.status, 200, "{}", r.error());
+    assert_eq!(r.json()["edit"]["removed"].as_u64(), Some(2));
 
     // Garbage, refused sizes and planes, unknown ids: clear 4xx, the server lives on.
     let open = |body: &str| request(addr, "POST", "/api/solid/open", body.as_bytes());

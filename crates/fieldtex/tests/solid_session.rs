@@ -103,6 +103,12 @@ fn session_cuts_equal_the_pipeline_cuts_and_edits_go_through_the_field() {
     assert_eq!((e.kept, e.removed), (1, 1));
     let e = session.set_sketch(&sketch).unwrap();
     assert_eq!((e.replaced, e.added), (1, 1));
+    // No curves: back to the constant field (the pipeline without --sketch).
+    let e = session.set_sketch(&fields::Sketch { curves: Vec::new() }).unwrap();
+    assert_eq!(e.removed, 2);
+    assert!(session.field().is_none());
+    let plain = session.cut(cuts[0], &NoProgress).unwrap();
+    assert!(bytes(&plain.image) != bytes(&slice.image));
 
     // Bad planes are refused with a message.
     assert!(session.cut([0.0, 0.0, 0.0, 0.0, 0.0, 0.0], &NoProgress).is_err());

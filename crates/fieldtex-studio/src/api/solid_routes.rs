@@ -105,7 +105,8 @@ pub(super) fn solid_create(state: &State, req: &Request) -> Result<Response, Res
     }
     let exemplar =
         root.existing_file(&c.exemplar.path).map_err(|(code, m)| Response::error(code, m))?;
-    if let Some(sk) = &c.sketch {
+    // A sketch without curves is no sketch (the constant field).
+    if let Some(sk) = c.sketch.as_ref().filter(|s| !s.curves.is_empty()) {
         sk.validate().map_err(|e| bad(format!("sketch: {e}")))?;
     }
     let mut o = fieldtex::SolidOptions {

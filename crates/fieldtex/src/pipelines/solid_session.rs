@@ -78,8 +78,9 @@ pub struct SketchEdit {
 
 impl SolidSession {
     /// Reads, repairs and analyses as [`crate::solid`] does. `sketch` overrides
-    /// `options.sketch` (a sketch already in memory); with neither, the field is
-    /// constant. `options.cuts`, `volume`, `keep` and `atlas_size` are not used.
+    /// `options.sketch` (a sketch already in memory); with neither, or a sketch without
+    /// curves, the field is constant. `options.cuts`, `volume`, `keep` and `atlas_size`
+    /// are not used.
     pub fn new(
         options: &SolidOptions,
         sketch: Option<&Sketch>,
@@ -108,6 +109,7 @@ impl SolidSession {
             .bounding_box()
             .ok_or_else(|| Error::bad_input(Some(&options.mesh), "the mesh has no vertex"))?;
         let (field, curves) = match (sketch, &options.sketch) {
+            (Some(s), _) if s.curves.is_empty() => (None, Vec::new()),
             (Some(s), _) => {
                 s.validate().map_err(|e| Error::bad_input(None, format!("sketch: {e}")))?;
                 let (f, c) = sketch_frame_field(&mesh, s, options.field_cells, None)?;
@@ -167,7 +169,16 @@ impl SolidSession {
 
     /// Makes `sketch` the session's sketch: each curve that changed is replaced in the
     /// factored field, new ones added, dropped ones removed (module docs).
+    /// A sketch without curves returns the session to the constant field (no sketch).
     pub fn set_sketch(&mut self, sketch: &Sketch) -> Result<SketchEdit> {
+        if sketch.curves.is_empty() {
+            let removed = self.curves.len();
+            if self.field.take().is_some() {
+                self.cache = SolidCache::default();
+            }
+            self.curves.clear();
+            return Ok(SketchEdit { removed, ..Default::default() });
+        }
         sketch.validate().map_err(|e| Error::bad_input(None, format!("sketch: {e}")))?;
         let t0 = Instant::now();
         let new = sketch
