@@ -401,6 +401,39 @@ function sketchChanged() {
   if (solid) syncSketch().then(() => { if ($('cut-auto').checked) requestCut(); }).catch((e) => status(e.message, true));
   else if ($('cut-auto').checked) requestCut();
 }
+/** The cut image on its plane in the 3-D view (a textured quad, transparent outside the
+ *  mesh), and the mesh clipped to the kept (negative) side of the plane. */
+function showCutInView(img, placement, plane) {
+  const old = groups.cut.getObjectByName('cut-image');
+  if (old) { groups.cut.remove(old); old.geometry.dispose(); old.material.map.dispose(); old.material.dispose(); }
+  if (placement && img.naturalWidth > 0) {
+    const [c, u, v] = placement;
+    const at = (a, b) => [0, 1, 2].map((k) => c[k] + a * u[k] + b * v[k]);
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute([...at(0, 0), ...at(1, 0), ...at(1, 1), ...at(0, 1)], 3));
+    g.setAttribute('uv', new THREE.Float32BufferAttribute([0, 1, 1, 1, 1, 0, 0, 0], 2));
+    g.setIndex([0, 1, 2, 0, 2, 3]);
+    const canvas = document.createElement('canvas');
+    canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
+    canvas.getContext('2d').drawImage(img, 0, 0);
+    const tex = new THREE.CanvasTexture(canvas);
+    tex.colorSpace = THREE.SRGBColorSpace;
+    tex.magFilter = THREE.NearestFilter;
+    const quad = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ map: tex, transparent: true, alphaTest: 0.5, side: THREE.DoubleSide }));
+    quad.name = 'cut-image';
+    groups.cut.add(quad);
+  }
+  clipMesh(plane);
+  render();
+}
+function clipMesh(plane) {
+  if (!meshObj) return;
+  renderer.localClippingEnabled = true;
+  const on = plane && $('cut-clip').checked;
+  const n = plane ? new THREE.Vector3(plane[3], plane[4], plane[5]).normalize() : null;
+  meshObj.material.clippingPlanes = on ? [new THREE.Plane(n.clone().negate(), n.dot(new THREE.Vector3(plane[0], plane[1], plane[2])))] : [];
+  meshObj.material.needsUpdate = true;
+}
 let cutBusy = false;
 let cutPending = false;
 /** Redraws the cut image from the open solid; while one cut runs, the newest plane waits. */
@@ -421,6 +454,7 @@ async function requestCut() {
     img.src = URL.createObjectURL(blob);
     img.hidden = false;
     await img.decode().catch(() => {});
+    showCutInView(img, JSON.parse(resp.headers.get('X-Cut-Placement') || 'null'), plane);
     const c = {
       round_trip_ms: rt,
       shown_ms: performance.now() - t0,
@@ -458,6 +492,7 @@ function placeCutPlane() {
   plane.lookAt(c[0] + c[3], c[1] + c[4], c[2] + c[5]);
   cutPlaneObj = plane;
   groups.cut.add(plane);
+  if (solid && cuts.length) clipMesh(c);
   render();
 }
 
@@ -709,6 +744,7 @@ async function start() {
   $('cut-pos').oninput = () => { placeCutPlane(); if ($('cut-auto').checked && solid) requestCut(); };
   $('cut-axis').onchange = () => { placeCutPlane(); if ($('cut-auto').checked && solid) requestCut(); };
   $('cut-show').onclick = () => requestCut();
+  $('cut-clip').onchange = () => { if (meshData) clipMesh(cuts.length ? cutPlane() : null); render(); };
   $('solid-open').onclick = () => ensureSolid().catch((e) => status(e.message, true));
   $('cut-now').onclick = () => runJob('solid');
   for (const id of ['ref-show', 'ref-draw', 'ref-pos', 'ref-yaw', 'ref-pitch']) $(id).oninput = placeRefPlane;

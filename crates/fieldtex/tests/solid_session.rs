@@ -69,6 +69,18 @@ fn session_cuts_equal_the_pipeline_cuts_and_edits_go_through_the_field() {
         let opaque = c.image.pixels.iter().filter(|p| p[3] > 0.0).count();
         assert!(opaque > 100, "cut {i}: {opaque} opaque pixels");
     }
+    // Placement: the slice lies in its plane, one voxel per pixel; the oblique image
+    // spans vectors in its plane.
+    let [corner, u, v] = slice.placement;
+    let sp = session.grid().spacing;
+    assert!((corner[1] - cuts[0][1]).abs() < 1e-9);
+    assert!((u[0] - slice.image.width as f64 * sp).abs() < 1e-9 && u[1] == 0.0);
+    assert!((v[2] - slice.image.height as f64 * sp).abs() < 1e-9 && v[1] == 0.0);
+    let [_, u, v] = oblique.placement;
+    let n = [0.3, 0.2, 1.0];
+    for w in [u, v] {
+        assert!((w[0] * n[0] + w[1] * n[1] + w[2] * n[2]).abs() < 1e-9, "{w:?} not in the plane");
+    }
     // Asked again, the cut comes from the kept blocks.
     let again = session.cut(cuts[0], &NoProgress).unwrap();
     assert_eq!(again.voxels_computed, 0);

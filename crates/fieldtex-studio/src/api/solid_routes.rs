@@ -183,5 +183,6 @@ pub(super) fn solid_cut(state: &State, req: &Request) -> Result<Response, Respon
         .with_header("X-Cut-Ms", format!("{:.1}", cut.seconds * 1e3))
         .with_header("X-Voxels-Requested", cut.voxels_requested.to_string())
         .with_header("X-Voxels-Computed", cut.voxels_computed.to_string())
-        .with_header("X-Grid-Slice", cut.grid_slice.to_string()))
+        .with_header("X-Grid-Slice", cut.grid_slice.to_string())
+        .with_header("X-Cut-Placement", serde_json::json!(cut.placement).to_string()))
 }

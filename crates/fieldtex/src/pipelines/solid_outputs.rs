@@ -28,6 +28,10 @@ pub(crate) struct CutVoxels {
     pub height: usize,
     /// `(axis, column axis, row axis)` for a plane through a plane of voxel centres.
     pub slice: Option<(usize, usize, usize)>,
+    /// Where the image lies in space: the outer corner of pixel (0, 0), then the
+    /// vectors spanning all columns and all rows (pixel `(c, r)` has its centre at
+    /// `corner + (c + ½)/width · u + (r + ½)/height · v`, sampled at the nearest voxel).
+    pub placement: [[f64; 3]; 3],
 }
 
 /// The pixels of the cut image of plane `cut` (`point`, `normal`): a grid slice, or
@@ -54,7 +58,21 @@ pub(crate) fn cut_voxels(grid: &SolidGrid, cut: [f64; 6], part: &TriMesh) -> Cut
                     voxels.push(v);
                 }
             }
-            CutVoxels { voxels, width: w, height: h, slice: Some((axis, a1, a2)) }
+            let sp = grid.spacing;
+            let mut corner = grid.origin;
+            corner[axis] += k as f64 * sp;
+            corner[a1] -= 0.5 * sp;
+            corner[a2] -= 0.5 * sp;
+            let (mut u, mut v) = ([0.0; 3], [0.0; 3]);
+            u[a1] = w as f64 * sp;
+            v[a2] = h as f64 * sp;
+            CutVoxels {
+                voxels,
+                width: w,
+                height: h,
+                slice: Some((axis, a1, a2)),
+                placement: [corner, u, v],
+            }
         }
         None => {
             let len =
@@ -87,7 +105,11 @@ pub(crate) fn cut_voxels(grid: &SolidGrid, cut: [f64; 6], part: &TriMesh) -> Cut
                     }));
                 }
             }
-            CutVoxels { voxels, width: w, height: h, slice: None }
+            let corner: [f64; 3] =
+                std::array::from_fn(|a| point[a] + lo[0] * e1[a] + lo[1] * e2[a]);
+            let u = e1.map(|x| x * w as f64 * grid.spacing);
+            let v = e2.map(|x| x * h as f64 * grid.spacing);
+            CutVoxels { voxels, width: w, height: h, slice: None, placement: [corner, u, v] }
         }
     }
 }

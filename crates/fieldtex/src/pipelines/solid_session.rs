@@ -57,6 +57,9 @@ pub struct SolidCut {
     pub image: Image,
     /// Whether the plane runs through a plane of voxel centres (the image is that slice).
     pub grid_slice: bool,
+    /// Where the image lies in space: `[corner, u, v]`, the outer corner of pixel
+    /// (0, 0) and the vectors spanning all columns and all rows.
+    pub placement: [[f64; 3]; 3],
     /// Wall time of the whole cut (plane cut of the mesh, inside test, synthesis).
     pub seconds: f64,
     /// Voxels the image needed (inside the mesh).
@@ -245,7 +248,8 @@ impl SolidSession {
                 "the cut plane leaves nothing of the mesh on its negative side",
             ));
         }
-        let CutVoxels { voxels, width, height, slice } = cut_voxels(&self.grid, plane, &pc.mesh);
+        let CutVoxels { voxels, width, height, slice, placement } =
+            cut_voxels(&self.grid, plane, &pc.mesh);
         let grid = self.grid;
         let scale = self.scale;
         let mut work = Work::default();
@@ -269,6 +273,7 @@ impl SolidSession {
         Ok(SolidCut {
             image,
             grid_slice: slice.is_some(),
+            placement,
             seconds: t0.elapsed().as_secs_f64(),
             voxels_requested: work.requested,
             voxels_computed: work.computed_all_levels,
