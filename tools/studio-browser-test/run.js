@@ -4,13 +4,17 @@
 // checks, in order:
 //   orient — add a wedge by clicking, check the drawn field's index (winding) is ½
 //            around the click and 0 elsewhere, drag it, check the index moved with it
-//            and the canvas changed, print the drag → redraw latency (median, p90, max);
+//            and the canvas changed, print the drag → redraw latency (median, p90, max),
+//            then the texture latencies after an edit (first 128², then full size);
 //   align  — open fandisk, crest lines and streamlines drawn (pixel checks), draw a
 //            curve on the surface by dragging, run an align job to completion over
 //            server-sent events, open its model.glb in the viewer (pixel checks), then
 //            the patch colours and UV checker displays;
-//   solid  — draw a sketch curve on the torus, show the frame field, compute a cut
-//            (a solid job) and check the cut image and cut mesh are shown.
+//   solid  — draw a sketch curve on the torus and one on the tilted reference plane,
+//            open the solid on the server, redraw the frame field through it, move the
+//            cut plane slider through seven positions (each cut computed on demand; the
+//            last repeats the first and must come from the kept blocks), print the cut
+//            latencies, then run a solid job for the cut mesh and show it.
 // Screenshots go to tools/studio-browser-test/out/ (and docs/gallery/studio-*.png with
 // --gallery). Image checks compare statistics (share of non-background pixels, colour
 // spread), never bytes. Any failure, including a browser that cannot start, exits 1.
@@ -174,9 +178,31 @@ async function orientMode(page, url) {
   const solve = after.timings.map((t) => t.solve_ms);
   check(lat.length >= 5, `${lat.length} drag redraws`);
   log(`LATENCY drag event → field redrawn: median ${median(lat).toFixed(1)} ms, p90 ${quantile(lat, 0.9).toFixed(1)} ms, max ${Math.max(...lat).toFixed(1)} ms over ${lat.length} redraws (server solve median ${median(solve).toFixed(1)} ms; target 50 ms)`);
-  await page.waitForTimeout(1500); // the progressive texture
+  // Texture after an edit: three short drags of the singularity (8 px), each waited
+  // out until the full-size texture of its design version is shown.
+  const full = await page.evaluate(() => Math.min(1024, Math.round(window.studio.state.width)));
+  const first = []; const whole = [];
+  let at = [...B];
+  for (let r = 0; r < 3; r++) {
+    const c3 = await page.locator('#field').boundingBox();
+    await page.mouse.move(c3.x + at[0], c3.y + at[1]);
+    await page.mouse.down();
+    at = [at[0] - 8, at[1] - 6];
+    await page.mouse.move(c3.x + at[0], c3.y + at[1]);
+    await page.mouse.up();
+    await waitFor(page, () => !window.studio.busy, null, 10000, 'the edit to settle');
+    const version = await page.evaluate(() => window.studio.state.version);
+    if (!await waitFor(page, ([v, n]) => window.studio.textureTimings.some((t) => t.version === v && t.size === n), [version, full], 20000, `the ${full}² texture of version ${version}`)) break;
+    const t = await page.evaluate((v) => window.studio.textureTimings.filter((x) => x.version === v), version);
+    const a = t.find((x) => x.size === 128); const b = t.find((x) => x.size === full);
+    if (a) first.push(a.since_edit_ms);
+    whole.push(b.since_edit_ms);
+    log(`texture after edit ${r + 1}: 128² shown at ${a ? a.since_edit_ms.toFixed(0) : '-'} ms (synthesis ${a ? a.synth_ms.toFixed(0) : '-'} ms), ${full}² at ${b.since_edit_ms.toFixed(0)} ms (synthesis ${b.synth_ms.toFixed(0)} ms)`);
+  }
+  check(first.length >= 1 && whole.length >= 1, `texture latencies measured (${first.length} first, ${whole.length} full)`);
+  log(`LATENCY edit → first texture (128²) shown: median ${median(first).toFixed(0)} ms (target 300 ms); edit → full ${full}² texture shown: median ${median(whole).toFixed(0)} ms (target 1500 ms); ${whole.length} edits, 100 ms debounce included`);
   await shot(page, 'studio-orient', 'main');
-  return { median: median(lat), p90: quantile(lat, 0.9), max: Math.max(...lat), n: lat.length };
+  return { median: median(lat), p90: quantile(lat, 0.9), max: Math.max(...lat), n: lat.length, first: median(first), full: median(whole), fullSize: full };
 }
 
 // ------------------------------------------------------------------ align + viewer
@@ -232,24 +258,92 @@ async function alignMode(page, url) {
 }
 
 // ------------------------------------------------------------------ solid
+// Statistics of the cut image (opaque share, colour spread of the opaque pixels).
+const imageStats = (sel) => {
+  const img = document.querySelector(sel);
+  const c = document.createElement('canvas');
+  c.width = img.naturalWidth; c.height = img.naturalHeight;
+  const x = c.getContext('2d');
+  x.drawImage(img, 0, 0);
+  const d = x.getImageData(0, 0, c.width, c.height).data;
+  let n = 0; const sum = [0, 0, 0]; const sq = [0, 0, 0];
+  for (let i = 0; i < d.length; i += 4) {
+    if (d[i + 3] < 128) continue;
+    n++;
+    for (let k = 0; k < 3; k++) { sum[k] += d[i + k]; sq[k] += d[i + k] * d[i + k]; }
+  }
+  const varc = sq.map((s, k) => (n ? s / n - (sum[k] / n) ** 2 : 0));
+  return { opaque: n / Math.max(1, c.width * c.height), colorStd: Math.sqrt(Math.max(0, (varc[0] + varc[1] + varc[2]) / 3)), width: c.width, height: c.height };
+};
+
+async function dragAcross(page, from, to) {
+  const v = await page.locator('#viewport canvas').boundingBox();
+  await page.mouse.move(v.x + v.width * from[0], v.y + v.height * from[1]);
+  await page.mouse.down();
+  for (let s = 1; s <= 20; s++) await page.mouse.move(v.x + v.width * (from[0] + (to[0] - from[0]) * s / 20), v.y + v.height * (from[1] + (to[1] - from[1]) * s / 20));
+  await page.mouse.up();
+}
+
 async function solidMode(page, url) {
   const mesh = encodeURIComponent(JSON.stringify({ root: 'meshes', path: 'torus.obj' }));
   await page.goto(`${url}mesh.html?mode=solid&mesh=${mesh}`);
   if (!await waitFor(page, () => window.studioMesh && window.studioMesh.ready && window.studioMesh.mesh, null, 30000, 'the torus to open')) return;
   await page.uncheck('#cut-auto');
+  // A curve on the surface.
   await page.check('#draw');
-  const v = await page.locator('#viewport canvas').boundingBox();
-  await page.mouse.move(v.x + v.width * 0.3, v.y + v.height * 0.5);
-  await page.mouse.down();
-  for (let s = 1; s <= 20; s++) await page.mouse.move(v.x + v.width * (0.3 + 0.2 * s / 20), v.y + v.height * (0.5 - 0.1 * s / 20));
-  await page.mouse.up();
+  await dragAcross(page, [0.3, 0.5], [0.5, 0.4]);
   await page.uncheck('#draw');
-  const drawn = await page.evaluate(() => window.studioMesh.drawn.length);
-  check(drawn === 1, `sketch curve drawn: ${drawn}`);
+  // A curve on the reference plane: tilted, moved, then drawn on by ray picking.
+  await page.check('#ref-draw');
+  for (const [id, v] of [['ref-pitch', '70'], ['ref-yaw', '30'], ['ref-pos', '0.05']]) {
+    await page.evaluate(([i, x]) => { const e = document.getElementById(i); e.value = x; e.dispatchEvent(new Event('input')); }, [id, v]);
+  }
+  await dragAcross(page, [0.35, 0.55], [0.65, 0.5]);
+  await page.uncheck('#ref-draw');
+  await page.check('#ref-show');
+  const sk = await page.evaluate(() => window.studioMesh.sketch.map((c) => ({ n: c.points.length, plane: !!c.plane })));
+  check(sk.length === 2 && !sk[0].plane && sk[1].plane && sk[1].n >= 3, `sketch: a surface curve and a reference-plane curve (${JSON.stringify(sk)})`);
+  const onPlane = await page.evaluate(() => {
+    const c = window.studioMesh.sketch[1];
+    const n = c.plane.normal; const o = c.plane.point;
+    return Math.max(...c.points.map((p) => Math.abs((p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2])));
+  });
+  check(onPlane < 1e-6, `reference-plane curve lies on its plane (max distance ${onPlane.toExponential(1)})`);
+  // Open the solid (exemplar analysis, frame field of both curves).
+  await page.fill('#solid-res', '64');
+  const tOpen = Date.now();
+  await page.click('#solid-open');
+  if (!await waitFor(page, () => window.studioMesh.solid && window.studioMesh.timings.solid_open_ms > 0, null, 60000, 'the open solid')) return;
+  const to = await page.evaluate(() => window.studioMesh.timings);
+  log(`solid opened in ${((Date.now() - tOpen) / 1000).toFixed(1)} s (server build ${to.solid_build_server_ms.toFixed(0)} ms: exemplar analysis + frame field)`);
+  // A sketch edit through the open solid (the frames redrawn).
   await page.click('#show-frames');
-  await waitFor(page, () => window.studioMesh.timings.frames_server_ms > 0, null, 20000, 'the frame field');
+  await waitFor(page, () => window.studioMesh.timings.sketch_edit_server_ms >= 0, null, 20000, 'the frame field');
   const tf = await page.evaluate(() => window.studioMesh.timings);
-  log(`frame field: server ${tf.frames_server_ms.toFixed(0)} ms, round trip ${tf.frames_round_trip_ms.toFixed(0)} ms`);
+  log(`frame field redraw: server ${tf.frames_server_ms.toFixed(0)} ms, round trip ${tf.frames_round_trip_ms.toFixed(0)} ms`);
+  await shot(page, 'studio-solid-sketch', 'main');
+  // Cuts: the first, then the slider moved through five positions (each redrawn from the
+  // open solid), then back to the first position (the kept blocks).
+  await page.selectOption('#cut-axis', '1'); // normal y: the torus's ring
+  await page.check('#cut-auto');
+  const cutAt = async (v, what) => {
+    const before = await page.evaluate(() => window.studioMesh.cuts.length);
+    await page.evaluate((x) => { const e = document.getElementById('cut-pos'); e.value = x; e.dispatchEvent(new Event('input')); }, v);
+    return waitFor(page, (b) => window.studioMesh.cuts.length > b, before, 30000, what);
+  };
+  if (!await cutAt('0.5', 'the first cut')) return;
+  for (const v of ['0.45', '0.4', '0.35', '0.6', '0.65']) await cutAt(v, `the cut at ${v}`);
+  await cutAt('0.5', 'the cut at 0.5 again');
+  const cs = await page.evaluate(() => window.studioMesh.cuts);
+  const later = cs.slice(1, -1).map((c) => c.shown_ms);
+  check(cs.length === 7, `${cs.length} cuts drawn from the open solid`);
+  check(cs[cs.length - 1].computed === 0, `the repeated cut came from the kept blocks (${cs[cs.length - 1].computed} voxels computed)`);
+  const st = await page.evaluate(imageStats, '#cut-image');
+  check(st.opaque > 0.2 && st.colorStd > 5, `cut image ${st.width}×${st.height}: ${(100 * st.opaque).toFixed(0)} % inside, colour std ${st.colorStd.toFixed(1)}`);
+  log(`LATENCY cut plane moved → cut image shown: first cut ${cs[0].shown_ms.toFixed(0)} ms (server ${cs[0].server_ms.toFixed(0)} ms, ${cs[0].computed} voxels computed); later cuts median ${median(later).toFixed(0)} ms, max ${Math.max(...later).toFixed(0)} ms (server median ${median(cs.slice(1, -1).map((c) => c.server_ms)).toFixed(0)} ms); repeated cut ${cs[cs.length - 1].shown_ms.toFixed(0)} ms`);
+  await shot(page, 'studio-solid', 'main');
+  // The cut mesh as a solid job (capped mesh part, textured from the same solid).
+  await page.uncheck('#cut-auto');
   await page.fill('#solid-res', '32');
   await page.fill('#size', '128');
   const tJob = Date.now();
@@ -257,12 +351,12 @@ async function solidMode(page, url) {
   const done = await waitFor(page, () => Object.values(window.studioMesh.jobs).some((j) => j.kind === 'solid' && ['done', 'failed', 'cancelled'].includes(j.state)), null, 90000, 'the solid cut job');
   const job = await page.evaluate(() => Object.values(window.studioMesh.jobs).find((j) => j.kind === 'solid'));
   if (!done || !job) return;
-  check(job.state === 'done', `solid cut job ${job.state}${job.error ? ': ' + job.error : ''} in ${((Date.now() - tJob) / 1000).toFixed(1)} s`);
-  await waitFor(page, () => { const i = document.getElementById('cut-image'); return !i.hidden && i.complete && i.naturalWidth > 0; }, null, 10000, 'the cut image');
+  check(job.state === 'done', `solid cut-mesh job ${job.state}${job.error ? ': ' + job.error : ''} in ${((Date.now() - tJob) / 1000).toFixed(1)} s`);
   await waitFor(page, () => (window.studioMesh.glbLoaded || '').endsWith('cut-1.glb'), null, 10000, 'the cut mesh');
   const sg = await page.evaluate(canvasStats, '#viewport canvas');
   check(sg.nonBackground > 0.05 && sg.colorStd > 10, `cut mesh shown: ${(100 * sg.nonBackground).toFixed(1)} % covered, colour std ${sg.colorStd.toFixed(1)}`);
-  await shot(page, 'studio-solid', 'main');
+  await shot(page, 'studio-solid-cut-mesh', 'main');
+  return { first: cs[0].shown_ms, later: median(later), firstServer: cs[0].server_ms };
 }
 
 async function main() {
@@ -286,13 +380,14 @@ async function main() {
     fatal(`the browser did not start (${browserPath}): ${e.message}`);
   }
   let latency = null;
+  let solidLatency = null;
   try {
     const page = await browser.newPage({ viewport: { width: 1120, height: 720 } });
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));
     latency = await orientMode(page, url);
     await alignMode(page, url);
-    await solidMode(page, url);
+    solidLatency = await solidMode(page, url);
     check(errors.length === 0, `no uncaught page errors${errors.length ? ': ' + errors.join(' | ') : ''}`);
   } catch (e) {
     failures++;
@@ -303,7 +398,18 @@ async function main() {
     fs.rmSync(ws, { recursive: true, force: true });
   }
   const secs = (Date.now() - t0) / 1000;
-  if (latency) log(`summary: drag latency median ${latency.median.toFixed(1)} ms (p90 ${latency.p90.toFixed(1)}, max ${latency.max.toFixed(1)}, n ${latency.n}); ${secs.toFixed(1)} s in all`);
+  if (latency) log(`summary: drag → field median ${latency.median.toFixed(1)} ms (p90 ${latency.p90.toFixed(1)}, max ${latency.max.toFixed(1)}, n ${latency.n}); edit → first texture ${latency.first.toFixed(0)} ms, → full ${latency.fullSize}² ${latency.full.toFixed(0)} ms`);
+  if (solidLatency) log(`summary: cut shown: first ${solidLatency.first.toFixed(0)} ms (server ${solidLatency.firstServer.toFixed(0)} ms), later median ${solidLatency.later.toFixed(0)} ms`);
+  log(`${secs.toFixed(1)} s in all`);
+  // One machine-readable line for bench/studio_browser.sh.
+  console.log(`METRICS ${JSON.stringify({
+    drag_median_ms: latency ? latency.median : null,
+    texture_first_ms: latency ? latency.first : null,
+    texture_full_ms: latency ? latency.full : null,
+    cut_first_ms: solidLatency ? solidLatency.first : null,
+    cut_later_ms: solidLatency ? solidLatency.later : null,
+    total_s: secs,
+  })}`);
   if (failures) fatal(`${failures} check(s) failed`);
   log('all checks passed');
 }

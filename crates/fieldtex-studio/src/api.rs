@@ -47,6 +47,9 @@ const ROUTES: &[(&str, &str)] = &[
     ("POST", "/api/mesh/open"),
     ("POST", "/api/mesh/field"),
     ("POST", "/api/mesh/frames"),
+    ("POST", "/api/solid/open"),
+    ("POST", "/api/solid/sketch"),
+    ("POST", "/api/solid/cut"),
     ("GET", "/api/jobs"),
     ("POST", "/api/jobs"),
     ("GET", "/api/jobs/get"),
@@ -57,8 +60,10 @@ const ROUTES: &[(&str, &str)] = &[
 
 mod job_routes;
 mod mesh_routes;
+mod solid_routes;
 use job_routes::{job_events, job_files, job_get, job_submit};
 use mesh_routes::{mesh_field, mesh_frames, mesh_open, meshes};
+use solid_routes::{SolidRef, solid_create, solid_cut, solid_sketch};
 
 /// Most meshes kept open at once (the oldest is dropped beyond).
 const MAX_MESH_SESSIONS: usize = 8;
@@ -79,6 +84,8 @@ pub struct State {
     meshes: Option<Root>,
     mesh_sessions: Mutex<VecDeque<(String, Arc<MeshSession>)>>,
     mesh_counter: std::sync::atomic::AtomicU64,
+    /// Open solids (`api/solid_routes.rs`), oldest first.
+    solids: Mutex<VecDeque<(String, SolidRef)>>,
     jobs: Arc<Jobs>,
     loopback: bool,
     pub(crate) max_connections: usize,
@@ -102,6 +109,7 @@ impl State {
             meshes,
             mesh_sessions: Mutex::new(VecDeque::new()),
             mesh_counter: std::sync::atomic::AtomicU64::new(0),
+            solids: Mutex::new(VecDeque::new()),
             jobs: Jobs::start(o.max_jobs, 8),
             loopback: crate::is_loopback_host(&o.host),
             max_connections: o.max_connections.max(1),
@@ -280,6 +288,9 @@ fn route(state: &State, req: &Request) -> Response {
         ("POST", "/api/mesh/open") => respond(mesh_open(state, req)),
         ("POST", "/api/mesh/field") => respond(mesh_field(state, req)),
         ("POST", "/api/mesh/frames") => respond(mesh_frames(state, req)),
+        ("POST", "/api/solid/open") => respond(solid_create(state, req)),
+        ("POST", "/api/solid/sketch") => respond(solid_sketch(state, req)),
+        ("POST", "/api/solid/cut") => respond(solid_cut(state, req)),
         ("GET", "/api/jobs") => {
             Response::json(200, &serde_json::json!({ "jobs": state.jobs.list() }))
         }

@@ -185,24 +185,8 @@ impl MeshSession {
         }
         let errs = field.constraint_errors_deg();
         let solve_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let popts = fieldtex_mesh::PoissonDiskOptions {
-            target_count: Some(samples.clamp(10, 2000)),
-            seed: 1,
-            ..Default::default()
-        };
-        let (points, _) = fieldtex_mesh::poisson_disk_sampling(&self.mesh, &popts)
-            .map_err(|e| (500, format!("samples: {e}")))?;
-        let frames: Vec<serde_json::Value> = points
-            .samples
-            .iter()
-            .map(|s| {
-                let m = quaternion::to_matrix(field.frame_at(s.position));
-                // Row-major with the local axes as columns.
-                let axes: Vec<[f32; 3]> =
-                    (0..3).map(|c| [m[c] as f32, m[3 + c] as f32, m[6 + c] as f32]).collect();
-                serde_json::json!({ "p": s.position.map(|x| x as f32), "axes": axes })
-            })
-            .collect();
+        let frames =
+            frame_samples(&self.mesh, samples, |p| quaternion::to_matrix(field.frame_at(p)))?;
         Ok(serde_json::json!({
             "frames": frames,
             "curves": curves.len(),
@@ -211,6 +195,32 @@ impl MeshSession {
             "total_ms": t0.elapsed().as_secs_f64() * 1e3,
         }))
     }
+}
+
+/// `frame` (a row-major rotation matrix, local axes as columns) at `samples`
+/// Poisson-disk points of `mesh` (seed 1): `{"p": point, "axes": [x, y, z]}` each.
+pub fn frame_samples(
+    mesh: &TriMesh,
+    samples: usize,
+    frame: impl Fn([f64; 3]) -> [f64; 9],
+) -> Result<Vec<serde_json::Value>, (u16, String)> {
+    let popts = fieldtex_mesh::PoissonDiskOptions {
+        target_count: Some(samples.clamp(10, 2000)),
+        seed: 1,
+        ..Default::default()
+    };
+    let (points, _) = fieldtex_mesh::poisson_disk_sampling(mesh, &popts)
+        .map_err(|e| (500, format!("samples: {e}")))?;
+    Ok(points
+        .samples
+        .iter()
+        .map(|s| {
+            let m = frame(s.position);
+            let axes: Vec<[f32; 3]> =
+                (0..3).map(|c| [m[c] as f32, m[3 + c] as f32, m[6 + c] as f32]).collect();
+            serde_json::json!({ "p": s.position.map(|x| x as f32), "axes": axes })
+        })
+        .collect())
 }
 
 fn bbox(mesh: &TriMesh) -> ([f64; 3], [f64; 3]) {

@@ -3,80 +3,16 @@
 //! requests with garbage bodies, jobs end to end (SSE events, output listing, files),
 //! cancellation, and traversal or link escapes through job listings.
 
-use fieldtex_studio::{Studio, StudioOptions};
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-fn temp_dir(tag: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "fieldtex-studio-mj-{}-{tag}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst)
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+use common::{request, temp_dir, write_inputs};
 
 fn start(tag: &str) -> (SocketAddr, PathBuf) {
-    let ws = temp_dir(tag);
-    let mut o = StudioOptions::new(ws.clone());
-    o.port = 0;
-    o.max_upload_bytes = 256 * 1024;
-    let addr = Studio::bind(o).unwrap().spawn();
-    (addr, ws)
-}
-
-struct Reply {
-    status: u16,
-    body: Vec<u8>,
-}
-
-impl Reply {
-    fn json(&self) -> serde_json::Value {
-        serde_json::from_slice(&self.body)
-            .unwrap_or_else(|_| panic!("not JSON: {}", String::from_utf8_lossy(&self.body)))
-    }
-    fn error(&self) -> String {
-        self.json()["error"].as_str().unwrap_or("").to_string()
-    }
-}
-
-fn request(addr: SocketAddr, method: &str, path: &str, body: &[u8]) -> Reply {
-    let mut r = format!(
-        "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
-        addr.port(),
-        body.len()
-    )
-    .into_bytes();
-    r.extend_from_slice(body);
-    let mut s = TcpStream::connect(addr).unwrap();
-    let _ = s.write_all(&r);
-    let mut out = Vec::new();
-    let _ = s.read_to_end(&mut out);
-    let end = out.windows(4).position(|w| w == b"\r\n\r\n").expect("a response head");
-    let head = String::from_utf8_lossy(&out[..end]).to_string();
-    let status = head.split(' ').nth(1).unwrap().parse().unwrap();
-    Reply { status, body: out[end + 4..].to_vec() }
-}
-
-/// A small torus (OBJ) and a striped exemplar in the workspace.
-fn write_inputs(ws: &Path) {
-    let mesh = fieldtex_mesh::primitives::torus(1.0, 0.4, 24, 12);
-    fieldtex_io::write_obj(&ws.join("torus.obj"), &mesh, None).unwrap();
-    let n = 32;
-    let mut img = fieldtex_core::Image::new(n, n, [0.0, 0.0, 0.0, 1.0]);
-    for y in 0..n {
-        for x in 0..n {
-            let v = if (x / 4) % 2 == 0 { 0.9 } else { 0.1 };
-            img.pixels[y * n + x] = [v, v * 0.8, 0.3, 1.0];
-        }
-    }
-    fieldtex_io::write_png(&ws.join("stripes.png"), &img).unwrap();
+    common::start(tag, 256 * 1024)
 }
 
 fn open_mesh(addr: SocketAddr, path: &str) -> (serde_json::Value, Vec<f32>, Vec<u32>) {

@@ -2,79 +2,14 @@
 //! edit → solve → field round trip. Each test starts its own server on a free port
 //! with a fresh temporary workspace.
 
-use fieldtex_studio::{Studio, StudioOptions};
-use std::io::{Read, Write};
-use std::net::{SocketAddr, TcpStream};
+use std::net::SocketAddr;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
-fn temp_dir(tag: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "fieldtex-studio-test-{}-{tag}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst)
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+use common::{raw, request, temp_dir};
 
 fn start(tag: &str) -> (SocketAddr, PathBuf) {
-    let ws = temp_dir(tag);
-    let mut o = StudioOptions::new(ws.clone());
-    o.port = 0;
-    o.max_upload_bytes = 64 * 1024;
-    let addr = Studio::bind(o).unwrap().spawn();
-    (addr, ws)
-}
-
-struct Reply {
-    status: u16,
-    body: Vec<u8>,
-}
-
-impl Reply {
-    fn json(&self) -> serde_json::Value {
-        serde_json::from_slice(&self.body)
-            .unwrap_or_else(|_| panic!("not JSON: {}", String::from_utf8_lossy(&self.body)))
-    }
-    fn error(&self) -> String {
-        self.json()["error"].as_str().unwrap_or("").to_string()
-    }
-    /// The binary state: JSON and the field.
-    fn state(&self) -> (serde_json::Value, Vec<f32>) {
-        assert_eq!(self.status, 200, "{}", String::from_utf8_lossy(&self.body));
-        let n = u32::from_le_bytes(self.body[..4].try_into().unwrap()) as usize;
-        let json = serde_json::from_slice(&self.body[4..4 + n]).unwrap();
-        let field = self.body[4 + n..]
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-            .collect();
-        (json, field)
-    }
-}
-
-fn raw(addr: SocketAddr, request: &[u8]) -> Reply {
-    let mut s = TcpStream::connect(addr).unwrap();
-    let _ = s.write_all(request);
-    let mut out = Vec::new();
-    let _ = s.read_to_end(&mut out);
-    let text_end = out.windows(4).position(|w| w == b"\r\n\r\n").expect("a response head");
-    let head = String::from_utf8_lossy(&out[..text_end]).to_string();
-    let status = head.split(' ').nth(1).unwrap().parse().unwrap();
-    Reply { status, body: out[text_end + 4..].to_vec() }
-}
-
-fn request(addr: SocketAddr, method: &str, path: &str, body: &[u8]) -> Reply {
-    let mut r = format!(
-        "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
-        addr.port(),
-        body.len()
-    )
-    .into_bytes();
-    r.extend_from_slice(body);
-    raw(addr, &r)
+    common::start(tag, 64 * 1024)
 }
 
 fn new_session(addr: SocketAddr, body: &str) -> (String, serde_json::Value, Vec<f32>) {

@@ -56,7 +56,10 @@ function showTimings(extra) {
 // Edit latencies for the page and the browser test: from the input event that caused
 // the edit (or the request, when there is none) to the end of the redraw.
 const timings = [];
-window.studio = { get state() { return state; }, get field() { return field; }, timings, get busy() { return inFlight || pending !== null; } };
+// Texture latencies: from the input event of the edit the texture shows to the image
+// decoded in the page, per size (128² first feedback, then the full size).
+const textureTimings = [];
+window.studio = { get state() { return state; }, get field() { return field; }, timings, textureTimings, get busy() { return inFlight || pending !== null; } };
 
 async function setState(resp, t0, tEvent = t0) {
   const [json, f] = decodeState(await resp.arrayBuffer());
@@ -68,7 +71,7 @@ async function setState(resp, t0, tEvent = t0) {
   timings.push({ version: json.version, round_trip_ms: tNet, draw_ms: tDraw, event_to_draw_ms: total, solve_ms: json.solve_ms });
   showTimings(`round trip ${tNet.toFixed(1)} ms + draw ${tDraw.toFixed(1)} ms; event → drawn ${total.toFixed(1)} ms`);
   updateSelectionUi();
-  scheduleTexture();
+  scheduleTexture(tEvent);
   return json;
 }
 
@@ -235,12 +238,15 @@ function currentExemplar() {
   const v = $('exemplar').value;
   return v ? JSON.parse(v) : null;
 }
-function scheduleTexture() {
+let textureEvent = 0;
+function scheduleTexture(tEvent = performance.now()) {
   if (!$('auto-texture').checked) return;
   clearTimeout(textureTimer);
-  textureTimer = setTimeout(synthesise, 150);
+  textureEvent = tEvent;
+  textureTimer = setTimeout(synthesise, 100);
 }
 async function synthesise() {
+  const tEvent = textureEvent || performance.now();
   const ex = currentExemplar();
   if (!ex || !state) return;
   if (textureAbort) textureAbort.abort();
@@ -261,6 +267,10 @@ async function synthesise() {
       const img = $('texture');
       if (img.src.startsWith('blob:')) URL.revokeObjectURL(img.src);
       img.src = URL.createObjectURL(blob);
+      await img.decode().catch(() => {});
+      if (abort.signal.aborted) return;
+      if (textureTimings.length > 1000) textureTimings.shift();
+      textureTimings.push({ version, size, since_edit_ms: performance.now() - tEvent, request_ms: performance.now() - t0, synth_ms: Number(resp.headers.get('X-Synth-Ms')) });
       status(`texture ${size}²: ${(performance.now() - t0).toFixed(0)} ms (synthesis ${resp.headers.get('X-Synth-Ms')} ms)`);
     } catch (e) {
       if (e.name !== 'AbortError') status(e.message, true);
@@ -268,8 +278,8 @@ async function synthesise() {
     }
   }
 }
-$('texture-now').onclick = synthesise;
-$('exemplar').onchange = synthesise;
+$('texture-now').onclick = () => { textureEvent = performance.now(); synthesise(); };
+$('exemplar').onchange = () => { textureEvent = performance.now(); synthesise(); };
 
 $('upload').onchange = async () => {
   const f = $('upload').files[0];

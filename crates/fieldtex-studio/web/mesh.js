@@ -1,6 +1,7 @@
 // fieldtex studio, mesh modes: align (crest lines, drawn curves, the field as
-// streamlines, align jobs), solid (sketch curves, the frame field, cut planes computed
-// by solid jobs) and the GLB viewer (texture, wireframe, UV checker, patch colours).
+// streamlines, align jobs), solid (sketch curves on the surface or on a movable
+// reference plane, the frame field, cut images computed on demand by an open solid on
+// the server, cut meshes by solid jobs) and the GLB viewer (texture, wireframe, UV checker, patch colours).
 // three.js comes from /vendor/ (embedded after scripts/setup-studio); without it the
 // page says which command to run.
 
@@ -19,12 +20,18 @@ let drawn = []; // curves drawn on the surface (align) — arrays of [x, y, z]
 let sketch = []; // solid sketch curves: {points, axis}
 let drawing = null;
 let cutPlaneObj = null;
+let refPlaneObj = null;
+let solid = null; // the open solid on the server: {id, key, sent}
+const cuts = []; // cut latencies: {round_trip_ms, shown_ms, server_ms, computed, requested}
 let checkerTexture = null;
 const timings = {};
 window.studioMesh = {
   get mesh() { return meshData; },
   get drawn() { return mode === 'solid' ? sketch.map((s) => s.points) : drawn; },
   get glb() { return glbRoot; },
+  get solid() { return solid; },
+  get sketch() { return sketch; },
+  cuts,
   timings,
   jobs: {},
 };
@@ -62,7 +69,7 @@ function setupView() {
   sun.position.set(1, 2, 3);
   camera.add(sun);
   scene.add(camera);
-  for (const g of ['mesh', 'crest', 'drawn', 'field', 'glb', 'cut']) {
+  for (const g of ['mesh', 'crest', 'drawn', 'field', 'glb', 'cut', 'ref']) {
     groups[g] = new THREE.Group();
     scene.add(groups[g]);
   }
@@ -138,7 +145,7 @@ async function openMesh(ref) {
   glbRoot = null;
   groups.mesh.visible = true; groups.drawn.visible = true; groups.field.visible = true;
   $('cut-image').hidden = true;
-  drawn = []; sketch = [];
+  drawn = []; sketch = []; solid = null;
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.BufferAttribute(pos.slice(), 3));
   g.setIndex(new THREE.BufferAttribute(idx.slice(), 1));
@@ -168,7 +175,7 @@ async function openMesh(ref) {
   applyDisplay();
   render();
   status(`${json.path}: ${json.vertices} vertices, ${json.triangles} triangles, ${json.crest.length} crest lines`);
-  if (mode === 'solid') placeCutPlane();
+  if (mode === 'solid') { placeCutPlane(); placeRefPlane(); }
 }
 
 function showInfo(extra = '') {
@@ -182,12 +189,22 @@ function showInfo(extra = '') {
 
 // ---------------------------------------------------------------- drawing on the surface
 const raycaster = () => new THREE.Raycaster();
+const onRefPlane = () => mode === 'solid' && $('ref-draw').checked;
 function pick(ev) {
   if (!meshObj) return null;
   const r = renderer.domElement.getBoundingClientRect();
   const ndc = new THREE.Vector2(((ev.clientX - r.left) / r.width) * 2 - 1, -((ev.clientY - r.top) / r.height) * 2 + 1);
   const rc = raycaster();
   rc.setFromCamera(ndc, camera);
+  if (onRefPlane()) {
+    // Ray-pick the reference plane, within the square drawn for it.
+    const rp = refPlane();
+    const n = new THREE.Vector3(...rp.normal);
+    const o = new THREE.Vector3(...rp.point);
+    const p = rc.ray.intersectPlane(new THREE.Plane().setFromNormalAndCoplanarPoint(n, o), new THREE.Vector3());
+    if (!p || p.distanceTo(o) > diag() * 0.57) return null;
+    return { p, n };
+  }
   const hit = rc.intersectObject(meshObj, false)[0];
   if (!hit) return null;
   const n = hit.face ? hit.face.normal.clone().transformDirection(meshObj.matrixWorld) : new THREE.Vector3();
@@ -195,12 +212,12 @@ function pick(ev) {
 }
 
 function onPointerDown(ev) {
-  if (!$('draw').checked || mode === 'viewer' || ev.button !== 0) return;
+  if (!($('draw').checked || onRefPlane()) || mode === 'viewer' || ev.button !== 0) return;
   const h = pick(ev);
   if (!h) return;
   controls.enabled = false;
   renderer.domElement.setPointerCapture(ev.pointerId);
-  drawing = { points: [h.p.toArray()], line: null };
+  drawing = { points: [h.p.toArray()], line: null, plane: onRefPlane() ? refPlane() : null };
   ev.preventDefault();
 }
 function onPointerMove(ev) {
@@ -211,7 +228,7 @@ function onPointerMove(ev) {
   if (Math.hypot(h.p.x - last[0], h.p.y - last[1], h.p.z - last[2]) < diag() * 0.006) return;
   drawing.points.push(h.p.toArray());
   if (drawing.line) groups.drawn.remove(drawing.line);
-  drawing.line = lifted(drawing.points, 0x0b8f3a);
+  drawing.line = drawing.plane ? planeCurve(drawing.points) : lifted(drawing.points, 0x0b8f3a);
   groups.drawn.add(drawing.line);
   render();
 }
@@ -220,12 +237,22 @@ function onPointerUp() {
   const d = drawing; drawing = null;
   controls.enabled = true;
   if (d.points.length >= 2) {
-    if (mode === 'solid') sketch.push({ points: d.points, axis: $('sketch-axis').value });
-    else drawn.push(d.points);
+    if (mode === 'solid') {
+      const c = { points: d.points, axis: $('sketch-axis').value };
+      if (d.plane) c.plane = d.plane;
+      sketch.push(c);
+    } else drawn.push(d.points);
     status(`${mode === 'solid' ? sketch.length : drawn.length} curve(s) drawn`);
-    if (mode === 'solid' && $('cut-auto').checked) scheduleCut();
+    if (mode === 'solid') sketchChanged();
   } else if (d.line) groups.drawn.remove(d.line);
   render();
+}
+/** A reference-plane curve: magenta, drawn over everything (it may run inside the mesh). */
+function planeCurve(points) {
+  const line = polyline(points, 0xc0148c, 2);
+  line.material.depthTest = false;
+  line.renderOrder = 10;
+  return line;
 }
 /** A curve drawn a little off the surface (along the view) so it is not hidden. */
 function lifted(points, color) {
@@ -267,35 +294,184 @@ async function showField() {
 }
 
 // ---------------------------------------------------------------- solid: frames and cut
+function drawFrames(r) {
+  clearGroup('field');
+  const cols = [[0.85, 0.15, 0.1], [0.1, 0.6, 0.15], [0.1, 0.3, 0.9]];
+  const pos = [], col = [];
+  const h = diag() * 0.02;
+  for (const f of r.frames) {
+    for (let a = 0; a < 3; a++) {
+      const ax = f.axes[a];
+      pos.push(...f.p, f.p[0] + h * ax[0], f.p[1] + h * ax[1], f.p[2] + h * ax[2]);
+      col.push(...cols[a], ...cols[a]);
+    }
+  }
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+  g.setAttribute('color', new THREE.Float32BufferAttribute(col, 3));
+  groups.field.add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true })));
+  render();
+}
 async function showFrames() {
   if (!meshData) { status('open a mesh first', true); return; }
   try {
     const t0 = performance.now();
-    const r = await (await post(`/api/mesh/frames?mesh=${meshData.id}`, { sketch: sketchJson() })).json();
-    clearGroup('field');
-    const cols = [[0.85, 0.15, 0.1], [0.1, 0.6, 0.15], [0.1, 0.3, 0.9]];
-    const pos = [], col = [];
-    const h = diag() * 0.02;
-    for (const f of r.frames) {
-      for (let a = 0; a < 3; a++) {
-        const ax = f.axes[a];
-        pos.push(...f.p, f.p[0] + h * ax[0], f.p[1] + h * ax[1], f.p[2] + h * ax[2]);
-        col.push(...cols[a], ...cols[a]);
-      }
+    let r;
+    if (solid) {
+      // The open solid edits its factored field (curve edits) and answers the frames.
+      r = await syncSketch(true);
+    } else {
+      r = await (await post(`/api/mesh/frames?mesh=${meshData.id}`, { sketch: sketchJson() })).json();
+      drawFrames(r);
+      timings.frames_server_ms = r.total_ms;
     }
-    const g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
-    g.setAttribute('color', new THREE.Float32BufferAttribute(col, 3));
-    groups.field.add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true })));
-    timings.frames_server_ms = r.total_ms;
     timings.frames_round_trip_ms = performance.now() - t0;
     showInfo();
-    render();
     status(`frame field: ${r.frames.length} frames, constraint error max ${r.alignment_error_max_deg.toFixed(2)}°`);
   } catch (e) { status(e.message, true); }
 }
 function sketchJson() {
-  return { curves: sketch.map((s) => ({ points: s.points, axis: s.axis })) };
+  return { curves: sketch.map((s) => (s.plane ? { points: s.points, axis: s.axis, plane: s.plane } : { points: s.points, axis: s.axis })) };
+}
+/** The reference plane from its sliders: normal (turn about y, tilt towards y) and
+ *  offset along the normal from the box centre (share of the diagonal). */
+function refPlane() {
+  const [lo, hi] = meshData.bbox;
+  const yaw = (Number($('ref-yaw').value) * Math.PI) / 180;
+  const pitch = (Number($('ref-pitch').value) * Math.PI) / 180;
+  const n = [Math.cos(pitch) * Math.sin(yaw), Math.sin(pitch), Math.cos(pitch) * Math.cos(yaw)];
+  const t = Number($('ref-pos').value) * diag();
+  const c = [0, 1, 2].map((a) => (lo[a] + hi[a]) / 2 + t * n[a]);
+  return { point: c, normal: n };
+}
+function placeRefPlane() {
+  if (!meshData) return;
+  clearGroup('ref');
+  refPlaneObj = null;
+  if (!$('ref-show').checked && !$('ref-draw').checked) { render(); return; }
+  const rp = refPlane();
+  const s = diag() * 0.8;
+  const plane = new THREE.Mesh(new THREE.PlaneGeometry(s, s), new THREE.MeshBasicMaterial({ color: 0xe07b20, transparent: true, opacity: 0.16, side: THREE.DoubleSide, depthWrite: false }));
+  plane.position.set(...rp.point);
+  plane.lookAt(rp.point[0] + rp.normal[0], rp.point[1] + rp.normal[1], rp.point[2] + rp.normal[2]);
+  const edge = new THREE.LineSegments(new THREE.EdgesGeometry(plane.geometry), new THREE.LineBasicMaterial({ color: 0xb05a10 }));
+  plane.add(edge);
+  refPlaneObj = plane;
+  groups.ref.add(plane);
+  render();
+}
+
+// ---------------------------------------------------------------- solid: the open solid
+function solidKey() {
+  return JSON.stringify([meshData.id, exemplarRef(), Number($('solid-res').value) || 64]);
+}
+/** Opens the solid on the server (exemplar analysis, frame field) unless the open one
+ *  has the same mesh, exemplar and voxels. */
+async function ensureSolid() {
+  if (!meshData) throw new Error('open a mesh first');
+  const key = solidKey();
+  if (solid && solid.key === key) return;
+  status('opening the solid (exemplar analysis)…');
+  const t0 = performance.now();
+  const body = { mesh: { root: meshData.root, path: meshData.path }, exemplar: exemplarRef(), resolution: Number($('solid-res').value) || 64 };
+  if (sketch.length) body.sketch = sketchJson();
+  const r = await (await post('/api/solid/open', body)).json();
+  solid = { id: r.id, key, sent: JSON.stringify(sketchJson()), grid: r.grid };
+  timings.solid_open_ms = performance.now() - t0;
+  timings.solid_build_server_ms = r.build_ms;
+  drawFrames(r);
+  showInfo();
+  status(`solid open: ${r.grid.sizes.join('×')} voxels, built in ${r.build_ms.toFixed(0)} ms`);
+}
+/** Sends the sketch to the open solid if it changed (or when `force`); draws the frames. */
+async function syncSketch(force = false) {
+  const text = JSON.stringify(sketchJson());
+  if (!solid || (!force && solid.sent === text)) return null;
+  const t0 = performance.now();
+  const r = await (await post(`/api/solid/sketch?solid=${solid.id}`, { sketch: sketchJson() })).json();
+  solid.sent = text;
+  timings.sketch_edit_server_ms = r.edit_ms;
+  timings.sketch_round_trip_ms = performance.now() - t0;
+  timings.frames_server_ms = r.edit_ms;
+  drawFrames(r);
+  showInfo();
+  return r;
+}
+function sketchChanged() {
+  if (solid) syncSketch().then(() => { if ($('cut-auto').checked) requestCut(); }).catch((e) => status(e.message, true));
+  else if ($('cut-auto').checked) requestCut();
+}
+/** The cut image on its plane in the 3-D view (a textured quad, transparent outside the
+ *  mesh), and the mesh clipped to the kept (negative) side of the plane. */
+function showCutInView(img, placement, plane) {
+  const old = groups.cut.getObjectByName('cut-image');
+  if (old) { groups.cut.remove(old); old.geometry.dispose(); old.material.map.dispose(); old.material.dispose(); }
+  if (placement && img.naturalWidth > 0) {
+    const [c, u, v] = placement;
+    const at = (a, b) => [0, 1, 2].map((k) => c[k] + a * u[k] + b * v[k]);
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute([...at(0, 0), ...at(1, 0), ...at(1, 1), ...at(0, 1)], 3));
+    g.setAttribute('uv', new THREE.Float32BufferAttribute([0, 1, 1, 1, 1, 0, 0, 0], 2));
+    g.setIndex([0, 1, 2, 0, 2, 3]);
+    const canvas = document.createElement('canvas');
+    canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
+    canvas.getContext('2d').drawImage(img, 0, 0);
+    const tex = new THREE.CanvasTexture(canvas);
+    tex.colorSpace = THREE.SRGBColorSpace;
+    tex.magFilter = THREE.NearestFilter;
+    const quad = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ map: tex, transparent: true, alphaTest: 0.5, side: THREE.DoubleSide }));
+    quad.name = 'cut-image';
+    groups.cut.add(quad);
+  }
+  clipMesh(plane);
+  render();
+}
+function clipMesh(plane) {
+  if (!meshObj) return;
+  renderer.localClippingEnabled = true;
+  const on = plane && $('cut-clip').checked;
+  const n = plane ? new THREE.Vector3(plane[3], plane[4], plane[5]).normalize() : null;
+  meshObj.material.clippingPlanes = on ? [new THREE.Plane(n.clone().negate(), n.dot(new THREE.Vector3(plane[0], plane[1], plane[2])))] : [];
+  meshObj.material.needsUpdate = true;
+}
+let cutBusy = false;
+let cutPending = false;
+/** Redraws the cut image from the open solid; while one cut runs, the newest plane waits. */
+async function requestCut() {
+  if (!meshData) return;
+  if (cutBusy) { cutPending = true; return; }
+  cutBusy = true;
+  try {
+    await ensureSolid();
+    await syncSketch();
+    const plane = cutPlane();
+    const t0 = performance.now();
+    const resp = await post(`/api/solid/cut?solid=${solid.id}`, { plane });
+    const blob = await resp.blob();
+    const rt = performance.now() - t0;
+    const img = $('cut-image');
+    if (img.src.startsWith('blob:')) URL.revokeObjectURL(img.src);
+    img.src = URL.createObjectURL(blob);
+    img.hidden = false;
+    await img.decode().catch(() => {});
+    showCutInView(img, JSON.parse(resp.headers.get('X-Cut-Placement') || 'null'), plane);
+    const c = {
+      round_trip_ms: rt,
+      shown_ms: performance.now() - t0,
+      server_ms: Number(resp.headers.get('X-Cut-Ms')),
+      computed: Number(resp.headers.get('X-Voxels-Computed')),
+      requested: Number(resp.headers.get('X-Voxels-Requested')),
+    };
+    if (cuts.length > 1000) cuts.shift();
+    cuts.push(c);
+    timings.cut_shown_ms = c.shown_ms;
+    timings.cut_server_ms = c.server_ms;
+    timings.cut_voxels_computed = c.computed;
+    showInfo();
+    status(`cut ${img.naturalWidth}×${img.naturalHeight}: ${c.shown_ms.toFixed(0)} ms (server ${c.server_ms.toFixed(0)} ms, ${c.computed} voxels computed)`);
+  } catch (e) { status(e.message, true); }
+  cutBusy = false;
+  if (cutPending) { cutPending = false; requestCut(); }
 }
 function cutPlane() {
   const [lo, hi] = meshData.bbox;
@@ -316,12 +492,8 @@ function placeCutPlane() {
   plane.lookAt(c[0] + c[3], c[1] + c[4], c[2] + c[5]);
   cutPlaneObj = plane;
   groups.cut.add(plane);
+  if (solid && cuts.length) clipMesh(c);
   render();
-}
-let cutTimer = null;
-function scheduleCut() {
-  clearTimeout(cutTimer);
-  cutTimer = setTimeout(() => runJob('solid'), 400);
 }
 
 // ---------------------------------------------------------------- jobs
@@ -409,9 +581,6 @@ async function onJobEnd(job) {
   status(`${job.kind} done in ${job.seconds.toFixed(1)} s`);
   await refreshLists().catch(() => {});
   if (job.kind === 'solid' && job.files.includes('cut-1.png')) {
-    const img = $('cut-image');
-    img.src = `/api/file?path=${encodeURIComponent(job.dir + '/cut-1.png')}&t=${Date.now()}`;
-    img.hidden = false;
     if (job.files.includes('cut-1.glb')) await openGlb({ root: 'workspace', path: `${job.dir}/cut-1.glb` }, false);
   } else if (job.files.includes('model.glb')) {
     await openGlb({ root: 'workspace', path: `${job.dir}/model.glb` });
@@ -559,7 +728,7 @@ async function start() {
   $('glb-open').onclick = () => $('glb-list').value && openGlb(JSON.parse($('glb-list').value));
   $('mesh-upload').onchange = () => upload($('mesh-upload'), (ref) => openMesh(ref));
   $('glb-upload').onchange = () => upload($('glb-upload'), (ref) => openGlb(ref));
-  $('clear-drawn').onclick = () => { drawn = []; sketch = []; clearGroup('drawn'); render(); };
+  $('clear-drawn').onclick = () => { drawn = []; sketch = []; clearGroup('drawn'); render(); if (mode === 'solid' && solid) sketchChanged(); };
   $('show-crest').onchange = () => { groups.crest.visible = $('show-crest').checked; render(); };
   const setAll = (v) => {
     crestUse.fill(v);
@@ -572,10 +741,14 @@ async function start() {
   $('show-field').onclick = showField;
   $('show-field-lines').onchange = () => { groups.field.visible = $('show-field-lines').checked; render(); };
   $('show-frames').onclick = showFrames;
-  $('cut-pos').oninput = placeCutPlane;
-  $('cut-axis').onchange = () => { placeCutPlane(); if ($('cut-auto').checked) scheduleCut(); };
-  $('cut-pos').onchange = () => { if ($('cut-auto').checked) scheduleCut(); };
+  $('cut-pos').oninput = () => { placeCutPlane(); if ($('cut-auto').checked && solid) requestCut(); };
+  $('cut-axis').onchange = () => { placeCutPlane(); if ($('cut-auto').checked && solid) requestCut(); };
+  $('cut-show').onclick = () => requestCut();
+  $('cut-clip').onchange = () => { if (meshData) clipMesh(cuts.length ? cutPlane() : null); render(); };
+  $('solid-open').onclick = () => ensureSolid().catch((e) => status(e.message, true));
   $('cut-now').onclick = () => runJob('solid');
+  for (const id of ['ref-show', 'ref-draw', 'ref-pos', 'ref-yaw', 'ref-pitch']) $(id).oninput = placeRefPlane;
+  for (const id of ['ref-show', 'ref-draw']) $(id).onchange = placeRefPlane;
   $('run').onclick = () => runJob(mode);
   for (const r of document.querySelectorAll('input[name=display]')) r.onchange = applyDisplay;
   const jobs = await (await fetch('/api/jobs')).json().catch(() => ({ jobs: [] }));

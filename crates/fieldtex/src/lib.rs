@@ -41,6 +41,7 @@ pub use pipelines::inspect::{RepairCommandOptions, RepairSummary, inspect_file, 
 pub use pipelines::orient::{DesignedSingularity, FieldSource, OrientOptions, orient};
 pub use pipelines::render::{RenderCommandOptions, render_file};
 pub use pipelines::solid::{SolidGrid, SolidOptions, solid, solid_frame_field};
+pub use pipelines::solid_session::{SketchEdit, SolidCut, SolidSession};
 pub use pipelines::synthesis::AnalysisCache;
 pub use pipelines::transfer as pipelines_transfer;
 pub use pipelines::transfer::{TransferCommandOptions, transfer_files};

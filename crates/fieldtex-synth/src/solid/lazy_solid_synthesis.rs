@@ -109,6 +109,16 @@ pub struct SolidSynthesizer<'a> {
     cache: Vec<LevelCache>,
 }
 
+/// The computed blocks of a [`SolidSynthesizer`], detached from its borrows
+/// ([`SolidSynthesizer::into_cache`]) so that a caller that owns the exemplar and the
+/// frame field can keep the work between requests and hand it to the next
+/// synthesizer over the same exemplar, lattice, frames and options
+/// ([`SolidSynthesizer::with_cache`]); with anything else changed, drop it.
+#[derive(Default)]
+pub struct SolidCache {
+    levels: Vec<LevelCache>,
+}
+
 struct Counts {
     corrections: u64,
     evaluations: u64,
@@ -152,6 +162,21 @@ impl<'a> SolidSynthesizer<'a> {
             options,
             cache: (0..levels).map(|_| LevelCache::default()).collect(),
         })
+    }
+
+    /// The cached blocks, for [`Self::with_cache`] on a later synthesizer.
+    pub fn into_cache(self) -> SolidCache {
+        SolidCache { levels: self.cache }
+    }
+
+    /// This synthesizer with `cache`'s blocks, which must come from one over the same
+    /// exemplar, lattice, frames and options (then every voxel keeps its value); a
+    /// cache of another level count is ignored.
+    pub fn with_cache(mut self, cache: SolidCache) -> Self {
+        if cache.levels.len() == self.cache.len() {
+            self.cache = cache.levels;
+        }
+        self
     }
 
     /// The lattice placement.

@@ -37,6 +37,6 @@ pub mod voxel_lattice;
 mod tests;
 
 pub use candidate_triples::{CandidateTriples, Triple};
-pub use lazy_solid_synthesis::{LevelStats, SolidSynthesisOptions, SolidSynthesizer};
+pub use lazy_solid_synthesis::{LevelStats, SolidCache, SolidSynthesisOptions, SolidSynthesizer};
 pub use solid_exemplar::{SolidAnalysisOptions, SolidExemplar};
 pub use voxel_lattice::{ConstantFrame, FrameSource, VoxelLattice};

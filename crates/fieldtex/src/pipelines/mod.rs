@@ -13,6 +13,7 @@ pub(crate) mod orient_patch;
 pub mod render;
 pub(crate) mod repair_stage;
 pub mod solid;
+pub mod solid_session;
 pub(crate) mod synthesis;
 pub mod transfer;
 pub mod transfer_fidelity;

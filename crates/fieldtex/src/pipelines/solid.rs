@@ -35,10 +35,12 @@ use std::time::Instant;
 
 #[path = "solid_outputs.rs"]
 mod extra_outputs;
+pub(crate) use extra_outputs::{CutVoxels, cut_voxels, slice_image};
 use extra_outputs::{write_cut, write_frames, write_volume};
 #[path = "solid_regions.rs"]
 mod regions;
-use regions::{Interior, SolidRegions};
+use regions::Interior;
+pub(crate) use regions::SolidRegions;
 
 /// Options of [`solid`].
 #[derive(Debug, Clone, Serialize)]
@@ -109,7 +111,7 @@ pub struct SolidGrid {
 }
 
 impl SolidGrid {
-    fn over_box(min: [f64; 3], max: [f64; 3], resolution: usize) -> Self {
+    pub(crate) fn over_box(min: [f64; 3], max: [f64; 3], resolution: usize) -> Self {
         let ext: [f64; 3] = std::array::from_fn(|a| max[a] - min[a]);
         let longest = ext.iter().cloned().fold(0.0, f64::max).max(1e-12);
         let spacing = longest / resolution as f64;
@@ -127,7 +129,7 @@ impl SolidGrid {
 }
 
 /// The frame field as the synthesis sees it (rotation matrices).
-struct FieldFrames<'a>(Option<&'a FrameField3d>);
+pub(crate) struct FieldFrames<'a>(pub Option<&'a FrameField3d>);
 
 impl FrameSource for FieldFrames<'_> {
     fn frame(&self, p: [f64; 3]) -> [f64; 9] {
@@ -145,10 +147,10 @@ fn rgb8(c: [f32; 3]) -> [u8; 3] {
 
 /// Running totals of the synthesis work, for the report.
 #[derive(Default, Serialize)]
-struct Work {
-    requested: u64,
+pub(crate) struct Work {
+    pub(crate) requested: u64,
     computed_finest: u64,
-    computed_all_levels: u64,
+    pub(crate) computed_all_levels: u64,
     corrections: u64,
     seconds: f64,
 }
@@ -325,7 +327,10 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     Ok(report)
 }
 
-fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, Vec<PathBuf>)> {
+pub(crate) fn read_inputs(
+    options: &SolidOptions,
+    report: &mut Report,
+) -> Result<(TriMesh, Vec<PathBuf>)> {
     let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
     let repaired =
@@ -348,7 +353,7 @@ fn read_inputs(options: &SolidOptions, report: &mut Report) -> Result<(TriMesh, 
 }
 
 /// The three plane exemplars, and whether they all came from `--exemplar`.
-fn read_exemplars(options: &SolidOptions) -> Result<([Image; 3], bool)> {
+pub(crate) fn read_exemplars(options: &SolidOptions) -> Result<([Image; 3], bool)> {
     let planes = [&options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx];
     let mut out = Vec::with_capacity(3);
     let mut cache: Vec<(PathBuf, Image)> = Vec::new();
@@ -402,8 +407,6 @@ pub fn solid_frame_field(
     field_cells: usize,
 ) -> Result<(FrameField3d, Vec<fieldtex_fields::FrameCurve>)> {
     let path = sketch;
-    let bbox =
-        mesh.bounding_box().ok_or_else(|| Error::bad_input(None, "the mesh has no vertex"))?;
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::bad_input(Some(path), format!("cannot read the sketch: {e}")))?;
     let sketch: Sketch = serde_json::from_str(&text).map_err(|e| {
@@ -412,14 +415,25 @@ pub fn solid_frame_field(
             format!("the sketch is not valid JSON for the schema in docs/solid.md: {e}"),
         )
     })?;
-    let curves =
-        sketch.frame_curves(mesh).map_err(|e| Error::bad_input(Some(path), e.to_string()))?;
+    sketch_frame_field(mesh, &sketch, field_cells, Some(path))
+}
+
+/// [`solid_frame_field`] of a sketch already in memory (`path` names it in errors).
+pub(crate) fn sketch_frame_field(
+    mesh: &TriMesh,
+    sketch: &Sketch,
+    field_cells: usize,
+    path: Option<&Path>,
+) -> Result<(FrameField3d, Vec<fieldtex_fields::FrameCurve>)> {
+    let bbox =
+        mesh.bounding_box().ok_or_else(|| Error::bad_input(None, "the mesh has no vertex"))?;
+    let curves = sketch.frame_curves(mesh).map_err(|e| Error::bad_input(path, e.to_string()))?;
     let grid = FrameGrid::over_box(bbox.min, bbox.max, field_cells)
         .map_err(|e| Error::bad_input(None, format!("--field-cells: {e}")))?;
     let mut field = FrameField3d::new(grid, FrameFieldOptions::default())
         .map_err(|e| Error::Internal(e.to_string()))?;
     for (i, c) in curves.iter().enumerate() {
-        field.add_curve(c).map_err(|e| Error::bad_input(Some(path), format!("curve {i}: {e}")))?;
+        field.add_curve(c).map_err(|e| Error::bad_input(path, format!("curve {i}: {e}")))?;
     }
     Ok((field, curves))
 }

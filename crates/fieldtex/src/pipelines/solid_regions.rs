@@ -14,7 +14,7 @@
 use super::*;
 
 /// The interior region: its synthesizer and where it starts.
-pub(super) struct Interior<'a> {
+pub(crate) struct Interior<'a> {
     pub synth: SolidSynthesizer<'a>,
     pub bvh: &'a Bvh,
     /// Depth below the surface (mesh units) of the middle of the blend band.
@@ -26,7 +26,7 @@ pub(super) struct Interior<'a> {
 }
 
 /// The outer synthesizer and, with `--interior`, the interior region.
-pub(super) struct SolidRegions<'a> {
+pub(crate) struct SolidRegions<'a> {
     pub outer: SolidSynthesizer<'a>,
     pub inner: Option<Interior<'a>>,
     pub grid: SolidGrid,
