@@ -32,6 +32,13 @@
 //! final cells; the coarse packing is valid as it stands and is kept if no finer one
 //! fits. Results do not depend on the thread count.
 //!
+//! **Small inputs** (at most [`SMALL_INPUT_TRIANGLES`] triangles in all charts, atlases
+//! of 512² texels or more): the rest of the atlas is cheap there, so the trials are
+//! what costs. The final cells are four times as large, at most 1/128 of the atlas side
+//! (8×8 texels at 1024²), the bracket runs on cells of 1/64 of the atlas side (16
+//! texels at 1024²), and the final search stops after two rounds. This costs a few
+//! points of packing efficiency (numbers in `docs/perf/atlas.md`).
+//!
 //! **Packing efficiency** (reported by the atlas) is the charts' UV triangle area in
 //! texels over the atlas area; gutters and the conservative coverage of boundary
 //! texels count as waste.
@@ -142,6 +149,10 @@ pub struct Packing {
     /// Offset in texels of chart points inside their footprint (half a cell).
     pub inset: f64,
 }
+
+/// Inputs with at most this many triangles in all charts pack on the coarser cells of
+/// the small-input shortcut (module docs).
+pub const SMALL_INPUT_TRIANGLES: usize = 2048;
 
 /// Offset of chart points inside their footprint, in texels (keeps columns ≥ 0).
 const INSET: f64 = 0.5;
@@ -365,7 +376,16 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
     // of the work per trial); its packing is valid as it stands, so it is kept as the
     // fallback, and the search then goes on at full precision on the final cells from
     // just above it, for a few rounds at most.
-    let coarse_k = 2 * fine.k;
+    // Small inputs: the packer's trials dominate the atlas's time, so they run on a
+    // coarser working raster (module docs).
+    let n_triangles: usize = charts.iter().map(|c| c.triangles.len()).sum();
+    let small = n_triangles <= SMALL_INPUT_TRIANGLES && options.resolution >= 512;
+    let (coarse_k, fine, fine_rounds) = if small {
+        let k = (4 * fine.k).min(options.resolution as i64 / 128);
+        ((options.resolution as i64 / 64).max(2 * k), CellGrid::new(options, k), 2)
+    } else {
+        (2 * fine.k, fine, 3)
+    };
     if options.resolution as i64 / coarse_k >= 64 {
         let coarse = CellGrid::new(options, coarse_k);
         search_scale(
@@ -383,7 +403,17 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
             state.hi = upper * (1.0 + 1e-9);
             state.guess = lo.scale * 1.03;
         }
-        search_scale(charts, &outlines, &origins, &order, options, fine, &mut state, tol, 3);
+        search_scale(
+            charts,
+            &outlines,
+            &origins,
+            &order,
+            options,
+            fine,
+            &mut state,
+            tol,
+            fine_rounds,
+        );
     } else {
         search_scale(charts, &outlines, &origins, &order, options, fine, &mut state, tol, 40);
     }
