@@ -32,12 +32,14 @@
 //! final cells; the coarse packing is valid as it stands and is kept if no finer one
 //! fits. Results do not depend on the thread count.
 //!
-//! **Small inputs** (at most [`SMALL_INPUT_TRIANGLES`] triangles in all charts, atlases
-//! of 512² texels or more): the rest of the atlas is cheap there, so the trials are
-//! what costs. The final cells are four times as large, at most 1/128 of the atlas side
-//! (8×8 texels at 1024²), the bracket runs on cells of 1/64 of the atlas side (16
-//! texels at 1024²), and the final search stops after two rounds. This costs a few
-//! points of packing efficiency (numbers in `docs/perf/atlas.md`).
+//! **Few charts** (at most 16 at 1024²: [`SMALL_INPUT_CHART_SIDE`]; atlases of 512²
+//! texels or more): each trial rasterises and grows a few large footprints, and the
+//! waste of a coarse cell along a chart's outline is small against the chart's area,
+//! so the trials run on a coarser working raster. The final cells are four times as
+//! large, at most 1/128 of the atlas side (8×8 texels at 1024²), the bracket runs on
+//! cells of 1/64 of the atlas side (16 texels at 1024²), and the final search stops
+//! after two rounds. This costs a few points of packing efficiency (numbers in
+//! `docs/perf/atlas.md`).
 //!
 //! **Packing efficiency** (reported by the atlas) is the charts' UV triangle area in
 //! texels over the atlas area; gutters and the conservative coverage of boundary
@@ -150,9 +152,15 @@ pub struct Packing {
     pub inset: f64,
 }
 
-/// Inputs with at most this many triangles in all charts pack on the coarser cells of
-/// the small-input shortcut (module docs).
-pub const SMALL_INPUT_TRIANGLES: usize = 2048;
+/// Inputs whose charts would be at least this many texels wide on average (the atlas
+/// side over the square root of the chart count: at most 16 charts at 1024²) pack on
+/// the coarser cells of the small-input shortcut (module docs).
+pub const SMALL_INPUT_CHART_SIDE: f64 = 256.0;
+
+/// Footprints of at most this many cells are remembered per shape within a trial (the
+/// lowest row still worth testing; this only skips rows that cannot fit, so results
+/// are the same with or without it).
+const SHAPE_CACHE_CELLS: i64 = 4096;
 
 /// Offset of chart points inside their footprint, in texels (keeps columns ≥ 0).
 const INSET: f64 = 0.5;
@@ -272,7 +280,9 @@ fn try_pack(
             }
             // Only rows that could beat the best top edge so far.
             let oy_max = best.as_ref().map_or(i64::MAX, |(bk, _)| bk.0 - fp.h);
-            let (grown, seen) = match lowest.get(&fp) {
+            // Large footprints rarely repeat and cost to hash: only small ones are kept.
+            let cached = fp.w * fp.h <= SHAPE_CACHE_CELLS;
+            let (grown, seen) = match lowest.get(&fp).filter(|_| cached) {
                 Some((gr, row)) => (gr.clone(), *row),
                 None => (std::rc::Rc::new(fp.grow(cells.gutter)), 0),
             };
@@ -284,7 +294,9 @@ fn try_pack(
                 None if lo <= hi => hi + 1,
                 None => seen,
             };
-            lowest.insert(fp.clone(), (grown, next));
+            if cached {
+                lowest.insert(fp.clone(), (grown, next));
+            }
             if let Some((ox, oy)) = found {
                 let key = (oy + fp.h, oy, ox, k as u8);
                 if best.as_ref().is_none_or(|(bk, _)| key < *bk) {
@@ -378,8 +390,8 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
     // just above it, for a few rounds at most.
     // Small inputs: the packer's trials dominate the atlas's time, so they run on a
     // coarser working raster (module docs).
-    let n_triangles: usize = charts.iter().map(|c| c.triangles.len()).sum();
-    let small = n_triangles <= SMALL_INPUT_TRIANGLES && options.resolution >= 512;
+    let side = options.resolution as f64 / (charts.len().max(1) as f64).sqrt();
+    let small = side >= SMALL_INPUT_CHART_SIDE && options.resolution >= 512;
     let (coarse_k, fine, fine_rounds) = if small {
         let k = (4 * fine.k).min(options.resolution as i64 / 128);
         ((options.resolution as i64 / 64).max(2 * k), CellGrid::new(options, k), 2)
