@@ -500,6 +500,48 @@ mod tests {
     }
 
     #[test]
+    fn block_pattern_is_the_symmetric_vertex_graph() {
+        let mesh = fieldtex_mesh::primitives::grid(4, 3, 1.0, 1.0);
+        let graph = FaceGraph::build(&mesh);
+        let chart =
+            ChartMesh::build((0..mesh.n_triangles() as u32).collect(), &graph, &mesh.triangles);
+        // Pin local vertex 0: the others are free, numbered in order.
+        let n = chart.n_vertices;
+        let free: Vec<u32> = (0..n).map(|v| if v == 0 { u32::MAX } else { v as u32 - 1 }).collect();
+        let pat = BlockPattern::build(&chart, &free, n - 1);
+        let mut expected = vec![std::collections::BTreeSet::new(); n - 1];
+        for c in &chart.corners {
+            for &a in c {
+                for &b in c {
+                    if a != 0 && b != 0 {
+                        expected[free[a as usize] as usize].insert(free[b as usize]);
+                    }
+                }
+            }
+        }
+        for (j, want) in expected.iter().enumerate() {
+            let got = &pat.rows[pat.start[j]..pat.start[j + 1]];
+            assert_eq!(got, want.iter().copied().collect::<Vec<_>>().as_slice(), "column {j}");
+        }
+        // Block b = [uu, uv, vu, vv] lands at rows (2i, 2i+1) of columns (2j, 2j+1).
+        let blocks: Vec<[f64; 4]> = (0..pat.rows.len())
+            .map(|b| [b as f64, b as f64 + 0.25, b as f64 + 0.5, b as f64 + 0.75])
+            .collect();
+        let (start, rows) = (pat.start.clone(), pat.rows.clone());
+        let m = pat.into_matrix(&blocks).unwrap();
+        for (j, w) in start.windows(2).enumerate() {
+            for (&i, blk) in rows[w[0]..w[1]].iter().zip(&blocks[w[0]..w[1]]) {
+                let i = i as usize;
+                assert_eq!(m.get(2 * i, 2 * j), blk[0]);
+                assert_eq!(m.get(2 * i, 2 * j + 1), blk[1]);
+                assert_eq!(m.get(2 * i + 1, 2 * j), blk[2]);
+                assert_eq!(m.get(2 * i + 1, 2 * j + 1), blk[3]);
+            }
+        }
+        assert_eq!(m.nnz(), 4 * rows.len());
+    }
+
+    #[test]
     fn flat_grid_is_reproduced_up_to_similarity() {
         let mesh = fieldtex_mesh::primitives::grid(6, 4, 3.0, 2.0);
         let graph = FaceGraph::build(&mesh);
