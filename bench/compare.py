@@ -30,6 +30,8 @@ rows = [
     for name in ["avocado", "spot", "fandisk", "armadillo", "bunny", "horse", "bunny_x4", "horse_x4"]
     for row in [
         (f"atlas sweep {name} (ms)", f"atlas_sw_{name}", f"peer_xatlas_atlas_sw_{name}", "ratio<=", 0.25),
+        (f"atlas sweep {name} CPU (ms)", f"atlas_sw_{name}_cpu", f"peer_xatlas_atlas_sw_{name}_cpu", "ratio<=", 0.25),
+        (f"atlas sweep {name} area distortion", f"atlas_sw_{name}_area_distortion", None, "value<=", 1.5),
         (f"atlas sweep {name} charts", f"atlas_sw_{name}_charts", f"peer_xatlas_atlas_sw_{name}_charts", "vs_peer<=", None),
         (f"atlas sweep {name} packing", f"atlas_sw_{name}_packing", f"peer_xatlas_atlas_sw_{name}_packing", "vs_peer>=", None),
         (f"atlas sweep {name} flipped triangles", f"atlas_sw_{name}_flips", None, "value<=", 0),

@@ -107,10 +107,12 @@ for spec in "${specs[@]}"; do
   name=${spec%%=*}; file=${spec#*=}
   runs=3; [ "$(grep -c '^f ' "$file")" -gt 50000 ] && runs=1
   [ -n "$quick" ] && runs=1
+  echo "# load before sw_$name: $(cut -d' ' -f1-3 /proc/loadavg)"
   run "$ex/bench_atlas" "$file" 1024 4 "$runs" --atlas-only --name "sw_$name"
 done
 if [ "$peers" = 1 ]; then
   [ "$sweep_only" = 1 ] && bench/setup_peers.sh
+  echo "# load before the xatlas sweep: $(cut -d' ' -f1-3 /proc/loadavg)"
   run bench/.venv/bin/python bench/peers.py $quick --atlas-sweep "${specs[@]/#/sw_}"
 fi
 python3 bench/compare.py bench/results/latest.json < "$log"

@@ -17,14 +17,28 @@ pub(crate) struct Footprint {
 }
 
 /// A footprint grown by the gutter, as spans per row: row `k` is footprint row
-/// `y0 + k`; `need[k]` is the length of its longest span; `by_need` lists the rows
-/// from the widest to the narrowest (ties by row).
+/// `y0 + k` (its spans are `spans[start[k]..start[k + 1]]`, one allocation for all
+/// rows); `need[k]` is the length of its longest span; `by_need` lists the rows from
+/// the widest to the narrowest (ties by row).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Grown {
     pub y0: i64,
-    pub rows: Vec<Vec<(i64, i64)>>,
+    spans: Vec<(i64, i64)>,
+    start: Vec<u32>,
     pub need: Vec<i64>,
     pub by_need: Vec<u32>,
+}
+
+impl Grown {
+    /// Number of rows.
+    pub fn n_rows(&self) -> usize {
+        self.need.len()
+    }
+
+    /// Spans of row `k`.
+    pub fn row(&self, k: usize) -> &[(i64, i64)] {
+        &self.spans[self.start[k] as usize..self.start[k + 1] as usize]
+    }
 }
 
 /// Sets bits `a..=b` of a row.
@@ -289,10 +303,12 @@ impl Footprint {
         let n = h + 2 * g as usize;
         let mut grown = Grown {
             y0: -g,
-            rows: Vec::with_capacity(n),
+            spans: Vec::with_capacity(2 * n),
+            start: Vec::with_capacity(n + 1),
             need: Vec::with_capacity(n),
             by_need: Vec::new(),
         };
+        grown.start.push(0);
         let mut acc = vec![0u64; sg];
         for k in 0..n as i64 {
             let y = k - g;
@@ -307,10 +323,11 @@ impl Footprint {
                     *a |= b;
                 }
             }
-            let mut row = Vec::new();
-            row_runs(&acc, wg, -g, &mut row);
+            let first = grown.spans.len();
+            row_runs(&acc, wg, -g, &mut grown.spans);
+            let row = &grown.spans[first..];
             grown.need.push(row.iter().map(|&(a, b)| b - a + 1).max().unwrap_or(0));
-            grown.rows.push(row);
+            grown.start.push(grown.spans.len() as u32);
         }
         grown.by_need = (0..n as u32).collect();
         grown.by_need.sort_by_key(|&r| (std::cmp::Reverse(grown.need[r as usize]), r));
@@ -385,8 +402,9 @@ mod tests {
         assert_eq!((f.w, f.h), (1, 1));
         let g = f.grow(2.0);
         assert_eq!(g.y0, -2);
+        let rows: Vec<Vec<(i64, i64)>> = (0..g.n_rows()).map(|k| g.row(k).to_vec()).collect();
         assert_eq!(
-            g.rows,
+            rows,
             vec![vec![(0, 0)], vec![(-1, 1)], vec![(-2, 2)], vec![(-1, 1)], vec![(0, 0)]]
         );
         assert_eq!(g.need, vec![1, 3, 5, 3, 1]);

@@ -33,6 +33,11 @@
 //! 6. **Disk guarantee.** Every chart whose Euler characteristic is not 1 (see
 //!    [`crate::chart_topology`]) is split in two by a farthest-pair flood, repeatedly.
 //!
+//! Steps 1–3 work on planar units ([`crate::planar_units`]: connected groups of
+//! at most 8 triangles within 0.01° of one plane, one unit per triangle elsewhere), with a unit's
+//! area-weighted normal and centroid in the cost and its perimeter in `β`; steps 4–6
+//! work on triangles.
+//!
 //! Charts follow chart adjacency ([`crate::face_graph`]): they never cross a
 //! non-manifold or inconsistently oriented edge, nor a gap between components.
 //! Not implemented: feature-curve detection (Lévy et al. §3) and texture-seam costs.
@@ -40,6 +45,7 @@
 use crate::chart_merging::merge_small_charts;
 use crate::chart_topology::{ChartMesh, split_in_two};
 use crate::face_graph::{FaceGraph, NONE};
+use crate::planar_units::Units;
 use fieldtex_core::vec3::{self, V3};
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
@@ -111,10 +117,12 @@ pub fn segment_charts(
     let cos_max = theta.cos();
     let w = options.compactness_weight.max(0.0);
     let total_area: f64 = graph.areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+    let units = Units::build(graph);
 
-    let ctx = GrowCtx { graph, cos_max, w, wb: options.boundary_weight.max(0.0), total_area };
+    let ctx =
+        GrowCtx { units: &units, cos_max, w, wb: options.boundary_weight.max(0.0), total_area };
     let mut proxies: Vec<Proxy> = Vec::new();
-    let mut assign = vec![NONE; nf];
+    let mut assign = vec![NONE; units.n_units()];
     let mut budget = MAX_SEEDING_ROUNDS;
     seed_uncovered(&ctx, &mut assign, &mut proxies, &mut budget);
     for _ in 0..options.lloyd_iterations {
@@ -132,6 +140,7 @@ pub fn segment_charts(
             next += 1;
         }
     }
+    let assign: Vec<u32> = units.unit_of_face.iter().map(|&u| assign[u as usize]).collect();
     let mut charts = collect_charts(&assign);
     for _ in 0..options.smoothing_passes {
         smooth_boundaries(graph, &mut charts, cos_max);
@@ -144,9 +153,10 @@ pub fn segment_charts(
 /// Upper bound on seeding rounds (each adds at least one chart).
 const MAX_SEEDING_ROUNDS: usize = 200;
 
-/// What chart growing needs besides the proxies.
+/// What chart growing needs besides the proxies. Growing, seeding and the Lloyd
+/// steps work on planar units ([`crate::planar_units`]); `assign` is per unit there.
 struct GrowCtx<'a> {
-    graph: &'a FaceGraph,
+    units: &'a Units,
     cos_max: f64,
     w: f64,
     wb: f64,
@@ -160,13 +170,13 @@ impl GrowCtx<'_> {
     }
 }
 
-/// Adds charts for uncovered regions and grows them into uncovered triangles only,
+/// Adds charts for uncovered regions and grows them into uncovered units only,
 /// until no region qualifies (see [`seeds_for_uncovered`]) or the budget is spent.
 fn seed_uncovered(ctx: &GrowCtx, assign: &mut [u32], proxies: &mut Vec<Proxy>, budget: &mut usize) {
     while *budget > 0 {
         let r2 = ctx.r2(proxies.len());
         let mean_area = ctx.total_area / proxies.len().max(1) as f64;
-        let new = seeds_for_uncovered(ctx.graph, assign, ctx.w, r2, 0.1 * mean_area);
+        let new = seeds_for_uncovered(ctx.units, assign, ctx.w, r2, 0.1 * mean_area);
         if new.is_empty() {
             break;
         }
@@ -177,10 +187,10 @@ fn seed_uncovered(ctx: &GrowCtx, assign: &mut [u32], proxies: &mut Vec<Proxy>, b
     }
 }
 
-/// Best-first growth of the proxies in `active` through uncovered triangles under the
-/// normal-cone limit; triangles already assigned stay where they are.
+/// Best-first growth of the proxies in `active` through uncovered units under the
+/// normal-cone limit; units already assigned stay where they are.
 fn grow(ctx: &GrowCtx, proxies: &[Proxy], active: std::ops::Range<usize>, assign: &mut [u32]) {
-    let graph = ctx.graph;
+    let units = ctx.units;
     let r2 = ctx.r2(proxies.len());
     let mut heap = BinaryHeap::new();
     for c in active {
@@ -194,33 +204,32 @@ fn grow(ctx: &GrowCtx, proxies: &[Proxy], active: std::ops::Range<usize>, assign
         }
         assign[f as usize] = c;
         let p = &proxies[c as usize];
-        for &g in &graph.adj[f as usize] {
-            if g == NONE || assign[g as usize] != NONE {
+        for (g, _) in units.neighbours(f as usize) {
+            if assign[g as usize] != NONE {
                 continue;
             }
-            let d = vec3::dot(graph.normals[g as usize], p.normal);
-            if !graph.degenerate[g as usize] && d < ctx.cos_max {
+            let d = vec3::dot(units.normals[g as usize], p.normal);
+            if !units.degenerate[g as usize] && d < ctx.cos_max {
                 continue;
             }
-            let cost = face_cost(graph, g as usize, p, ctx.w, r2)
-                + ctx.wb * boundary_term(graph, assign, g as usize, c);
+            let cost = unit_cost(units, g as usize, p, ctx.w, r2)
+                + ctx.wb * boundary_term(units, assign, g as usize, c);
             heap.push(Reverse((cost.to_bits(), g, c)));
         }
     }
 }
 
-/// Change of the chart's boundary length if `f` joined chart `c`, relative to `f`'s
-/// perimeter, shifted to `[0, 2]`: 0 when all three neighbours are in `c`.
+/// Change of the chart's boundary length if unit `f` joined chart `c`, relative to
+/// `f`'s perimeter, shifted to `[0, 2]`: 0 when all its neighbours are in `c`.
 #[inline]
-fn boundary_term(graph: &FaceGraph, assign: &[u32], f: usize, c: u32) -> f64 {
-    let l = graph.edge_len[f];
-    let total = l[0] + l[1] + l[2];
+fn boundary_term(units: &Units, assign: &[u32], f: usize, c: u32) -> f64 {
+    let total = units.perimeter[f];
     if total.is_nan() || total <= 0.0 {
         return 1.0;
     }
     let mut inside = 0.0;
-    for (&g, &len) in graph.adj[f].iter().zip(&l) {
-        if g != NONE && assign[g as usize] == c {
+    for (g, len) in units.neighbours(f) {
+        if assign[g as usize] == c {
             inside += len;
         }
     }
@@ -229,13 +238,13 @@ fn boundary_term(graph: &FaceGraph, assign: &[u32], f: usize, c: u32) -> f64 {
 }
 
 #[inline]
-fn face_cost(graph: &FaceGraph, f: usize, p: &Proxy, w: f64, r2: f64) -> f64 {
-    let normal_term = if graph.degenerate[f] {
+fn unit_cost(units: &Units, f: usize, p: &Proxy, w: f64, r2: f64) -> f64 {
+    let normal_term = if units.degenerate[f] {
         0.0
     } else {
-        (1.0 - vec3::dot(graph.normals[f], p.normal)).max(0.0)
+        (1.0 - vec3::dot(units.normals[f], p.normal)).max(0.0)
     };
-    let d2 = vec3::norm2(vec3::sub(graph.centroids[f], p.center));
+    let d2 = vec3::norm2(vec3::sub(units.centroids[f], p.center));
     let c = normal_term + w * d2 / r2;
     if c.is_finite() { c.max(0.0) } else { f64::MAX }
 }
@@ -244,32 +253,29 @@ fn face_cost(graph: &FaceGraph, f: usize, p: &Proxy, w: f64, r2: f64) -> f64 {
 /// (or that touch no chart at all, i.e. whole components). The largest region always
 /// qualifies when it is at least a tenth of `min_area`.
 fn seeds_for_uncovered(
-    graph: &FaceGraph,
+    units: &Units,
     assign: &[u32],
     w: f64,
     r2: f64,
     min_area: f64,
 ) -> Vec<Proxy> {
-    let nf = graph.n_faces();
-    let mut seen = vec![false; nf];
+    let nu = units.n_units();
+    let mut seen = vec![false; nu];
     let mut regions: Vec<(Vec<u32>, f64, bool)> = Vec::new();
     let mut stack = Vec::new();
-    for s in 0..nf {
+    for s in 0..nu {
         if seen[s] || assign[s] != NONE {
             continue;
         }
         seen[s] = true;
         stack.push(s as u32);
-        let mut faces = Vec::new();
+        let mut members = Vec::new();
         let mut area = 0.0;
         let mut touches = false;
         while let Some(f) = stack.pop() {
-            faces.push(f);
-            area += graph.areas[f as usize];
-            for &g in &graph.adj[f as usize] {
-                if g == NONE {
-                    continue;
-                }
+            members.push(f);
+            area += units.areas[f as usize];
+            for (g, _) in units.neighbours(f as usize) {
                 if assign[g as usize] != NONE {
                     touches = true;
                 } else if !seen[g as usize] {
@@ -278,7 +284,7 @@ fn seeds_for_uncovered(
                 }
             }
         }
-        regions.push((faces, area, touches));
+        regions.push((members, area, touches));
     }
     let largest = regions
         .iter()
@@ -286,48 +292,51 @@ fn seeds_for_uncovered(
         .max_by(|a, b| a.1.1.total_cmp(&b.1.1).then(b.0.cmp(&a.0)))
         .map(|(i, _)| i);
     let mut out = Vec::new();
-    for (k, (faces, area, touches)) in regions.iter().enumerate() {
+    for (k, (members, area, touches)) in regions.iter().enumerate() {
         let qualifies =
             !*touches || *area >= min_area || (Some(k) == largest && *area >= 0.1 * min_area);
         if qualifies {
-            out.push(proxy_for(graph, faces, w, r2, None));
+            out.push(proxy_for(units, members, w, r2, None));
         }
     }
     out
 }
 
-/// The proxy of a set of faces: mean normal and centroid, seed at the cheapest face.
+/// The proxy of a set of units: mean normal and centroid, seed at the cheapest unit.
 /// When the mean normal vanishes (a closed part) the `fallback` normal or the largest
-/// face's normal is used.
-fn proxy_for(graph: &FaceGraph, faces: &[u32], w: f64, r2: f64, fallback: Option<V3>) -> Proxy {
+/// unit's normal is used.
+fn proxy_for(units: &Units, members: &[u32], w: f64, r2: f64, fallback: Option<V3>) -> Proxy {
     let mut nsum = [0.0; 3];
     let mut csum = [0.0; 3];
     let mut area = 0.0;
-    for &f in faces {
-        let a = graph.areas[f as usize];
-        nsum = vec3::add(nsum, vec3::scale(graph.normals[f as usize], a));
-        csum = vec3::add(csum, vec3::scale(graph.centroids[f as usize], a));
+    for &f in members {
+        let a = units.areas[f as usize];
+        nsum = vec3::add(nsum, vec3::scale(units.normals[f as usize], a));
+        csum = vec3::add(csum, vec3::scale(units.centroids[f as usize], a));
         area += a;
     }
-    let center =
-        if area > 0.0 { vec3::scale(csum, 1.0 / area) } else { graph.centroids[faces[0] as usize] };
+    let center = if area > 0.0 {
+        vec3::scale(csum, 1.0 / area)
+    } else {
+        units.centroids[members[0] as usize]
+    };
     let normal = match vec3::normalize(nsum) {
         Some(n) if vec3::norm(nsum) > 0.2 * area => n,
         _ => fallback.unwrap_or_else(|| {
-            let big = faces
+            let big = members
                 .iter()
                 .copied()
                 .max_by(|&a, &b| {
-                    graph.areas[a as usize].total_cmp(&graph.areas[b as usize]).then(b.cmp(&a))
+                    units.areas[a as usize].total_cmp(&units.areas[b as usize]).then(b.cmp(&a))
                 })
-                .unwrap_or(faces[0]);
-            graph.normals[big as usize]
+                .unwrap_or(members[0]);
+            units.normals[big as usize]
         }),
     };
-    let mut p = Proxy { seed: faces[0], normal, center };
+    let mut p = Proxy { seed: members[0], normal, center };
     let mut best = f64::INFINITY;
-    for &f in faces {
-        let c = face_cost(graph, f as usize, &p, w, r2);
+    for &f in members {
+        let c = unit_cost(units, f as usize, &p, w, r2);
         if c < best {
             best = c;
             p.seed = f;
@@ -337,7 +346,7 @@ fn proxy_for(graph: &FaceGraph, faces: &[u32], w: f64, r2: f64, fallback: Option
 }
 
 fn lloyd_update(ctx: &GrowCtx, assign: &[u32], proxies: &[Proxy]) -> Vec<Proxy> {
-    let (graph, w, r2) = (ctx.graph, ctx.w, ctx.r2(proxies.len()));
+    let (units, w, r2) = (ctx.units, ctx.w, ctx.r2(proxies.len()));
     let mut members: Vec<Vec<u32>> = vec![Vec::new(); proxies.len()];
     for (f, &c) in assign.iter().enumerate() {
         if c != NONE {
@@ -348,22 +357,22 @@ fn lloyd_update(ctx: &GrowCtx, assign: &[u32], proxies: &[Proxy]) -> Vec<Proxy> 
         .iter()
         .zip(proxies)
         .filter(|(m, _)| !m.is_empty())
-        .map(|(m, p)| proxy_for(graph, m, w, r2, Some(p.normal)))
+        .map(|(m, p)| proxy_for(units, m, w, r2, Some(p.normal)))
         .collect()
 }
 
-/// Assigns uncovered faces to neighbouring charts, best first, without the cone limit.
+/// Assigns uncovered units to neighbouring charts, best first, without the cone limit.
 fn absorb_uncovered(ctx: &GrowCtx, assign: &mut [u32], proxies: &[Proxy]) {
-    let (graph, w, r2) = (ctx.graph, ctx.w, ctx.r2(proxies.len()));
+    let (units, w, r2) = (ctx.units, ctx.w, ctx.r2(proxies.len()));
     let mut heap = BinaryHeap::new();
-    for f in 0..graph.n_faces() {
+    for f in 0..units.n_units() {
         if assign[f] == NONE {
             continue;
         }
-        for &g in &graph.adj[f] {
-            if g != NONE && assign[g as usize] == NONE {
+        for (g, _) in units.neighbours(f) {
+            if assign[g as usize] == NONE {
                 let c = assign[f];
-                let cost = face_cost(graph, g as usize, &proxies[c as usize], w, r2);
+                let cost = unit_cost(units, g as usize, &proxies[c as usize], w, r2);
                 heap.push(Reverse((cost.to_bits(), g, c)));
             }
         }
@@ -373,9 +382,9 @@ fn absorb_uncovered(ctx: &GrowCtx, assign: &mut [u32], proxies: &[Proxy]) {
             continue;
         }
         assign[f as usize] = c;
-        for &g in &graph.adj[f as usize] {
-            if g != NONE && assign[g as usize] == NONE {
-                let cost = face_cost(graph, g as usize, &proxies[c as usize], w, r2);
+        for (g, _) in units.neighbours(f as usize) {
+            if assign[g as usize] == NONE {
+                let cost = unit_cost(units, g as usize, &proxies[c as usize], w, r2);
                 heap.push(Reverse((cost.to_bits(), g, c)));
             }
         }

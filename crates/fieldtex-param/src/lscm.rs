@@ -117,7 +117,8 @@ pub fn lscm(
     let mean_area: f64 = chart.faces.iter().map(|&f| graph.areas[f as usize]).sum::<f64>()
         / chart.faces.len() as f64;
     let floor = (1e-6 * mean_area).max(f64::MIN_POSITIVE);
-    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(chart.faces.len() * 36);
+    let pattern = BlockPattern::build(chart, &free, nfree as usize);
+    let mut blocks = vec![[0.0f64; 4]; pattern.rows.len()];
     let mut rhs = vec![0.0; m];
     for (lf, &f) in chart.faces.iter().enumerate() {
         let z = local_corners(mesh.triangle_positions(f as usize));
@@ -158,11 +159,22 @@ pub fn lscm(
                 }
             }
         }
+        // Entries are added in the order a triplet list would sum them (face by face,
+        // row-major within a face), so the matrix is the same to the last bit.
+        let mut bidx = [[0usize; 3]; 3];
+        for k in 0..3 {
+            for l in 0..3 {
+                if let (Some(gk), Some(gl)) = (gidx[2 * k], gidx[2 * l]) {
+                    bidx[k][l] = pattern.find(gl / 2, gk / 2);
+                }
+            }
+        }
         for i in 0..6 {
             let Some(gi) = gidx[i] else { continue };
             for j in 0..6 {
                 let Some(gj) = gidx[j] else { continue };
-                trip.push((gi, gj, rows[0][i] * rows[0][j] + rows[1][i] * rows[1][j]));
+                blocks[bidx[i / 2][j / 2]][2 * (gi % 2) + gj % 2] +=
+                    rows[0][i] * rows[0][j] + rows[1][i] * rows[1][j];
             }
         }
     }
@@ -170,7 +182,7 @@ pub fn lscm(
     uv[pa] = [0.0, 0.0];
     uv[pb] = [dist, 0.0];
     if m > 0 {
-        let a = SparseMatrix::from_triplets(m, m, &trip)?;
+        let a = pattern.into_matrix(&blocks)?;
         let chol = Cholesky::factor(&a)?;
         let x = chol.solve(&rhs)?;
         for v in 0..n {
@@ -182,6 +194,96 @@ pub fn lscm(
     }
     orient_positive(chart, &mut uv);
     Ok(uv)
+}
+
+/// Sparsity of the LSCM normal matrix by free-vertex pairs: for block column `j` (a
+/// free vertex), the free vertices `rows[start[j]..start[j + 1]]` (ascending, `j`
+/// included) that share a triangle with it. Each pair is a 2 × 2 block of scalar
+/// entries (`u`, `v` interleaved), so the matrix is written as CSC directly instead of
+/// through 36 triplets per triangle and a sort.
+struct BlockPattern {
+    start: Vec<usize>,
+    rows: Vec<u32>,
+}
+
+impl BlockPattern {
+    fn build(chart: &ChartMesh, free: &[u32], nfree: usize) -> Self {
+        let mut count = vec![0usize; nfree + 1];
+        for c in &chart.corners {
+            for &a in c {
+                if free[a as usize] != u32::MAX {
+                    count[free[a as usize] as usize + 1] += 3;
+                }
+            }
+        }
+        for j in 0..nfree {
+            count[j + 1] += count[j];
+        }
+        let mut rows = vec![0u32; count[nfree]];
+        let mut next = count.clone();
+        for c in &chart.corners {
+            for &a in c {
+                let fa = free[a as usize];
+                if fa == u32::MAX {
+                    continue;
+                }
+                for &b in c {
+                    let fb = free[b as usize];
+                    if fb != u32::MAX {
+                        rows[next[fa as usize]] = fb;
+                        next[fa as usize] += 1;
+                    }
+                }
+            }
+        }
+        // Sort and deduplicate each column in place, compacting as we go.
+        let mut start = Vec::with_capacity(nfree + 1);
+        start.push(0);
+        let mut out = 0;
+        for j in 0..nfree {
+            let (lo, hi) = (count[j], next[j]);
+            rows[lo..hi].sort_unstable();
+            let col_start = out;
+            for k in lo..hi {
+                if out == col_start || rows[out - 1] != rows[k] {
+                    rows[out] = rows[k];
+                    out += 1;
+                }
+            }
+            start.push(out);
+        }
+        rows.truncate(out);
+        Self { start, rows }
+    }
+
+    /// Index of block (row vertex `i`, column vertex `j`).
+    #[inline]
+    fn find(&self, j: usize, i: usize) -> usize {
+        let col = &self.rows[self.start[j]..self.start[j + 1]];
+        self.start[j] + col.iter().position(|&r| r as usize == i).expect("pattern has the pair")
+    }
+
+    /// The `2n × 2n` matrix; `blocks[b]` is `[uu, uv, vu, vv]` of block `b` (row part
+    /// first).
+    fn into_matrix(self, blocks: &[[f64; 4]]) -> Result<SparseMatrix, LinalgError> {
+        let n = self.start.len() - 1;
+        let mut col_ptr = Vec::with_capacity(2 * n + 1);
+        let mut row_idx = Vec::with_capacity(4 * self.rows.len());
+        let mut values = Vec::with_capacity(4 * self.rows.len());
+        col_ptr.push(0);
+        for j in 0..n {
+            for c in 0..2 {
+                let col = self.start[j]..self.start[j + 1];
+                for (&i, blk) in self.rows[col.clone()].iter().zip(&blocks[col]) {
+                    let i = i as usize;
+                    row_idx.extend([2 * i, 2 * i + 1]);
+                    values.extend([blk[c], blk[2 + c]]);
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        SparseMatrix::from_csc(2 * n, 2 * n, col_ptr, row_idx, values)
+    }
 }
 
 /// Orthographic projection onto the plane orthogonal to the chart's mean normal.
@@ -395,6 +497,48 @@ mod tests {
         assert!(segments_intersect([0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [1.0, 0.0]));
         assert!(!segments_intersect([0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]));
         assert!(segments_intersect([0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [1.0, 1.0]));
+    }
+
+    #[test]
+    fn block_pattern_is_the_symmetric_vertex_graph() {
+        let mesh = fieldtex_mesh::primitives::grid(4, 3, 1.0, 1.0);
+        let graph = FaceGraph::build(&mesh);
+        let chart =
+            ChartMesh::build((0..mesh.n_triangles() as u32).collect(), &graph, &mesh.triangles);
+        // Pin local vertex 0: the others are free, numbered in order.
+        let n = chart.n_vertices;
+        let free: Vec<u32> = (0..n).map(|v| if v == 0 { u32::MAX } else { v as u32 - 1 }).collect();
+        let pat = BlockPattern::build(&chart, &free, n - 1);
+        let mut expected = vec![std::collections::BTreeSet::new(); n - 1];
+        for c in &chart.corners {
+            for &a in c {
+                for &b in c {
+                    if a != 0 && b != 0 {
+                        expected[free[a as usize] as usize].insert(free[b as usize]);
+                    }
+                }
+            }
+        }
+        for (j, want) in expected.iter().enumerate() {
+            let got = &pat.rows[pat.start[j]..pat.start[j + 1]];
+            assert_eq!(got, want.iter().copied().collect::<Vec<_>>().as_slice(), "column {j}");
+        }
+        // Block b = [uu, uv, vu, vv] lands at rows (2i, 2i+1) of columns (2j, 2j+1).
+        let blocks: Vec<[f64; 4]> = (0..pat.rows.len())
+            .map(|b| [b as f64, b as f64 + 0.25, b as f64 + 0.5, b as f64 + 0.75])
+            .collect();
+        let (start, rows) = (pat.start.clone(), pat.rows.clone());
+        let m = pat.into_matrix(&blocks).unwrap();
+        for (j, w) in start.windows(2).enumerate() {
+            for (&i, blk) in rows[w[0]..w[1]].iter().zip(&blocks[w[0]..w[1]]) {
+                let i = i as usize;
+                assert_eq!(m.get(2 * i, 2 * j), blk[0]);
+                assert_eq!(m.get(2 * i, 2 * j + 1), blk[1]);
+                assert_eq!(m.get(2 * i + 1, 2 * j), blk[2]);
+                assert_eq!(m.get(2 * i + 1, 2 * j + 1), blk[3]);
+            }
+        }
+        assert_eq!(m.nnz(), 4 * rows.len());
     }
 
     #[test]

@@ -32,6 +32,15 @@
 //! final cells; the coarse packing is valid as it stands and is kept if no finer one
 //! fits. Results do not depend on the thread count.
 //!
+//! **Few charts** (at most 16 at 1024²: [`SMALL_INPUT_CHART_SIDE`]; atlases of 512²
+//! texels or more): each trial rasterises and grows a few large footprints, and the
+//! waste of a coarse cell along a chart's outline is small against the chart's area,
+//! so the trials run on a coarser working raster. The final cells are four times as
+//! large, at most 1/128 of the atlas side (8×8 texels at 1024²), the bracket runs on
+//! cells of 1/64 of the atlas side (16 texels at 1024²), and the final search stops
+//! after two rounds. This costs a few points of packing efficiency (numbers in
+//! `docs/perf/atlas.md`).
+//!
 //! **Packing efficiency** (reported by the atlas) is the charts' UV triangle area in
 //! texels over the atlas area; gutters and the conservative coverage of boundary
 //! texels count as waste.
@@ -142,6 +151,16 @@ pub struct Packing {
     /// Offset in texels of chart points inside their footprint (half a cell).
     pub inset: f64,
 }
+
+/// Inputs whose charts would be at least this many texels wide on average (the atlas
+/// side over the square root of the chart count: at most 16 charts at 1024²) pack on
+/// the coarser cells of the small-input shortcut (module docs).
+pub const SMALL_INPUT_CHART_SIDE: f64 = 256.0;
+
+/// Footprints of at most this many cells are remembered per shape within a trial (the
+/// lowest row still worth testing; this only skips rows that cannot fit, so results
+/// are the same with or without it).
+const SHAPE_CACHE_CELLS: i64 = 4096;
 
 /// Offset of chart points inside their footprint, in texels (keeps columns ≥ 0).
 const INSET: f64 = 0.5;
@@ -261,7 +280,9 @@ fn try_pack(
             }
             // Only rows that could beat the best top edge so far.
             let oy_max = best.as_ref().map_or(i64::MAX, |(bk, _)| bk.0 - fp.h);
-            let (grown, seen) = match lowest.get(&fp) {
+            // Large footprints rarely repeat and cost to hash: only small ones are kept.
+            let cached = fp.w * fp.h <= SHAPE_CACHE_CELLS;
+            let (grown, seen) = match lowest.get(&fp).filter(|_| cached) {
                 Some((gr, row)) => (gr.clone(), *row),
                 None => (std::rc::Rc::new(fp.grow(cells.gutter)), 0),
             };
@@ -273,7 +294,9 @@ fn try_pack(
                 None if lo <= hi => hi + 1,
                 None => seen,
             };
-            lowest.insert(fp.clone(), (grown, next));
+            if cached {
+                lowest.insert(fp.clone(), (grown, next));
+            }
             if let Some((ox, oy)) = found {
                 let key = (oy + fp.h, oy, ox, k as u8);
                 if best.as_ref().is_none_or(|(bk, _)| key < *bk) {
@@ -365,7 +388,16 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
     // of the work per trial); its packing is valid as it stands, so it is kept as the
     // fallback, and the search then goes on at full precision on the final cells from
     // just above it, for a few rounds at most.
-    let coarse_k = 2 * fine.k;
+    // Small inputs: the packer's trials dominate the atlas's time, so they run on a
+    // coarser working raster (module docs).
+    let side = options.resolution as f64 / (charts.len().max(1) as f64).sqrt();
+    let small = side >= SMALL_INPUT_CHART_SIDE && options.resolution >= 512;
+    let (coarse_k, fine, fine_rounds) = if small {
+        let k = (4 * fine.k).min(options.resolution as i64 / 128);
+        ((options.resolution as i64 / 64).max(2 * k), CellGrid::new(options, k), 2)
+    } else {
+        (2 * fine.k, fine, 3)
+    };
     if options.resolution as i64 / coarse_k >= 64 {
         let coarse = CellGrid::new(options, coarse_k);
         search_scale(
@@ -383,7 +415,17 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
             state.hi = upper * (1.0 + 1e-9);
             state.guess = lo.scale * 1.03;
         }
-        search_scale(charts, &outlines, &origins, &order, options, fine, &mut state, tol, 3);
+        search_scale(
+            charts,
+            &outlines,
+            &origins,
+            &order,
+            options,
+            fine,
+            &mut state,
+            tol,
+            fine_rounds,
+        );
     } else {
         search_scale(charts, &outlines, &origins, &order, options, fine, &mut state, tol, 40);
     }

@@ -80,7 +80,7 @@ impl Grid {
         if ox_lo > ox_hi || oy_lo > oy_hi {
             return None;
         }
-        let nrows = grown.rows.len() as i64;
+        let nrows = grown.n_rows() as i64;
         let mut feasible: Vec<(i64, i64)> = Vec::with_capacity(16);
         let mut scratch: Vec<(i64, i64)> = Vec::with_capacity(16);
         // Atlas row where the last test failed: the obstacle there usually blocks the
@@ -119,7 +119,7 @@ impl Grid {
                 if occ.is_empty() {
                     continue;
                 }
-                for &(a, b) in &grown.rows[r as usize] {
+                for &(a, b) in grown.row(r as usize) {
                     // Offsets where span [a, b] meets occupied span [p, q]: [p - b, q - a].
                     scratch.clear();
                     for &(s, e) in &feasible {

@@ -365,6 +365,26 @@ fn same_result_for_any_thread_count() {
     assert_eq!(i1, i2);
 }
 
+/// Inputs with few charts at 1024² take the packer's small-input shortcut (coarser
+/// cells): still valid, gutters kept, deterministic.
+#[test]
+fn small_input_shortcut_keeps_gutters_and_determinism() {
+    let mesh = concat(
+        &primitives::subdivide_midpoint(&primitives::icosphere(2)),
+        &translate(primitives::torus(1.0, 0.4, 16, 8), [3.0, 0.0, 0.0]),
+    );
+    let opts = AtlasOptions::default();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| build_atlas(&mesh, &opts, &NoProgress).unwrap())
+    };
+    let a = check_atlas(&mesh, &opts);
+    assert!(a.stats.charts <= 16, "not the shortcut: {:?}", a.stats);
+    assert!(a.stats.packing_efficiency > 0.45, "{:?}", a.stats);
+    assert_eq!(run(1), run(2));
+    assert_eq!(a, run(2));
+}
+
 #[test]
 fn texel_map_and_bake_round_trip() {
     let mut mesh = primitives::icosphere(3);
