@@ -37,6 +37,9 @@ pub struct ImageMetrics {
     pub rosy_seam: Option<ev::RosySeamReport>,
     /// Metrics that could not be computed, with the reason.
     pub skipped: Vec<String>,
+    /// How the nearest-patch metrics were searched and how far the approximate values
+    /// may be from the exact ones.
+    pub search: String,
 }
 
 /// Counts and positions of the singularities found in an image.
@@ -81,7 +84,10 @@ pub(crate) fn image_metrics(
         .with_approximate(approximate.clone());
     let (coherence, completeness) = ev::coherence_and_completeness(&o, &e, &popts)?;
     progress.advance(2);
-    let swo = ev::SlicedWassersteinOptions { seed, ..Default::default() };
+    // Default: the colours of a 512² output sampled on a regular sub-grid (the gap
+    // to all pixels is pinned by fieldtex-eval's tests/approximate_metrics.rs).
+    let max_pixels = (!exact).then_some(ev::color_sliced_wasserstein::SAMPLED_PIXELS);
+    let swo = ev::SlicedWassersteinOptions { seed, max_pixels, ..Default::default() };
     let color_sliced_wasserstein = ev::color_sliced_wasserstein(&o, &e, &swo)?;
     progress.advance(1);
     let mut skipped = Vec::new();
@@ -150,6 +156,24 @@ pub(crate) fn image_metrics(
         phase_defects,
         rosy_seam: None,
         skipped,
+        search: if exact {
+            "exact: exhaustive nearest-patch searches".into()
+        } else {
+            format!(
+                "approximate: coherence, completeness and guided_coherence use the approximate \
+                 nearest-patch search (one PCA basis for both images, k-d trees searched \
+                 with a bounded budget, coherent candidates, coherence queries on a step-3 \
+                 sub-grid); each is an upper bound of the exact value, \
+                 at most {}% above it on the test exemplars; color_sliced_wasserstein uses a \
+                 seeded sample of about {} pixels per image, within {} + {}% of the all-pixel \
+                 value on the test exemplars (docs/perf/orient.md); --exact-metrics for the \
+                 exhaustive versions",
+                ev::approximate_nearest_patch::ERROR_BOUND_PERCENT,
+                ev::color_sliced_wasserstein::SAMPLED_PIXELS,
+                ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_ABS,
+                ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_PERCENT,
+            )
+        },
     })
 }
 
