@@ -287,12 +287,31 @@ pub fn phase_defects(
         if !bins.contains(&(b as u16)) {
             continue;
         }
-        // Row pass: complex T(x, y) = Σ hx(d) l0(x + d, y).
+        // Row pass: complex T(x, y) = Σ hx(d) l0(x + d, y), only where the column pass
+        // below reads it (the column of a pixel of this bin, within the kernel's reach
+        // of its row): the values read are the same, the others are never computed.
+        let mut needed = vec![false; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                if bins[y * w + x] as usize == b {
+                    for j in 0..hy.len() {
+                        needed[mirror(y as isize + j as isize - r, h) * w + x] = true;
+                    }
+                }
+            }
+        }
         let mut tre = vec![0f32; w * h];
         let mut tim = vec![0f32; w * h];
         tre.par_chunks_mut(w).zip(tim.par_chunks_mut(w)).enumerate().for_each(|(y, (tr, ti))| {
+            let need = &needed[y * w..(y + 1) * w];
+            if !need.contains(&true) {
+                return;
+            }
             let padded = mirrored_row(&l0[y * w..(y + 1) * w], r as usize);
             for x in 0..w {
+                if !need[x] {
+                    continue;
+                }
                 let win = &padded[x..x + hx.len()];
                 let (mut a, mut c) = (0f32, 0f32);
                 for (&(hr, hi), &v) in hx.iter().zip(win) {
