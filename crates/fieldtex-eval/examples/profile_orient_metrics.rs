@@ -48,7 +48,17 @@ fn main() {
     let ov = ImageView::new(&o, ow, oh, 3).unwrap();
     let ev = ImageView::new(&e, ew, eh, 3).unwrap();
     let fv = FieldView::new(&f, ow, oh).unwrap();
-    let approximate = (!exact).then(ApproximateSearchOptions::default);
+    // `--search DIMS,RERANK,CHECKS` tries other approximate-search options.
+    let search = a.iter().position(|s| s == "--search").map(|i| {
+        let v: Vec<usize> = a[i + 1].split(',').map(|x| x.parse().unwrap()).collect();
+        ApproximateSearchOptions {
+            pca_dims: v[0],
+            rerank: v[1],
+            max_checks: v[2],
+            ..Default::default()
+        }
+    });
+    let approximate = (!exact).then(|| search.clone().unwrap_or_default());
     let t0 = Instant::now();
     let angle = stage("exemplar_orientation", || {
         let (angle, _) = dominant_orientation(&ev).unwrap();

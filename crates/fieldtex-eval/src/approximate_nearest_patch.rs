@@ -306,15 +306,35 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
                         node = near as usize;
                     }
                     Node::Leaf { start, end } => {
+                        // The current m-th best, refreshed only when the heap changes.
+                        let mut worst = if best.len() < m {
+                            f32::INFINITY
+                        } else {
+                            best.peek().map_or(f32::INFINITY, |b| b.0.0)
+                        };
                         for p in start as usize..end as usize {
-                            let pt = &self.points[p * k..(p + 1) * k];
-                            let d: f32 =
-                                pt.iter().zip(q.iter()).map(|(a, b)| (a - b) * (a - b)).sum();
+                            let d = if k == 12 {
+                                // The default size, unrolled (same summation order).
+                                let pt: &[f32; 12] =
+                                    self.points[p * 12..p * 12 + 12].try_into().unwrap();
+                                let mut d = 0f32;
+                                for j in 0..12 {
+                                    d += (pt[j] - q[j]) * (pt[j] - q[j]);
+                                }
+                                d
+                            } else {
+                                let pt = &self.points[p * k..(p + 1) * k];
+                                pt.iter().zip(q.iter()).map(|(a, b)| (a - b) * (a - b)).sum()
+                            };
                             if best.len() < m {
                                 best.push((OrdF32(d), p as u32));
-                            } else if d < best.peek().map_or(f32::INFINITY, |b| b.0.0) {
+                                if best.len() == m {
+                                    worst = best.peek().map_or(f32::INFINITY, |b| b.0.0);
+                                }
+                            } else if d < worst {
                                 best.pop();
                                 best.push((OrdF32(d), p as u32));
+                                worst = best.peek().map_or(f32::INFINITY, |b| b.0.0);
                             }
                         }
                         checks += (end - start) as usize;
