@@ -112,6 +112,16 @@ fn approximate_metrics_do_not_depend_on_the_thread_count() {
             .install(|| coherence_and_completeness(&o, &e, &opts).unwrap())
     };
     assert_eq!(run(1), run(2));
+    // The sampled sliced Wasserstein distance too (a sample of 2 000 of 9 216 pixels).
+    let sw = SlicedWassersteinOptions { seed: 4, max_pixels: Some(2_000), ..Default::default() };
+    let run_sw = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| color_sliced_wasserstein(&o, &e, &sw).unwrap())
+    };
+    assert_eq!(run_sw(1), run_sw(2));
 }
 
 /// The sampled colour sliced Wasserstein distance of the default reports against all
