@@ -213,7 +213,7 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
             proj
         });
         let mut order: Vec<u32> = (0..n as u32).collect();
-        index.build_node(&proj, &mut order, 0, n);
+        index.nodes = build_subtree(&proj, k, &mut order, 0);
         index.points = order
             .iter()
             .flat_map(|&i| proj[i as usize * k..(i as usize + 1) * k].iter().copied())
@@ -228,44 +228,6 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
         for (c, o) in out.iter_mut().enumerate() {
             *o = dot(&self.basis[c * dim..(c + 1) * dim], patch) - self.offset[c];
         }
-    }
-
-    /// Builds the subtree over `order[start..end]`, returns its node index.
-    fn build_node(&mut self, proj: &[f32], order: &mut [u32], start: usize, end: usize) -> u32 {
-        let k = self.k;
-        let id = self.nodes.len() as u32;
-        if end - start <= LEAF_SIZE {
-            self.nodes.push(Node::Leaf { start: start as u32, end: end as u32 });
-            return id;
-        }
-        // Widest coordinate, judged on at most 64 evenly spaced points of the node.
-        let mut best = (0usize, -1f32);
-        let step = (end - start).div_ceil(64).max(1);
-        for d in 0..k {
-            let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-            for &i in order[start..end].iter().step_by(step) {
-                let v = proj[i as usize * k + d];
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-            if hi - lo > best.1 {
-                best = (d, hi - lo);
-            }
-        }
-        let d = best.0;
-        let mid = (end - start) / 2;
-        let key = |i: &u32| (proj[*i as usize * k + d], *i);
-        order[start..end].select_nth_unstable_by(mid, |a, b| {
-            let (va, ia) = key(a);
-            let (vb, ib) = key(b);
-            va.total_cmp(&vb).then(ia.cmp(&ib))
-        });
-        let value = proj[order[start + mid] as usize * k + d];
-        self.nodes.push(Node::Leaf { start: 0, end: 0 });
-        let left = self.build_node(proj, order, start, start + mid);
-        let right = self.build_node(proj, order, start + mid, end);
-        self.nodes[id as usize] = Node::Split { dim: d as u16, value, left, right };
-        id
     }
 
     /// The approximate nearest squared distance (full dimension) of `query` (`dim`
@@ -356,6 +318,58 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
         }
         out
     }
+}
+
+/// The nodes of the subtree over `order` (whose first entry is entry `base` of the whole
+/// order), in preorder with indices relative to its root: a split at the median of the
+/// widest coordinate (judged on at most 64 evenly spaced points), ties by index. Large
+/// halves are built in parallel; the node array is the same as a serial preorder
+/// build's, whatever the thread count.
+fn build_subtree(proj: &[f32], k: usize, order: &mut [u32], base: usize) -> Vec<Node> {
+    let len = order.len();
+    if len <= LEAF_SIZE {
+        return vec![Node::Leaf { start: base as u32, end: (base + len) as u32 }];
+    }
+    let mut best = (0usize, -1f32);
+    let step = len.div_ceil(64).max(1);
+    for d in 0..k {
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for &i in order.iter().step_by(step) {
+            let v = proj[i as usize * k + d];
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        if hi - lo > best.1 {
+            best = (d, hi - lo);
+        }
+    }
+    let d = best.0;
+    let mid = len / 2;
+    let key = |i: &u32| (proj[*i as usize * k + d], *i);
+    order.select_nth_unstable_by(mid, |a, b| {
+        let (va, ia) = key(a);
+        let (vb, ib) = key(b);
+        va.total_cmp(&vb).then(ia.cmp(&ib))
+    });
+    let value = proj[order[mid] as usize * k + d];
+    let (lo, hi) = order.split_at_mut(mid);
+    let (left, right) = if len > 8192 {
+        rayon::join(|| build_subtree(proj, k, lo, base), || build_subtree(proj, k, hi, base + mid))
+    } else {
+        (build_subtree(proj, k, lo, base), build_subtree(proj, k, hi, base + mid))
+    };
+    let shift = |node: Node, by: u32| match node {
+        Node::Split { dim, value, left, right } => {
+            Node::Split { dim, value, left: left + by, right: right + by }
+        }
+        leaf => leaf,
+    };
+    let right_root = 1 + left.len() as u32;
+    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+    nodes.push(Node::Split { dim: d as u16, value, left: 1, right: right_root });
+    nodes.extend(left.into_iter().map(|n| shift(n, 1)));
+    nodes.extend(right.into_iter().map(|n| shift(n, right_root)));
+    nodes
 }
 
 /// Dot product with eight partial sums (vectorisable), summed in a fixed order.
