@@ -17,10 +17,11 @@
 # - const: a constant 0° field design (no resampling: `orient --field` of a 0° field)
 #   against Embark's unguided output on the same exemplar and size, plain coherence
 #   (approximate search, both scored by `fieldtex eval`); limit: fieldtex ≤ Embark.
-# - speed: median over --runs of the whole command's wall time, `orient --preset whorl
-#   --no-metrics` against Embark `generate` (both write a 512² PNG from the exemplar file),
-#   and the ratio; CPU time (user+sys) medians too. Run on a quiet machine: `uptime` is
-#   printed with the numbers.
+# - speed: median over --runs of the whole command's wall time, `orient --preset whorl`
+#   end to end with its default metrics (the issue 17 target: ≤ 1/20 of Embark) and with
+#   `--no-metrics`, against Embark `generate` (all write a 512² PNG from the exemplar
+#   file), the ratios, the metrics' share of the default run (target < 10 %), and CPU
+#   time (user+sys) medians. Run on a quiet machine: `uptime` is printed with the numbers.
 # Usage: bench/orient_bench.sh [--size N] [--runs R] [--presets "whorl left-loop"]
 #        [--exemplars "stripes_Fabric071 ..."] [--no-speed] [--keep-embark]
 # --summary-only prints the tables from the outputs of earlier runs (e.g. one run per
@@ -105,8 +106,10 @@ for e in $exemplars; do
     for r in $(seq 2 "$runs"); do
       timed "$d/embark-times.txt" "$embark" --no-progress --out-size "$size" --seed 1 --out "$d/embark.png" generate "$ex/$e.png"
     done
+    rm -f "$d/orient-default-times.txt"
     for r in $(seq 1 "$runs"); do
       timed "$d/orient-times.txt" "$bin" orient --preset whorl --exemplar "$ex/$e.png" --size "$size" --out "$d/speed" --quiet --no-metrics
+      timed "$d/orient-default-times.txt" "$bin" orient --preset whorl --exemplar "$ex/$e.png" --size "$size" --out "$d/speed-default" --quiet
     done
   fi
 done
@@ -154,7 +157,8 @@ for e in exemplars:
             "seam_ratio": sr, "seam_ratio_nofix": srn, "jump_pairs": s["jump_pairs"],
             "coherent_share": s["coherent_share"], "coherent_share_nofix": sn["coherent_share"]})
 print(f"\n{'exemplar':32} {'const0 coh':>10} {'embark coh':>10} {'':4} {'floor':>8} "
-      + (f"{'orient_s':>8} {'embark_s':>8} {'ratio':>7} {'o_cpu_s':>7} {'e_cpu_s':>7}" if speed else ""))
+      + (f"{'default_s':>9} {'nometr_s':>8} {'embark_s':>8} {'ratio':>7} {'ratio_nm':>8} "
+         f"{'metr%':>6} {'d_cpu_s':>7} {'o_cpu_s':>7} {'e_cpu_s':>7}" if speed else ""))
 for e in exemplars:
     d = os.path.join(out, e)
     c = load(os.path.join(d, "const0", "report.json"))["metrics"]["texture"]["coherence"]["mean"]
@@ -171,9 +175,15 @@ for e in exemplars:
             return statistics.median(r[0] for r in rows), statistics.median(r[1] + r[2] for r in rows), len(rows)
         ow, oc, on = med(os.path.join(d, "orient-times.txt"))
         ew, ec, en = med(os.path.join(d, "embark-times.txt"))
-        line += f" {ow:8.2f} {ew:8.2f} {ow / ew:7.4f} {oc:7.2f} {ec:7.2f}"
-        entry.update({"orient_wall_s": ow, "embark_wall_s": ew, "ratio": ow / ew,
-                      "orient_cpu_s": oc, "embark_cpu_s": ec, "runs": min(on, en)})
+        dpath = os.path.join(d, "orient-default-times.txt")
+        dw, dc, dn = med(dpath) if os.path.exists(dpath) else (float("nan"),) * 2 + (0,)
+        share = 100 * (dw - ow) / dw
+        line += (f" {dw:9.2f} {ow:8.2f} {ew:8.2f} {dw / ew:7.4f} {ow / ew:8.4f} {share:6.1f} "
+                 f"{dc:7.2f} {oc:7.2f} {ec:7.2f}")
+        entry.update({"orient_default_wall_s": dw, "orient_wall_s": ow, "embark_wall_s": ew,
+                      "ratio": dw / ew, "ratio_no_metrics": ow / ew, "metrics_share_percent": share,
+                      "orient_default_cpu_s": dc, "orient_cpu_s": oc, "embark_cpu_s": ec,
+                      "runs": min(on, en, dn)})
     print(line)
     summary["exemplars"][e] = entry
 json.dump(summary, open(os.path.join(out, "summary.json"), "w"), indent=1)

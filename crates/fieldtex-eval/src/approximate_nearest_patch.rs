@@ -8,6 +8,11 @@
 //!    regular index stride, keeping [`ApproximateSearchOptions::pca_dims`] components.
 //!    Patch appearance concentrates in few components (Lefebvre & Hoppe 2006 use 8 for
 //!    synthesis), so near neighbours in the projection are near in full dimension.
+//!    The basis can be shared between the two images of a comparison
+//!    ([`PatchIndex::build_with_basis`]: the metrics fit it once, on the exemplar), and
+//!    a source may project all its patches in bulk ([`PatchSource::project_all`]: the
+//!    patch grid does it row by row, vectorised). 4 096 samples give the same measured
+//!    error as the earlier 20 000 at a fifth of the fitting cost (`docs/perf/orient.md`).
 //! 2. **kd-tree** over the projected database (split at the median of the widest
 //!    coordinate, leaves of at most [`LEAF_SIZE`] points; ties broken by index, so the
 //!    tree is the same for any thread count).
@@ -30,10 +35,15 @@ use serde::Serialize;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-/// Database patches used to fit the PCA basis (a regular index stride over all).
-pub const PCA_SAMPLES: usize = 20_000;
+/// Most database patches used to fit the PCA basis (a regular index stride over all).
+pub const PCA_SAMPLES: usize = 4_096;
 /// Largest kd-tree leaf.
 pub const LEAF_SIZE: usize = 12;
+/// The stated bound of the approximate metrics: their means are at most this many
+/// per cent above the exact ones on the test exemplars (`tests/approximate_metrics.rs`
+/// fails above it; measured values in `docs/perf/orient.md`). Reported in
+/// `PatchDistanceReport::error_bound_percent`.
+pub const ERROR_BOUND_PERCENT: f64 = 5.0;
 
 /// Options of the approximate search.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -47,7 +57,8 @@ pub struct ApproximateSearchOptions {
     pub max_checks: usize,
     /// Query patches are taken every `query_stride` positions along x and y (the
     /// mean over a regular sub-grid estimates the mean over all). Applies to the
-    /// direction whose queries are the larger image. Default 3.
+    /// direction whose queries are the larger image. Default 3 (4 aliases with the
+    /// 16-pixel blocks of the test patchworks: −12 to −18 %, `docs/perf/orient.md`).
     pub query_stride: usize,
 }
 
@@ -57,12 +68,54 @@ impl Default for ApproximateSearchOptions {
     }
 }
 
+/// A PCA basis of patch vectors (mean, `k × dim` row-major components, and
+/// `component · mean`), shareable between indices of the same patch size so that the
+/// patches of both images are fitted once (`PatchIndex::build_with_basis`).
+#[derive(Debug, Clone)]
+pub(crate) struct PatchBasis {
+    mean: Vec<f32>,
+    basis: Vec<f32>,
+    offset: Vec<f32>,
+    k: usize,
+}
+
+impl PatchBasis {
+    /// Fits the basis on at most [`PCA_SAMPLES`] patches of `source` (a regular index
+    /// stride), keeping `pca_dims` components.
+    pub fn fit<S: PatchSource>(source: &S, pca_dims: usize) -> Result<Self, String> {
+        let (n, dim) = (source.len(), source.dim());
+        if n == 0 || dim == 0 {
+            return Err("empty patch database".into());
+        }
+        let k = pca_dims.clamp(1, dim);
+        let step = n.div_ceil(PCA_SAMPLES).max(1);
+        let picked: Vec<usize> = (0..n).step_by(step).collect();
+        let mut samples = vec![0f32; picked.len() * dim];
+        samples.par_chunks_mut(dim).zip(&picked).for_each(|(row, &i)| source.fill(i, row));
+        let pca = Pca::fit(&samples, dim, k).map_err(|e| e.to_string())?;
+        let mean: Vec<f32> = pca.mean.iter().map(|&v| v as f32).collect();
+        let basis: Vec<f32> = pca.components.iter().flatten().map(|&v| v as f32).collect();
+        let k = basis.len() / dim;
+        if k == 0 {
+            return Err("no principal component".into());
+        }
+        let offset: Vec<f32> = basis.chunks_exact(dim).map(|b| dot(b, &mean)).collect();
+        Ok(Self { mean, basis, offset, k })
+    }
+}
+
 /// A source of fixed-length patch vectors, addressed `0..len()`.
 pub(crate) trait PatchSource: Sync {
     fn len(&self) -> usize;
     fn dim(&self) -> usize;
     /// Writes patch `i` into `out` (`dim()` values).
     fn fill(&self, i: usize, out: &mut [f32]);
+    /// `Some(len() × k values)`: every patch projected on the `k` rows of `basis`
+    /// (`k × dim()`) minus `offset`, where the source has a faster way than `fill` and
+    /// one dot product per component (the result may differ from that in rounding).
+    fn project_all(&self, _basis: &[f32], _offset: &[f32], _k: usize) -> Option<Vec<f32>> {
+        None
+    }
 }
 
 /// Dense row-major patch vectors.
@@ -109,23 +162,32 @@ pub(crate) struct PatchIndex<'a, S: PatchSource> {
 impl<'a, S: PatchSource> PatchIndex<'a, S> {
     /// Fits the PCA and builds the tree over every patch of `source` (`len() ≥ 1`).
     pub fn build(source: &'a S, options: &ApproximateSearchOptions) -> Result<Self, String> {
+        let basis = PatchBasis::fit(source, options.pca_dims)?;
+        Self::build_with_basis(source, options, &basis)
+    }
+
+    /// The basis this index projects with.
+    pub fn basis(&self) -> PatchBasis {
+        PatchBasis {
+            mean: self.mean.clone(),
+            basis: self.basis.clone(),
+            offset: self.offset.clone(),
+            k: self.k,
+        }
+    }
+
+    /// Builds the tree over every patch of `source` projected on a given `basis` (of
+    /// patches of the same dimension).
+    pub fn build_with_basis(
+        source: &'a S,
+        options: &ApproximateSearchOptions,
+        basis: &PatchBasis,
+    ) -> Result<Self, String> {
         let (n, dim) = (source.len(), source.dim());
-        if n == 0 || dim == 0 {
-            return Err("empty patch database".into());
+        if n == 0 || dim == 0 || basis.mean.len() != dim {
+            return Err("empty patch database or basis of another patch size".into());
         }
-        let k = options.pca_dims.clamp(1, dim);
-        let step = n.div_ceil(PCA_SAMPLES).max(1);
-        let picked: Vec<usize> = (0..n).step_by(step).collect();
-        let mut samples = vec![0f32; picked.len() * dim];
-        samples.par_chunks_mut(dim).zip(&picked).for_each(|(row, &i)| source.fill(i, row));
-        let pca = Pca::fit(&samples, dim, k).map_err(|e| e.to_string())?;
-        let mean: Vec<f32> = pca.mean.iter().map(|&v| v as f32).collect();
-        let basis: Vec<f32> = pca.components.iter().flatten().map(|&v| v as f32).collect();
-        let k = basis.len() / dim;
-        if k == 0 {
-            return Err("no principal component".into());
-        }
-        let offset: Vec<f32> = basis.chunks_exact(dim).map(|b| dot(b, &mean)).collect();
+        let PatchBasis { mean, basis, offset, k } = basis.clone();
         let mut index = Self {
             source,
             mean,
@@ -137,17 +199,21 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
             nodes: Vec::new(),
             options: options.clone(),
         };
-        // Project every patch (per-item slots: thread-count independent).
-        let mut proj = vec![0f32; n * k];
-        proj.par_chunks_mut(k * 256).enumerate().for_each(|(chunk, out)| {
-            let mut buf = vec![0f32; dim];
-            for (r, o) in out.chunks_mut(k).enumerate() {
-                source.fill(chunk * 256 + r, &mut buf);
-                index.project(&buf, o);
-            }
+        // Project every patch (per-item slots: thread-count independent), through the
+        // source's own bulk projection where it has one.
+        let proj = source.project_all(&index.basis, &index.offset, k).unwrap_or_else(|| {
+            let mut proj = vec![0f32; n * k];
+            proj.par_chunks_mut(k * 256).enumerate().for_each(|(chunk, out)| {
+                let mut buf = vec![0f32; dim];
+                for (r, o) in out.chunks_mut(k).enumerate() {
+                    source.fill(chunk * 256 + r, &mut buf);
+                    index.project(&buf, o);
+                }
+            });
+            proj
         });
         let mut order: Vec<u32> = (0..n as u32).collect();
-        index.build_node(&proj, &mut order, 0, n);
+        index.nodes = build_subtree(&proj, k, &mut order, 0);
         index.points = order
             .iter()
             .flat_map(|&i| proj[i as usize * k..(i as usize + 1) * k].iter().copied())
@@ -162,44 +228,6 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
         for (c, o) in out.iter_mut().enumerate() {
             *o = dot(&self.basis[c * dim..(c + 1) * dim], patch) - self.offset[c];
         }
-    }
-
-    /// Builds the subtree over `order[start..end]`, returns its node index.
-    fn build_node(&mut self, proj: &[f32], order: &mut [u32], start: usize, end: usize) -> u32 {
-        let k = self.k;
-        let id = self.nodes.len() as u32;
-        if end - start <= LEAF_SIZE {
-            self.nodes.push(Node::Leaf { start: start as u32, end: end as u32 });
-            return id;
-        }
-        // Widest coordinate, judged on at most 64 evenly spaced points of the node.
-        let mut best = (0usize, -1f32);
-        let step = (end - start).div_ceil(64).max(1);
-        for d in 0..k {
-            let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-            for &i in order[start..end].iter().step_by(step) {
-                let v = proj[i as usize * k + d];
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-            if hi - lo > best.1 {
-                best = (d, hi - lo);
-            }
-        }
-        let d = best.0;
-        let mid = (end - start) / 2;
-        let key = |i: &u32| (proj[*i as usize * k + d], *i);
-        order[start..end].select_nth_unstable_by(mid, |a, b| {
-            let (va, ia) = key(a);
-            let (vb, ib) = key(b);
-            va.total_cmp(&vb).then(ia.cmp(&ib))
-        });
-        let value = proj[order[start + mid] as usize * k + d];
-        self.nodes.push(Node::Leaf { start: 0, end: 0 });
-        let left = self.build_node(proj, order, start, start + mid);
-        let right = self.build_node(proj, order, start + mid, end);
-        self.nodes[id as usize] = Node::Split { dim: d as u16, value, left, right };
-        id
     }
 
     /// The approximate nearest squared distance (full dimension) of `query` (`dim`
@@ -240,15 +268,35 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
                         node = near as usize;
                     }
                     Node::Leaf { start, end } => {
+                        // The current m-th best, refreshed only when the heap changes.
+                        let mut worst = if best.len() < m {
+                            f32::INFINITY
+                        } else {
+                            best.peek().map_or(f32::INFINITY, |b| b.0.0)
+                        };
                         for p in start as usize..end as usize {
-                            let pt = &self.points[p * k..(p + 1) * k];
-                            let d: f32 =
-                                pt.iter().zip(q.iter()).map(|(a, b)| (a - b) * (a - b)).sum();
+                            let d = if k == 12 {
+                                // The default size, unrolled (same summation order).
+                                let pt: &[f32; 12] =
+                                    self.points[p * 12..p * 12 + 12].try_into().unwrap();
+                                let mut d = 0f32;
+                                for j in 0..12 {
+                                    d += (pt[j] - q[j]) * (pt[j] - q[j]);
+                                }
+                                d
+                            } else {
+                                let pt = &self.points[p * k..(p + 1) * k];
+                                pt.iter().zip(q.iter()).map(|(a, b)| (a - b) * (a - b)).sum()
+                            };
                             if best.len() < m {
                                 best.push((OrdF32(d), p as u32));
-                            } else if d < best.peek().map_or(f32::INFINITY, |b| b.0.0) {
+                                if best.len() == m {
+                                    worst = best.peek().map_or(f32::INFINITY, |b| b.0.0);
+                                }
+                            } else if d < worst {
                                 best.pop();
                                 best.push((OrdF32(d), p as u32));
+                                worst = best.peek().map_or(f32::INFINITY, |b| b.0.0);
                             }
                         }
                         checks += (end - start) as usize;
@@ -270,6 +318,58 @@ impl<'a, S: PatchSource> PatchIndex<'a, S> {
         }
         out
     }
+}
+
+/// The nodes of the subtree over `order` (whose first entry is entry `base` of the whole
+/// order), in preorder with indices relative to its root: a split at the median of the
+/// widest coordinate (judged on at most 64 evenly spaced points), ties by index. Large
+/// halves are built in parallel; the node array is the same as a serial preorder
+/// build's, whatever the thread count.
+fn build_subtree(proj: &[f32], k: usize, order: &mut [u32], base: usize) -> Vec<Node> {
+    let len = order.len();
+    if len <= LEAF_SIZE {
+        return vec![Node::Leaf { start: base as u32, end: (base + len) as u32 }];
+    }
+    let mut best = (0usize, -1f32);
+    let step = len.div_ceil(64).max(1);
+    for d in 0..k {
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for &i in order.iter().step_by(step) {
+            let v = proj[i as usize * k + d];
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        if hi - lo > best.1 {
+            best = (d, hi - lo);
+        }
+    }
+    let d = best.0;
+    let mid = len / 2;
+    let key = |i: &u32| (proj[*i as usize * k + d], *i);
+    order.select_nth_unstable_by(mid, |a, b| {
+        let (va, ia) = key(a);
+        let (vb, ib) = key(b);
+        va.total_cmp(&vb).then(ia.cmp(&ib))
+    });
+    let value = proj[order[mid] as usize * k + d];
+    let (lo, hi) = order.split_at_mut(mid);
+    let (left, right) = if len > 8192 {
+        rayon::join(|| build_subtree(proj, k, lo, base), || build_subtree(proj, k, hi, base + mid))
+    } else {
+        (build_subtree(proj, k, lo, base), build_subtree(proj, k, hi, base + mid))
+    };
+    let shift = |node: Node, by: u32| match node {
+        Node::Split { dim, value, left, right } => {
+            Node::Split { dim, value, left: left + by, right: right + by }
+        }
+        leaf => leaf,
+    };
+    let right_root = 1 + left.len() as u32;
+    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+    nodes.push(Node::Split { dim: d as u16, value, left: 1, right: right_root });
+    nodes.extend(left.into_iter().map(|n| shift(n, 1)));
+    nodes.extend(right.into_iter().map(|n| shift(n, right_root)));
+    nodes
 }
 
 /// Dot product with eight partial sums (vectorisable), summed in a fixed order.

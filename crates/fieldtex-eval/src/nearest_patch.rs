@@ -96,6 +96,40 @@ impl PatchSource for PatchGrid {
     fn dim(&self) -> usize {
         PatchGrid::dim(self)
     }
+    /// Row by row: for each component, each patch value's weight times the whole
+    /// image row segment it multiplies, accumulated over contiguous rows of positions
+    /// (vectorisable; about 10× faster than gathering every patch). Rows are the
+    /// parallel loop and each sums in a fixed order: thread-count independent.
+    fn project_all(&self, basis: &[f32], offset: &[f32], k: usize) -> Option<Vec<f32>> {
+        let (n, c, dim, cols) = (self.n, self.channels, self.dim(), self.cols);
+        if basis.len() != k * dim || offset.len() != k {
+            return None;
+        }
+        let mut out = vec![0f32; self.count() * k];
+        out.par_chunks_mut(cols * k).enumerate().for_each(|(y, row_out)| {
+            let mut acc = vec![0f32; cols];
+            for comp in 0..k {
+                acc.fill(0.0);
+                let b = &basis[comp * dim..(comp + 1) * dim];
+                for r in 0..n {
+                    for t in 0..n {
+                        for ch in 0..c {
+                            let w = b[(r * n + t) * c + ch];
+                            let src = self.span(ch, y + r, t, cols);
+                            for (a, v) in acc.iter_mut().zip(src) {
+                                *a += w * v;
+                            }
+                        }
+                    }
+                }
+                for (x, a) in acc.iter().enumerate() {
+                    row_out[x * k + comp] = a - offset[comp];
+                }
+            }
+        });
+        Some(out)
+    }
+
     /// Patch `i` (top-left `(i % cols, i / cols)`), row, column, channel order.
     fn fill(&self, i: usize, out: &mut [f32]) {
         let (x, y) = (i % self.cols, i / self.cols);

@@ -6,7 +6,9 @@
 //! `tests/approximate_metrics.rs`, `docs/first-hour.md`).
 
 use crate::EvalError;
-use crate::approximate_nearest_patch::{ApproximateSearchOptions, PatchIndex, PatchSource};
+use crate::approximate_nearest_patch::{
+    ApproximateSearchOptions, ERROR_BOUND_PERCENT, PatchBasis, PatchIndex, PatchSource,
+};
 use crate::image_view::ImageView;
 use crate::nearest_patch::{PatchGrid, nearest_patch_ssd};
 use rayon::prelude::*;
@@ -63,28 +65,41 @@ impl PatchDistanceOptions {
     }
 }
 
+/// Squared distance of two patch vectors.
+#[inline]
+fn ssd(a: &[f32], b: &[f32]) -> f32 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
 /// Approximate nearest squared distances of the `queries` patches (indices into `q`)
-/// to the database `db` (module `approximate_nearest_patch`), with coherent
-/// candidates: the match of the previous query of the same chunk, shifted by the
-/// displacement between the two queries, is compared exactly too (Ashikhmin 2001;
-/// the propagation step of PatchMatch, Barnes et al. 2009). Neighbouring patches of
-/// a texture tend to match neighbouring patches, so this candidate is often better
-/// than what a small tree budget finds. Every answer is the true distance to some
-/// database patch (an upper bound of the exact one). Chunks of 256 queries are fixed,
-/// so the result does not depend on the thread count.
+/// to the database `db` (module `approximate_nearest_patch`), and the PCA basis used
+/// (`basis`: reuse one fitted on patches of the same size, e.g. the other direction's
+/// database; `None`: fit one on `db`), with coherent candidates: the match of the
+/// previous query of the same chunk, shifted by the displacement between the two
+/// queries, is compared exactly too (Ashikhmin 2001; the propagation step of
+/// PatchMatch, Barnes et al. 2009). Neighbouring patches of a texture tend to match
+/// neighbouring patches, so this candidate is often better than what a small tree
+/// budget finds. Every answer is the true distance to some database patch (an upper
+/// bound of the exact one). Chunks of 256 queries are fixed, so the result does not
+/// depend on the thread count.
 fn approximate_ssd(
     q: &PatchGrid,
     queries: &[usize],
     db: &PatchGrid,
     options: &ApproximateSearchOptions,
-) -> Result<Vec<f32>, EvalError> {
-    let index = PatchIndex::build(db, options).map_err(|_| EvalError::InvalidOption {
+    basis: Option<&PatchBasis>,
+) -> Result<(Vec<f32>, PatchBasis), EvalError> {
+    let built = match basis {
+        Some(b) => PatchIndex::build_with_basis(db, options, b),
+        None => PatchIndex::build(db, options),
+    };
+    let index = built.map_err(|_| EvalError::InvalidOption {
         name: "approximate",
         value: format!("{options:?}"),
         reason: "the patch PCA failed (constant or degenerate patches?)",
     })?;
     let dim = q.dim();
-    Ok(queries
+    let dists = queries
         .par_chunks(256)
         .flat_map_iter(|chunk| {
             let mut buf = vec![0f32; dim];
@@ -104,8 +119,7 @@ fn approximate_ssd(
                             let j = y as usize * db.cols + x as usize;
                             if j != at {
                                 db.fill(j, &mut cand);
-                                let d: f32 =
-                                    buf.iter().zip(&cand).map(|(a, b)| (a - b) * (a - b)).sum();
+                                let d = ssd(&buf, &cand);
                                 if d < best {
                                     (best, at) = (d, j);
                                 }
@@ -117,7 +131,8 @@ fn approximate_ssd(
                 })
                 .collect::<Vec<f32>>()
         })
-        .collect())
+        .collect();
+    Ok((dists, index.basis()))
 }
 
 /// Indices of the patches of `g` on a regular sub-grid of step `stride`.
@@ -154,6 +169,11 @@ pub struct PatchDistanceReport {
     pub search: String,
     /// Step of the query sub-grid (1 = every patch).
     pub query_stride: usize,
+    /// For the approximate search: the stated bound of its error, in per cent above
+    /// the exact mean (measured on the test exemplars, `docs/perf/orient.md`); absent
+    /// for the exact search.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_bound_percent: Option<f64>,
 }
 
 pub(crate) fn summarize(
@@ -181,6 +201,7 @@ pub(crate) fn summarize(
         pairs_compared: dists.len() as u64 * candidates as u64,
         search: "exact".into(),
         query_stride: 1,
+        error_bound_percent: None,
     }
 }
 
@@ -195,6 +216,7 @@ fn approximate_report(
     let mut r = summarize(dists, dim, candidates, n);
     r.search = "approximate".into();
     r.query_stride = stride;
+    r.error_bound_percent = Some(ERROR_BOUND_PERCENT);
     r.pairs_compared =
         dists.len() as u64 * candidates.min(options.max_checks + options.rerank) as u64;
     r
@@ -231,9 +253,10 @@ pub fn coherence_and_completeness(
     let n = options.patch_size;
     if let Some(a) = &options.approximate {
         let qs = strided(&out, a.query_stride);
-        let to_ex = approximate_ssd(&out, &qs, &ex, a)?;
+        // One PCA basis (fitted on the exemplar's patches) for both directions.
+        let (to_ex, basis) = approximate_ssd(&out, &qs, &ex, a, None)?;
         let all_ex: Vec<usize> = (0..ex.count()).collect();
-        let to_out = approximate_ssd(&ex, &all_ex, &out, a)?;
+        let (to_out, _) = approximate_ssd(&ex, &all_ex, &out, a, Some(&basis))?;
         return Ok((
             approximate_report(&to_ex, out.dim(), ex.count(), n, a.query_stride, a),
             approximate_report(&to_out, ex.dim(), out.count(), n, 1, a),
@@ -252,7 +275,7 @@ pub(crate) fn coherence_distances(
     let (out, ex) = grids(output, exemplar, options, "coherence")?;
     if let Some(a) = &options.approximate {
         let qs = strided(&out, a.query_stride);
-        let to_ex = approximate_ssd(&out, &qs, &ex, a)?;
+        let (to_ex, _) = approximate_ssd(&out, &qs, &ex, a, None)?;
         let report = approximate_report(
             &to_ex,
             out.dim(),
@@ -282,7 +305,7 @@ pub(crate) fn completeness_distances(
     let (out, ex) = grids(output, exemplar, options, "completeness")?;
     if let Some(a) = &options.approximate {
         let all_ex: Vec<usize> = (0..ex.count()).collect();
-        let to_out = approximate_ssd(&ex, &all_ex, &out, a)?;
+        let (to_out, _) = approximate_ssd(&ex, &all_ex, &out, a, None)?;
         return Ok(approximate_report(&to_out, ex.dim(), out.count(), options.patch_size, 1, a));
     }
     let (_, to_out) = nearest_patch_ssd(&out, &ex, false, true);

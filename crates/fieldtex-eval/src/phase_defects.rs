@@ -287,20 +287,30 @@ pub fn phase_defects(
         if !bins.contains(&(b as u16)) {
             continue;
         }
-        // Row pass: complex T(x, y) = Σ hx(d) l0(x + d, y).
+        // Row pass: complex T(x, y) = Σ hx(d) l0(x + d, y), only on the rows the column
+        // pass below reads (within the kernel's reach of a pixel of this bin).
+        let mut needed = vec![false; h];
+        for y in 0..h {
+            if bins[y * w..(y + 1) * w].iter().any(|&v| v as usize == b) {
+                for j in 0..hy.len() {
+                    needed[mirror(y as isize + j as isize - r, h)] = true;
+                }
+            }
+        }
         let mut tre = vec![0f32; w * h];
         let mut tim = vec![0f32; w * h];
         tre.par_chunks_mut(w).zip(tim.par_chunks_mut(w)).enumerate().for_each(|(y, (tr, ti))| {
+            if !needed[y] {
+                return;
+            }
             let padded = mirrored_row(&l0[y * w..(y + 1) * w], r as usize);
-            for x in 0..w {
-                let win = &padded[x..x + hx.len()];
-                let (mut a, mut c) = (0f32, 0f32);
-                for (&(hr, hi), &v) in hx.iter().zip(win) {
-                    a += hr * v;
-                    c += hi * v;
+            // Tap by tap over the whole row (vectorisable; each value sums its taps in
+            // kernel order from 0, as a per-pixel loop would).
+            for (j, &(hr, hi)) in hx.iter().enumerate() {
+                for ((a, c), &v) in tr.iter_mut().zip(ti.iter_mut()).zip(&padded[j..j + w]) {
+                    *a += hr * v;
+                    *c += hi * v;
                 }
-                tr[x] = a;
-                ti[x] = c;
             }
         });
         // Column pass at the pixels of this bin: R = Σ hy(d) T(x, y + d).

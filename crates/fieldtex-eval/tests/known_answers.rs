@@ -85,7 +85,7 @@ fn sliced_wasserstein_of_a_colour_shift() {
     let a = exemplar(w, h);
     let b: Vec<f32> = a.iter().map(|v| v + 0.1).collect();
     let (va, vb) = (ImageView::new(&a, w, h, 3).unwrap(), ImageView::new(&b, w, h, 3).unwrap());
-    let opts = SlicedWassersteinOptions { directions: 256, seed: 3 };
+    let opts = SlicedWassersteinOptions { directions: 256, seed: 3, max_pixels: None };
     let r = color_sliced_wasserstein(&va, &vb, &opts).unwrap();
     // E[(θ·s)²] = |s|²/3 for uniform θ: SW = 0.1.
     assert!((r.distance - 0.1).abs() < 0.01, "{r:?}");

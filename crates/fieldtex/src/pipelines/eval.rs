@@ -37,6 +37,9 @@ pub struct ImageMetrics {
     pub rosy_seam: Option<ev::RosySeamReport>,
     /// Metrics that could not be computed, with the reason.
     pub skipped: Vec<String>,
+    /// How the nearest-patch metrics were searched and how far the approximate values
+    /// may be from the exact ones.
+    pub search: String,
 }
 
 /// Counts and positions of the singularities found in an image.
@@ -73,18 +76,12 @@ pub(crate) fn image_metrics(
     let o = ev::ImageView::new(&ob, output.width, output.height, 3)?;
     let e = ev::ImageView::new(&eb, exemplar.width, exemplar.height, 3)?;
     // Default: the approximate nearest-patch search (PCA + kd-tree, an upper bound of
-    // the exact distances; docs/first-hour.md gives the measured gap); `exact`: the
+    // the exact distances; docs/perf/orient.md gives the measured gap); `exact`: the
     // exhaustive scan.
     let approximate = (!exact).then(ev::ApproximateSearchOptions::default);
     let popts = ev::PatchDistanceOptions::default()
         .with_wrap_exemplar(true)
         .with_approximate(approximate.clone());
-    let (coherence, completeness) = ev::coherence_and_completeness(&o, &e, &popts)?;
-    progress.advance(2);
-    let swo = ev::SlicedWassersteinOptions { seed, ..Default::default() };
-    let color_sliced_wasserstein = ev::color_sliced_wasserstein(&o, &e, &swo)?;
-    progress.advance(1);
-    let mut skipped = Vec::new();
     let reference = match (field, angle_deg) {
         (Some(f), _) => Some(ev::OrientationReference::Field(ev::FieldView::new(
             f,
@@ -94,20 +91,100 @@ pub(crate) fn image_metrics(
         (None, Some(a)) => Some(ev::OrientationReference::ConstantDeg(a)),
         _ => None,
     };
+    // The nearest-patch pair beside the other metrics: both sides are parallel loops
+    // with serial parts (tree building, period estimate, merging), which overlap on
+    // few cores. Each metric is deterministic on its own; the results are assembled
+    // in a fixed order.
+    let (pair, rest) = rayon::join(
+        || {
+            let r = ev::coherence_and_completeness(&o, &e, &popts);
+            progress.advance(2);
+            r
+        },
+        || other_metrics(&o, &e, reference, exemplar_angle_deg, seed, exact, approximate, progress),
+    );
+    let (coherence, completeness) = pair?;
+    let (
+        color_sliced_wasserstein,
+        guided_coherence,
+        orientation_error,
+        singularities,
+        phase_defects,
+        skipped,
+    ) = rest?;
+    progress.finish_stage();
+    Ok(ImageMetrics {
+        coherence,
+        guided_coherence,
+        completeness,
+        color_sliced_wasserstein,
+        orientation_error,
+        singularities,
+        phase_defects,
+        rosy_seam: None,
+        skipped,
+        search: if exact {
+            "exact: exhaustive nearest-patch searches".into()
+        } else {
+            format!(
+                "approximate: coherence, completeness and guided_coherence use the approximate \
+                 nearest-patch search (one PCA basis for both images, k-d trees searched \
+                 with a bounded budget, coherent candidates, coherence queries on a step-3 \
+                 sub-grid); each is an upper bound of the exact value, \
+                 at most {}% above it on the test exemplars; color_sliced_wasserstein uses a \
+                 seeded sample of about {} pixels per image, within {} + {}% of the all-pixel \
+                 value on the test exemplars (docs/perf/orient.md); --exact-metrics for the \
+                 exhaustive versions",
+                ev::approximate_nearest_patch::ERROR_BOUND_PERCENT,
+                ev::color_sliced_wasserstein::SAMPLED_PIXELS,
+                ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_ABS,
+                ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_PERCENT,
+            )
+        },
+    })
+}
+
+/// The metrics of [`image_metrics`] other than coherence and completeness.
+type OtherMetrics = (
+    ev::SlicedWassersteinReport,
+    Option<ev::GuidedCoherenceReport>,
+    Option<ev::OrientationErrorReport>,
+    Option<SingularitySummary>,
+    Option<ev::PhaseDefectReport>,
+    Vec<String>,
+);
+
+/// Colour, guided coherence, orientation, singularities and phase defects of `o`
+/// against `e` (see [`image_metrics`]), with the list of skipped metrics.
+#[allow(clippy::too_many_arguments)]
+fn other_metrics(
+    o: &ev::ImageView,
+    e: &ev::ImageView,
+    reference: Option<ev::OrientationReference>,
+    exemplar_angle_deg: f64,
+    seed: u64,
+    exact: bool,
+    approximate: Option<ev::ApproximateSearchOptions>,
+    progress: &dyn Progress,
+) -> std::result::Result<OtherMetrics, ev::EvalError> {
+    // Default: a seeded sample of the pixels of a large image (the gap to all pixels
+    // is pinned by fieldtex-eval's tests/approximate_metrics.rs).
+    let max_pixels = (!exact).then_some(ev::color_sliced_wasserstein::SAMPLED_PIXELS);
+    let swo = ev::SlicedWassersteinOptions { seed, max_pixels, ..Default::default() };
+    let color_sliced_wasserstein = ev::color_sliced_wasserstein(o, e, &swo)?;
+    progress.advance(1);
+    let mut skipped = Vec::new();
     let guided_coherence = match &reference {
         Some(ev::OrientationReference::Field(f)) => {
-            let gopts = ev::GuidedCoherenceOptions {
-                approximate: approximate.clone(),
-                ..Default::default()
-            };
-            Some(ev::guided_coherence(&o, &e, f, &gopts)?)
+            let gopts = ev::GuidedCoherenceOptions { approximate, ..Default::default() };
+            Some(ev::guided_coherence(o, e, f, &gopts)?)
         }
         _ => None,
     };
     let orientation_error = match reference {
         Some(r) => {
             let opts = ev::OrientationErrorOptions { exemplar_angle_deg, ..Default::default() };
-            Some(ev::orientation_error(&o, &r, &opts)?)
+            Some(ev::orientation_error(o, &r, &opts)?)
         }
         None => {
             skipped.push("orientation_error: no guidance field or angle given".to_string());
@@ -115,7 +192,7 @@ pub(crate) fn image_metrics(
         }
     };
     progress.advance(1);
-    let singularities = match ev::image_orientation(&o, &ev::OrientationOptions::default()) {
+    let singularities = match ev::image_orientation(o, &ev::OrientationOptions::default()) {
         Ok(map) => {
             let r = ev::singularities(&map, &ev::SingularityOptions::default());
             Some(SingularitySummary {
@@ -131,7 +208,7 @@ pub(crate) fn image_metrics(
         }
     };
     progress.advance(1);
-    let phase_defects = match ev::phase_defects(&o, &ev::PhaseDefectOptions::default()) {
+    let phase_defects = match ev::phase_defects(o, &ev::PhaseDefectOptions::default()) {
         Ok(r) => Some(r),
         Err(err) => {
             skipped.push(format!("phase_defects: {err}"));
@@ -139,18 +216,14 @@ pub(crate) fn image_metrics(
         }
     };
     progress.advance(1);
-    progress.finish_stage();
-    Ok(ImageMetrics {
-        coherence,
-        guided_coherence,
-        completeness,
+    Ok((
         color_sliced_wasserstein,
+        guided_coherence,
         orientation_error,
         singularities,
         phase_defects,
-        rosy_seam: None,
         skipped,
-    })
+    ))
 }
 
 /// The exemplar-coordinate map of a synthesised image, for the seam measure of

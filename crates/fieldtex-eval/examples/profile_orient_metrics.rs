@@ -1,0 +1,119 @@
+//! Times each metric of `fieldtex orient`'s default report on a real orient output:
+//! `profile_orient_metrics OUT_DIR EXEMPLAR.png [--exact]` where `OUT_DIR` holds the
+//! `texture.png` and `field.npy` of an orient run at the exemplar's own size (no
+//! reduction). Prints one `STAGE name ms` line per metric in the facade's order
+//! (`crates/fieldtex/src/pipelines/eval.rs::image_metrics`, plus the exemplar's own
+//! orientation of `orient.rs`). Used for `docs/perf/orient.md`.
+
+use fieldtex_eval::*;
+use std::time::Instant;
+
+fn rgb(path: &str) -> (Vec<f32>, usize, usize) {
+    let img = image::open(path).unwrap_or_else(|e| panic!("{path}: {e}")).to_rgb8();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    (img.as_raw().iter().map(|&v| v as f32 / 255.0).collect(), w, h)
+}
+
+fn npy(path: &str) -> Vec<f32> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let hl = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    bytes[10 + hl..].chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
+}
+
+/// CPU seconds (user + system) of this process so far (`/proc/self/stat`, 100 Hz).
+fn cpu_s() -> f64 {
+    let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let f: Vec<&str> = s.rsplit(')').next().unwrap_or("").split_whitespace().collect();
+    let tick = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (tick(11) + tick(12)) / 100.0
+}
+
+fn stage<T>(name: &str, f: impl FnOnce() -> T) -> T {
+    let (t, c) = (Instant::now(), cpu_s());
+    let r = f();
+    println!(
+        "STAGE {name:28} {:8.1} ms wall {:8.0} ms cpu",
+        t.elapsed().as_secs_f64() * 1e3,
+        (cpu_s() - c) * 1e3
+    );
+    r
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    let exact = a.iter().any(|s| s == "--exact");
+    let (o, ow, oh) = rgb(&format!("{}/texture.png", a[1]));
+    let (e, ew, eh) = rgb(&a[2]);
+    let f = npy(&format!("{}/field.npy", a[1]));
+    let ov = ImageView::new(&o, ow, oh, 3).unwrap();
+    let ev = ImageView::new(&e, ew, eh, 3).unwrap();
+    let fv = FieldView::new(&f, ow, oh).unwrap();
+    // `--search DIMS,RERANK,CHECKS` tries other approximate-search options.
+    let search = a.iter().position(|s| s == "--search").map(|i| {
+        let v: Vec<usize> = a[i + 1].split(',').map(|x| x.parse().unwrap()).collect();
+        ApproximateSearchOptions {
+            pca_dims: v[0],
+            rerank: v[1],
+            max_checks: v[2],
+            ..Default::default()
+        }
+    });
+    let approximate = (!exact).then(|| search.clone().unwrap_or_default());
+    let t0 = Instant::now();
+    let angle = stage("exemplar_orientation", || {
+        let (angle, _) = dominant_orientation(&ev).unwrap();
+        let r = OrientationReference::ConstantDeg(angle);
+        orientation_error(&ev, &r, &Default::default()).unwrap();
+        angle
+    });
+    let popts = PatchDistanceOptions::default()
+        .with_wrap_exemplar(true)
+        .with_approximate(approximate.clone());
+    let (c, p) =
+        stage("coherence+completeness", || coherence_and_completeness(&ov, &ev, &popts).unwrap());
+    if std::env::args().any(|s| s == "--split") {
+        stage("  coherence only", || coherence(&ov, &ev, &popts).unwrap());
+        stage("  completeness only", || completeness(&ov, &ev, &popts).unwrap());
+    }
+    let sw = stage("color_sliced_wasserstein", || {
+        color_sliced_wasserstein(
+            &ov,
+            &ev,
+            &SlicedWassersteinOptions {
+                seed: 1,
+                max_pixels: (!exact).then_some(color_sliced_wasserstein::SAMPLED_PIXELS),
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    });
+    let g = stage("guided_coherence", || {
+        let o = GuidedCoherenceOptions { approximate: approximate.clone(), ..Default::default() };
+        guided_coherence(&ov, &ev, &fv, &o).unwrap()
+    });
+    let oe = stage("orientation_error", || {
+        let o = OrientationErrorOptions { exemplar_angle_deg: angle, ..Default::default() };
+        orientation_error(&ov, &OrientationReference::Field(fv), &o).unwrap()
+    });
+    let s = stage("singularities", || {
+        let map = image_orientation(&ov, &OrientationOptions::default()).unwrap();
+        singularities(&map, &SingularityOptions::default())
+    });
+    let pd = stage("phase_defects", || phase_defects(&ov, &PhaseDefectOptions::default()).unwrap());
+    println!(
+        "STAGE {:28} {:8.1} ms wall {:8.0} ms cpu",
+        "total",
+        t0.elapsed().as_secs_f64() * 1e3,
+        cpu_s() * 1e3
+    );
+    println!(
+        "coherence {:.6} completeness {:.6} sw {:.6} guided {:.6} orient_err {:.3} sing {} pd {}",
+        c.mean,
+        p.mean,
+        sw.distance,
+        g.mean,
+        oe.mean_error_deg,
+        s.merged.len(),
+        pd.count
+    );
+}
