@@ -305,6 +305,7 @@ fn align_metrics(
         serde_json::json!({
             "pixel_size": result.pixel_size,
             "carriers": n_carriers,
+            "histogram_distance": result.histogram_distance,
             "levels": levels,
             "feature_align": feature_align,
             "exemplar_feature_lines": m.exemplar_features.lines.len(),
