@@ -436,7 +436,12 @@ fn match_exemplar_histogram(
         colors.iter().flat_map(|c| [c[0] as f64, c[1] as f64, c[2] as f64]).collect();
     let reference: Vec<f64> =
         exemplar.pixels.iter().flat_map(|c| [c[0] as f64, c[1] as f64, c[2] as f64]).collect();
+    // 3 random rotations (the library default is 12) and the final per-channel pass:
+    // the RGB marginals come out exact and the joint close. Measured on 600 K points
+    // against a 512² exemplar (load 15): about 0.4 s CPU with 3 rotations, 0.9 s with
+    // 12; a 1024² fandisk atlas has about 600 K carriers.
     let options = HistogramMatchOptions {
+        iterations: 3,
         seed: stream_seed(seed, "texopt-histogram", 0),
         ..Default::default()
     };
