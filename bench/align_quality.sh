@@ -52,30 +52,31 @@ exemplar_path() {
   echo "$p"
 }
 echo "binary: $bin ($tag), atlas $size, $threads threads"
-printf "%-14s %-14s %7s %8s %8s %8s %8s %9s\n" mesh exemplar wall_s contrast gradient orient_deg coverage metrics_s
+printf "%-14s %-14s %7s %7s %8s %8s %8s %8s %9s\n" mesh exemplar wall_s cpu_s contrast gradient orient_deg coverage metrics_s
 for m in $meshes; do
   mesh="$data/meshes/$m.obj"
   for e in $exemplars; do
     ex="$(exemplar_path "$e")"
     dir="$out/$tag-$m-$e"
-    t0=$(date +%s.%N)
-    "$bin" align --mesh "$mesh" --exemplar "$ex" --size "$size" \
-      --threads "$threads" --out "$dir" --quiet
-    t1=$(date +%s.%N)
+    mkdir -p "$dir"
+    /usr/bin/time -f '%e %U %S' -o "$dir.time" "$bin" align --mesh "$mesh" --exemplar "$ex" \
+      --size "$size" --threads "$threads" --out "$dir" --quiet
     ratios="$(target/release/examples/texture_contrast "$dir/model.glb" "$ex" 1)"
-    python3 - "$t0" "$t1" "$dir/report.json" "$m" "$e" "$ratios" <<'PY'
+    python3 - "$dir.time" "$dir/report.json" "$m" "$e" "$ratios" "$(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || true)" <<'PY'
 import json, sys
-t0, t1, path, m, e = float(sys.argv[1]), float(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5]
-cr, gr = (float(v) for v in sys.argv[6].split())
+times, path, m, e = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
+wall, user, sys_s = (float(v) for v in open(times).read().split()[-3:])
+cr, gr = (float(v) for v in sys.argv[5].split())
 r = json.load(open(path))
 mt = r["metrics"]
 c = {"contrast_ratio": cr, "gradient_ratio": gr}
 t = dict((k, v) for k, v in r["timings_ms"])
 metrics = sum(v for k, v in r["timings_ms"] if k.startswith("metrics")) / 1e3
-print(f"{m:<14} {e:<14} {t1 - t0:7.1f} {c.get('contrast_ratio', float('nan')):8.3f} "
+print(f"{m:<14} {e:<14} {wall:7.1f} {user + sys_s:7.1f} {c.get('contrast_ratio', float('nan')):8.3f} "
       f"{c.get('gradient_ratio', float('nan')):8.3f} "
       f"{mt['orientation_error']['surface']['mean_deg']:8.2f} "
       f"{mt['feature_coverage']['fraction']:8.3f} {metrics:9.2f}")
+print(f"    load average (1, 5, 15 min) after the run: {sys.argv[6]}")
 print("    stages: " + " ".join(f"{k}={v / 1e3:.2f}" for k, v in r["timings_ms"] if v >= 100))
 PY
   done

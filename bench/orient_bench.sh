@@ -10,7 +10,10 @@
 #   30° and 45° (`orient_probe --ideal`, the synthesis's own colour lookup), scored by
 #   `fieldtex eval` with the same search, mean over the four angles.
 # - seam: `rosy_seam.seam_ratio` = coherent share of neighbour pairs across the field's
-#   representation jumps / the image-wide share (fieldtex-eval/src/rosy_seam.rs), with the
+#   representation jumps / the image-wide share (fieldtex-eval/src/rosy_seam.rs); rep: the
+#   same over the repaired jumps only (jump pairs whose flip-corrected frames agree; the
+#   limit is checked on it); forced: pairs on the effective seam the singularities force
+#   (coherent share ≈ 0 by construction), with the
 #   2-RoSy fix (limit ≥ 0.8) and without it (--no-rosy-fix; should be clearly lower).
 #   Presets whose field has no jumps print n/a.
 # Per exemplar:
@@ -124,7 +127,7 @@ def ok(b):
     return "ok" if b else "MISS"
 summary = {"size": size, "rows": [], "exemplars": {}}
 print(f"\n{'exemplar':32} {'preset':12} {'err':>6} {'limit':>6} {'':4} {'gcoh':>8} {'1.3floor':>8} {'':4} "
-      f"{'seam':>5} {'':4} {'nofix':>5} {'jumps':>6} {'coh%':>5} {'pd_near':>7} {'nofix':>5}")
+      f"{'seam':>5} {'rep':>5} {'':4} {'nofix':>5} {'jumps':>6} {'forced':>6} {'coh%':>5} {'pd_near':>7} {'nofix':>5}")
 misses = 0
 for e in exemplars:
     d = os.path.join(out, e)
@@ -144,17 +147,22 @@ for e in exemplars:
         g = t["guided_coherence"]["mean"]
         s, sn = t["rosy_seam"], tn["rosy_seam"]
         sr, srn = s["seam_ratio"], sn["seam_ratio"]
+        # Judged on the repaired jumps (jump pairs whose flip-corrected frames agree);
+        # the forced seam a ±1/2 singularity leaves is counted apart (rosy_seam.rs).
+        rep = (s.get("repaired") or {}).get("ratio")
+        forced = (s.get("effective_seam") or {}).get("pairs", -1)
         e_ok, g_ok = err <= limit, g <= 1.3 * floor
-        s_ok = sr is None or sr >= 0.8
+        s_ok = rep is None or rep >= 0.8
         misses += (not e_ok) + (not g_ok) + (not s_ok)
         f = lambda v: "n/a" if v is None else f"{v:.2f}"
         print(f"{e:32} {p:12} {err:6.2f} {limit:6.2f} {ok(e_ok):4} {g:8.5f} {1.3 * floor:8.5f} {ok(g_ok):4} "
-              f"{f(sr):>5} {ok(s_ok) if sr is not None else '':4} {f(srn):>5} {s['jump_pairs']:6} "
+              f"{f(sr):>5} {f(rep):>5} {ok(s_ok) if rep is not None else '':4} {f(srn):>5} {s['jump_pairs']:6} {forced:6} "
               f"{100 * s['coherent_share']:5.1f} {r.get('phase_defects_near_singularities', -1):7} "
               f"{n.get('phase_defects_near_singularities', -1):5}")
         summary["rows"].append({"exemplar": e, "preset": p, "orientation_error_deg": err,
             "orientation_limit_deg": limit, "guided_coherence": g, "rotated_copy_floor": floor,
-            "seam_ratio": sr, "seam_ratio_nofix": srn, "jump_pairs": s["jump_pairs"],
+            "seam_ratio": sr, "repaired_seam_ratio": rep, "forced_seam_pairs": forced,
+            "seam_ratio_nofix": srn, "jump_pairs": s["jump_pairs"],
             "coherent_share": s["coherent_share"], "coherent_share_nofix": sn["coherent_share"]})
 print(f"\n{'exemplar':32} {'const0 coh':>10} {'embark coh':>10} {'':4} {'floor':>8} "
       + (f"{'default_s':>9} {'nometr_s':>8} {'embark_s':>8} {'ratio':>7} {'ratio_nm':>8} "

@@ -58,6 +58,12 @@ fn rosy_fix_keeps_seams_coherent_and_eval_agrees() {
     let ratio_nofix = sn["seam_ratio"].as_f64().unwrap();
     assert!(ratio >= 0.8, "with the fix the seams are about as coherent as the image: {s}");
     assert!(ratio_nofix < 0.5 * ratio, "without it they break: {sn} vs {s}");
+    // With the flips, orient splits the jumps: without the fix no jump is repaired and
+    // every one is a forced (effective) seam; with it most jumps are repaired.
+    assert_eq!(sn["repaired"]["pairs"].as_u64(), Some(0), "{sn}");
+    assert_eq!(sn["effective_seam"]["pairs"].as_u64(), Some(jumps), "{sn}");
+    let repaired = s["repaired"]["pairs"].as_u64().unwrap();
+    assert!(repaired > jumps / 2, "{s}");
 
     // coords.npy: H × W × 2 float32, and `eval --coords` gives the same numbers.
     let npy = std::fs::read(fix.join("coords.npy")).unwrap();
@@ -81,7 +87,12 @@ fn rosy_fix_keeps_seams_coherent_and_eval_agrees() {
     );
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(&v["rosy_seam"], s, "eval --coords reproduces orient's seam measure");
+    // eval has no flips: the same numbers without the flip split.
+    let mut plain = s.clone();
+    for key in ["repaired", "effective_seam"] {
+        plain[key] = serde_json::Value::Null;
+    }
+    assert_eq!(v["rosy_seam"], plain, "eval --coords reproduces orient's seam measure");
 
     // --coords without --field, and a coordinate map of the wrong shape: exit 2.
     let o = run_limited(

@@ -65,7 +65,10 @@ pub use phase_defects::{
     PhaseDefect, PhaseDefectOptions, PhaseDefectReport, count_defects_near, estimate_stripe_period,
     phase_defects,
 };
-pub use rosy_seam::{RosySeamOptions, RosySeamReport, rosy_seam_coherence};
+pub use rosy_seam::{
+    RosySeamOptions, RosySeamReport, SeamSubset, rosy_seam_coherence,
+    rosy_seam_coherence_with_flips,
+};
 pub use singularities::{
     ExpectedSingularity, Singularity, SingularityCluster, SingularityMatch, SingularityOptions,
     SingularityReport, match_singularities, singularities,

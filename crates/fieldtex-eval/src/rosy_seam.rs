@@ -36,6 +36,23 @@
 //! field vector is zero or not finite are skipped. The result does not depend on the
 //! thread count (integer counts; the loop is sequential, `O(W·H)`).
 //!
+//! **With the synthesis's flip indicators** `I` ([`rosy_seam_coherence_with_flips`]),
+//! the jump pairs split in two. A jump pair whose *effective* frames `(−1)^I J` agree
+//! (`I(p) ⊕ I(q)` = jump) is a **repaired jump**: the fix made the frames continue, so
+//! its coordinates can continue too; this is what the fix is judged on
+//! ([`RosySeamReport::repaired`]). Every pair whose effective frames point in opposite
+//! directions (`σ · (−1)^(I(p) ⊕ I(q)) < 0`), at a representation jump or not, is an
+//! **effective seam**: the seam a ±½ singularity forces on any choice of flips (a loop
+//! around it must cross one). Across it the exemplar shows turned by 180°, which no
+//! coordinate step continues (the coordinates on the far side are a point reflection
+//! of the near side's), so its coherent share is low by construction; it is reported
+//! ([`RosySeamReport::effective_seam`]) so that one sees where the synthesis put it.
+//! Without flips both are `None`. Why this matters: where the designed singularities
+//! are close (the tented arch), the field's representation jump *is* the forced seam
+//! (all its pairs are effective seams) and the plain seam ratio is low for any
+//! synthesis; where they are far apart (loops, whorl), combing moves the forced seam
+//! off the representation jump and the plain ratio is high.
+//!
 //! This is the "coherent pairs" count of `fieldtex-synth`'s `orient_probe` example
 //! made into a metric; unlike the probe, it needs no flip indicators (the sign-free
 //! test above), so `fieldtex eval` can compute it from a texture's coordinate map
@@ -77,10 +94,27 @@ pub struct RosySeamReport {
     /// as the rest of the texture, near 0 when every seam pair breaks. `None` without
     /// jumps or without any coherent pair.
     pub seam_ratio: Option<f64>,
+    /// Jump pairs whose effective frames agree (repaired by the flips), judged like the
+    /// seam share; `None` without flips. See the module docs.
+    pub repaired: Option<SeamSubset>,
+    /// Pairs whose effective frames point in opposite directions (the forced seams),
+    /// anywhere in the image; `None` without flips.
+    pub effective_seam: Option<SeamSubset>,
     /// Exemplar pixels per output pixel used for the expected steps.
     pub step: f64,
     /// Tolerance used, exemplar pixels.
     pub tolerance_px: f64,
+}
+
+/// Coherence of a subset of the neighbour pairs (flip-aware split, module docs).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeamSubset {
+    pub pairs: usize,
+    /// Coherent share of these pairs; `None` when there are none.
+    pub coherent_share: Option<f64>,
+    /// `coherent_share / ` the image-wide share; `None` when there are no pairs or no
+    /// coherent pair in the image.
+    pub ratio: Option<f64>,
 }
 
 /// The seam measure (module docs) of an exemplar-coordinate map `coords`
@@ -95,7 +129,33 @@ pub fn rosy_seam_coherence(
     step: f64,
     options: &RosySeamOptions,
 ) -> Result<RosySeamReport, EvalError> {
+    rosy_seam_coherence_with_flips(coords, field, None, exemplar_size, step, options)
+}
+
+/// [`rosy_seam_coherence`] plus, with the synthesis's flip indicators `flips` (`W·H`,
+/// row-major like the field), the split into repaired jumps and effective seams
+/// (module docs).
+pub fn rosy_seam_coherence_with_flips(
+    coords: &[f32],
+    field: &FieldView,
+    flips: Option<&[bool]>,
+    exemplar_size: [usize; 2],
+    step: f64,
+    options: &RosySeamOptions,
+) -> Result<RosySeamReport, EvalError> {
     let (w, h) = (field.width, field.height);
+    if let Some(f) = flips
+        && f.len() != w * h
+    {
+        return Err(EvalError::BufferSize {
+            what: "flip indicators",
+            width: w,
+            height: h,
+            channels: 1,
+            expected: w * h,
+            found: f.len(),
+        });
+    }
     if coords.len() != field.data.len() {
         return Err(EvalError::BufferSize {
             what: "coordinate map",
@@ -144,6 +204,8 @@ pub fn rosy_seam_coherence(
     };
     let wrap = |d: f64, period: f64| d - (d / period).round() * period;
     let (mut pairs, mut coherent, mut jumps, mut jump_coherent) = (0usize, 0usize, 0usize, 0usize);
+    // (pairs, coherent) of the repaired jumps and of the effective seams.
+    let (mut repaired, mut seam) = ([0usize; 2], [0usize; 2]);
     for y in 0..h {
         for x in 0..w {
             let Some(up) = unit(x, y) else { continue };
@@ -173,13 +235,39 @@ pub fn rosy_seam_coherence(
                     jumps += 1;
                     jump_coherent += ok as usize;
                 }
+                if let Some(f) = flips {
+                    // Effective frames (−1)^I J disagree: a forced seam; agree across a
+                    // representation jump: a repaired jump.
+                    let toggled = f[y * w + x] != f[qy * w + qx];
+                    let slot = if jump != toggled {
+                        Some(&mut seam)
+                    } else if jump {
+                        Some(&mut repaired)
+                    } else {
+                        None
+                    };
+                    if let Some(slot) = slot {
+                        slot[0] += 1;
+                        slot[1] += ok as usize;
+                    }
+                }
             }
         }
     }
     let coherent_share = if pairs > 0 { coherent as f64 / pairs as f64 } else { 0.0 };
     let jump_coherent_share = (jumps > 0).then(|| jump_coherent as f64 / jumps as f64);
     let seam_ratio = jump_coherent_share.filter(|_| coherent > 0).map(|s| s / coherent_share);
+    let subset = |[n, ok]: [usize; 2]| {
+        let share = (n > 0).then(|| ok as f64 / n as f64);
+        SeamSubset {
+            pairs: n,
+            coherent_share: share,
+            ratio: share.filter(|_| coherent > 0).map(|s| s / coherent_share),
+        }
+    };
     Ok(RosySeamReport {
+        repaired: flips.map(|_| subset(repaired)),
+        effective_seam: flips.map(|_| subset(seam)),
         pairs,
         coherent_share,
         jump_pairs: jumps,
@@ -306,5 +394,37 @@ mod tests {
         assert!(rosy_seam_coherence(&c, &fv, [EX, EX], 0.0, &o).is_err());
         let bad = RosySeamOptions { tolerance: -1.0 };
         assert!(rosy_seam_coherence(&c, &fv, [EX, EX], 1.0, &bad).is_err());
+    }
+
+    #[test]
+    fn flips_split_repaired_jumps_from_forced_seams() {
+        let f = split_field();
+        let fv = FieldView::new(&f, N, N).unwrap();
+        let o = RosySeamOptions::default();
+        // Coherent seam, the right half flipped: every jump pair is repaired, none is an
+        // effective seam.
+        let c = coords(1.0, [10.0, 20.0]);
+        let flips: Vec<bool> = (0..N * N).map(|i| i % N >= N / 2).collect();
+        let r = rosy_seam_coherence_with_flips(&c, &fv, Some(&flips), [EX, EX], 1.0, &o).unwrap();
+        let rep = r.repaired.clone().unwrap();
+        assert_eq!((rep.pairs, rep.ratio), (N, Some(1.0)));
+        assert_eq!(r.effective_seam.as_ref().unwrap().pairs, 0);
+        // No flips at all: the jump column is an effective seam (and broken there).
+        let c = coords(-1.0, [90.0, 5.0]);
+        let none = vec![false; N * N];
+        let r = rosy_seam_coherence_with_flips(&c, &fv, Some(&none), [EX, EX], 1.0, &o).unwrap();
+        assert_eq!(r.repaired.as_ref().unwrap().pairs, 0);
+        let seam = r.effective_seam.unwrap();
+        assert_eq!((seam.pairs, seam.coherent_share), (N, Some(0.0)));
+        // A flip toggle away from the jump (column 10) is an effective seam too.
+        let c = coords(1.0, [10.0, 20.0]);
+        let moved: Vec<bool> = (0..N * N).map(|i| i % N >= 10).collect();
+        let r = rosy_seam_coherence_with_flips(&c, &fv, Some(&moved), [EX, EX], 1.0, &o).unwrap();
+        assert_eq!(r.effective_seam.unwrap().pairs, 2 * N);
+        assert!(
+            rosy_seam_coherence_with_flips(&c, &fv, Some(&moved[1..]), [EX, EX], 1.0, &o).is_err()
+        );
+        // Without flips the split is absent.
+        assert!(measure(&c, &f).repaired.is_none());
     }
 }

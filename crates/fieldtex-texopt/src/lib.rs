@@ -66,6 +66,12 @@
 //! - Crisp final pass ([`TexOptOptions::crisp`]): each carrier shows one covering
 //!   patch's exemplar pixel: by default the best-matching one near its centre
 //!   ([`CrispChoice`], see [`robust_blend`]).
+//! - Histogram step ([`TexOptOptions::histogram_match`], default on): after the crisp
+//!   pass the carriers' RGB distribution is moved onto the exemplar's (Pitié et al.
+//!   2005 n-D transfer). Substitute for Kopf et al. 2007's histogram reweighting inside
+//!   the loop: it restores the contrast that the optimisation's preference for flat
+//!   exemplar regions loses, but colours are then remaps of exemplar pixels and small
+//!   outputs (whose histogram is not the exemplar's) get over-stretched.
 
 mod error;
 mod exemplar_patches;

@@ -75,6 +75,17 @@ pub struct TexOptOptions {
     /// Which covering patch a carrier shows in the crisp pass. Default
     /// [`CrispChoice::BestMatch`].
     pub crisp_choice: CrispChoice,
+    /// Final colour step: match the RGB distribution of the carriers' colours to the
+    /// exemplar's (n-D histogram transfer, Pitié, Kokaram & Dahyot 2005,
+    /// `fieldtex_linalg::stats::match_histograms_nd`). Texture optimisation prefers flat
+    /// exemplar regions, whose patches match blended neighbourhoods well (Kopf et al.
+    /// 2007 §4 "histogram matching" name the same drift and reweight the blend by the
+    /// histograms inside the loop; this one-shot transfer after the crisp pass is our
+    /// substitute), so the result has less contrast than the exemplar. Colours then are
+    /// monotone-ish remaps of exemplar pixels, no longer the pixels themselves; the
+    /// sources are unchanged. Default true (measured on fandisk with the photo
+    /// exemplars: docs/real-exemplars.md).
+    pub histogram_match: bool,
     /// Seed of all random streams. Default 0.
     pub seed: u64,
 }
@@ -119,6 +130,7 @@ impl Default for TexOptOptions {
             coherence_bias: 1.0,
             crisp: true,
             crisp_choice: CrispChoice::BestMatch,
+            histogram_match: true,
             seed: 0,
         }
     }

@@ -71,6 +71,10 @@ pub struct TexOptResult {
     pub levels: Vec<LevelStats>,
     /// The pixel size `h` used (surface units per exemplar pixel).
     pub pixel_size: f64,
+    /// The final histogram step ([`TexOptOptions::histogram_match`]): mean absolute
+    /// quantile distance (colour units, mean over the RGB axes) between the carriers'
+    /// colours and the exemplar's pixels, before and after; `None` when off.
+    pub histogram_distance: Option<[f64; 2]>,
     pub warnings: Vec<Warning>,
 }
 
@@ -409,9 +413,47 @@ pub fn optimise(
             ),
         ));
     }
+    let histogram_distance = if options.histogram_match {
+        match_exemplar_histogram(&mut colors, exemplar, options.seed)
+    } else {
+        None
+    };
     // Pixel-index coordinates (internal) → pixel-centre convention (public).
     source.iter_mut().for_each(|s| *s = [s[0] + 0.5, s[1] + 0.5]);
-    Ok(TexOptResult { colors, source, levels, pixel_size: h, warnings })
+    Ok(TexOptResult { colors, source, levels, pixel_size: h, histogram_distance, warnings })
+}
+
+/// Moves the RGB distribution of `colors` onto the exemplar's pixels' (alpha kept,
+/// results clamped to `[0, 1]`; see [`TexOptOptions::histogram_match`]). Returns the
+/// marginal distance before and after, `None` when there is nothing to match.
+fn match_exemplar_histogram(
+    colors: &mut [[f32; 4]],
+    exemplar: &Image,
+    seed: u64,
+) -> Option<[f64; 2]> {
+    use fieldtex_linalg::stats::{HistogramMatchOptions, match_histograms_nd};
+    let mut x: Vec<f64> =
+        colors.iter().flat_map(|c| [c[0] as f64, c[1] as f64, c[2] as f64]).collect();
+    let reference: Vec<f64> =
+        exemplar.pixels.iter().flat_map(|c| [c[0] as f64, c[1] as f64, c[2] as f64]).collect();
+    // 3 random rotations (the library default is 12) and the final per-channel pass:
+    // the RGB marginals come out exact and the joint close. Measured on 600 K points
+    // against a 512² exemplar (load 15): about 0.4 s CPU with 3 rotations, 0.9 s with
+    // 12; a 1024² fandisk atlas has about 600 K carriers.
+    let options = HistogramMatchOptions {
+        iterations: 3,
+        seed: stream_seed(seed, "texopt-histogram", 0),
+        ..Default::default()
+    };
+    // Inputs are finite (validated exemplar, colours blended from it), so this only
+    // fails on empty input.
+    let stats = match_histograms_nd(&mut x, &reference, 3, &options).ok()?;
+    for (c, v) in colors.iter_mut().zip(x.chunks_exact(3)) {
+        for k in 0..3 {
+            c[k] = v[k].clamp(0.0, 1.0) as f32;
+        }
+    }
+    Some([stats.marginal_distance_before, stats.marginal_distance_after])
 }
 
 /// Up to `k` nearest other samples within `radius` per sample (`#S × k`, padded with

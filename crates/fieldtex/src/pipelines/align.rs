@@ -20,7 +20,8 @@
 //! pixels per side they are reduced, with a warning, and the pattern keeps its size).
 //! Synthesis runs coarse to fine over the exemplar's pyramid from a patch that spans its
 //! largest structure (`fieldtex_synth::characteristic_scale`,
-//! `fieldtex_texopt::pyramid_patch_sizes`), and ends with the crisp pass.
+//! `fieldtex_texopt::pyramid_patch_sizes`), and ends with the crisp pass and the
+//! histogram step (`TexOptOptions::histogram_match`).
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::atlas::atlas_options;
@@ -305,6 +306,7 @@ fn align_metrics(
         serde_json::json!({
             "pixel_size": result.pixel_size,
             "carriers": n_carriers,
+            "histogram_distance": result.histogram_distance,
             "levels": levels,
             "feature_align": feature_align,
             "exemplar_feature_lines": m.exemplar_features.lines.len(),

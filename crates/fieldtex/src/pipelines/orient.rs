@@ -248,7 +248,8 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
         let (mut metrics, _) =
             texture_metrics(&mut report, synth, &exemplar, &flat, &pts, options, progress)?;
-        metrics.rosy_seam = Some(seam_metric(&coords, &flat, n, &exemplar, per_pixel)?);
+        metrics.rosy_seam =
+            Some(seam_metric(&coords, &flat, &result.flips, n, &exemplar, per_pixel)?);
         report.metric("texture", &metrics);
     } else {
         report.notes.push("image metrics skipped (--no-metrics)".into());
@@ -284,7 +285,8 @@ pub(crate) fn orient_in_memory(
         let (mut metrics, _) =
             texture_metrics(report, synth, exemplar, &flat, &pts, options, progress)?;
         let coords: Vec<f32> = result.coords.iter().flat_map(|c| [c[0], c[1]]).collect();
-        metrics.rosy_seam = Some(seam_metric(&coords, &flat, n, exemplar, per_pixel)?);
+        metrics.rosy_seam =
+            Some(seam_metric(&coords, &flat, &result.flips, n, exemplar, per_pixel)?);
         report.metric("texture", &metrics);
     }
     Ok(preview_with_singularities(synth, &designed))
@@ -292,17 +294,29 @@ pub(crate) fn orient_in_memory(
 
 /// The seam measure (`fieldtex_eval::rosy_seam`) of an `n × n` synthesis: its exemplar
 /// coordinates `coords` against its field `flat`, at `per_pixel` exemplar pixels per
-/// output pixel.
+/// output pixel, split by its flip indicators `flips` into repaired jumps and
+/// effective (forced) seams.
 fn seam_metric(
     coords: &[f32],
     flat: &[f32],
+    flips: &[bool],
     n: usize,
     exemplar: &Image,
     per_pixel: f64,
 ) -> Result<fieldtex_eval::RosySeamReport> {
     let size = [exemplar.width, exemplar.height];
-    super::eval::rosy_seam_metric(coords, flat, n, n, size, per_pixel)
-        .map_err(|e| Error::Internal(format!("seam metric: {e}")))
+    let fail = |e: fieldtex_eval::EvalError| Error::Internal(format!("seam metric: {e}"));
+    let fv = fieldtex_eval::FieldView::new(flat, n, n).map_err(fail)?;
+    let options = fieldtex_eval::RosySeamOptions::default();
+    fieldtex_eval::rosy_seam_coherence_with_flips(
+        coords,
+        &fv,
+        Some(flips),
+        size,
+        per_pixel,
+        &options,
+    )
+    .map_err(fail)
 }
 
 /// The image metrics of an orient texture (`flat`: its `H×W×2` field) against the field
