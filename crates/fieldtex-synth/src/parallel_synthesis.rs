@@ -403,19 +403,8 @@ pub fn synthesize(
     options: &SynthesisOptions,
     progress: &dyn Progress,
 ) -> Result<SynthesisResult, SynthError> {
-    #[cfg(target_arch = "x86_64")]
-    let avx2 = std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    let avx2 = false;
     let (out_w, out_h) = check_output_size(domain)?;
-    let run = synthesize_with::<2, 8, { max_candidates(8) }>(
-        analysis,
-        &PlanarDomain(domain),
-        options,
-        progress,
-        avx2,
-        None,
-    )?;
+    let run = synthesize_planar(analysis, domain, options, progress, None)?;
     let filter = options.color_filter;
     let pixels = run.coords.par_iter().map(|&u| color_lookup(analysis, u, filter)).collect();
     Ok(SynthesisResult {
@@ -458,19 +447,8 @@ pub fn synthesize_subset(
             reason: format!("requested sample {bad} ≥ finest sample count {n0}"),
         });
     }
-    #[cfg(target_arch = "x86_64")]
-    let avx2 = std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    let avx2 = false;
     check_output_size(domain)?;
-    let run = synthesize_with::<2, 8, { max_candidates(8) }>(
-        analysis,
-        &PlanarDomain(domain),
-        options,
-        progress,
-        avx2,
-        Some(requested),
-    )?;
+    let run = synthesize_planar(analysis, domain, options, progress, Some(requested))?;
     let filter = options.color_filter;
     Ok(SubsetSynthesis {
         samples: requested.to_vec(),
@@ -482,6 +460,29 @@ pub fn synthesize_subset(
         flips: requested.iter().map(|&r| run.flips[r]).collect(),
         evaluated_per_level: run.evaluated_per_level,
     })
+}
+
+/// Whether the correction can run its AVX2 build on this CPU.
+pub(crate) fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
+/// The engine over a 2-D [`SynthesisDomain`] (8 neighbours, 4 subpass classes).
+fn synthesize_planar(
+    analysis: &ExemplarAnalysis,
+    domain: &dyn SynthesisDomain,
+    options: &SynthesisOptions,
+    progress: &dyn Progress,
+    requested: Option<&[usize]>,
+) -> Result<EngineRun, SynthError> {
+    let avx2 = avx2_available();
+    let planar = PlanarDomain(domain);
+    synthesize_with::<2, 8, { max_candidates(8) }>(
+        analysis, &planar, options, progress, avx2, requested,
+    )
 }
 
 /// The finest level's output image size, checked against its sample count.

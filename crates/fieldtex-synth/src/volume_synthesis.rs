@@ -13,7 +13,9 @@ use crate::SynthError;
 use crate::color_lookup::color_lookup;
 use crate::exemplar_analysis::ExemplarAnalysis;
 use crate::lattice_domain::LatticeDomain;
-use crate::parallel_synthesis::{SynthesisOptions, max_candidates, synthesize_with};
+use crate::parallel_synthesis::{
+    SynthesisOptions, avx2_available, max_candidates, synthesize_with,
+};
 
 /// Result of [`synthesize_volume`] for the requested voxels (all of them, in index
 /// order, when none were named).
@@ -51,12 +53,13 @@ pub fn synthesize_volume(
             reason: format!("requested voxel {bad} ≥ finest voxel count {n0}"),
         });
     }
-    #[cfg(target_arch = "x86_64")]
-    let avx2 = std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    let avx2 = false;
     let run = synthesize_with::<3, 26, { max_candidates(26) }>(
-        analysis, domain, options, progress, avx2, requested,
+        analysis,
+        domain,
+        options,
+        progress,
+        avx2_available(),
+        requested,
     )?;
     let samples: Vec<usize> = requested.map_or_else(|| (0..n0).collect(), <[usize]>::to_vec);
     let filter = options.color_filter;
