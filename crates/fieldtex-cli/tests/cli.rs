@@ -280,23 +280,7 @@ fn orient_preset_outputs_and_determinism() {
     let limit = Duration::from_secs(300);
     // a small left-loop run into `dir` with extra flags
     let orient = |dir: &std::path::Path, extra: &[&str]| {
-        let mut args = vec![
-            "orient",
-            "--preset",
-            "left-loop",
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--size",
-            "128",
-            "--grid",
-            "32",
-            "--out",
-            dir.to_str().unwrap(),
-            "--quiet",
-        ];
-        args.extend_from_slice(extra);
-        let o = run(&args, limit);
-        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        common::orient_small(dir, "left-loop", extra, limit);
     };
     for (dir, t) in [(&a, "1"), (&b, "2")] {
         orient(dir, &["--threads", t]);
