@@ -71,4 +71,4 @@ pub use parallel_synthesis::{
     SubsetSynthesis, SynthesisOptions, SynthesisResult, synthesize, synthesize_subset,
 };
 pub use regular_lattice::{JacobianField, RegularLattice};
-pub use volume_synthesis::{VolumeSynthesis, synthesize_volume};
+pub use volume_synthesis::synthesize_volume;

@@ -415,10 +415,12 @@ pub fn synthesize(
     })
 }
 
-/// Result of [`synthesize_subset`]: the requested finest samples, in the order given.
+/// Result of [`synthesize_subset`] and [`crate::synthesize_volume`]: the requested
+/// finest samples, in the order given.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SubsetSynthesis {
-    /// The requested sample indices (row-major over [`SynthesisDomain::output_size`]).
+    /// The requested sample indices (row-major over [`SynthesisDomain::output_size`];
+    /// for a volume x fastest, then y, then z).
     pub samples: Vec<usize>,
     /// Exemplar colour of each requested sample.
     pub colors: Vec<[f32; 4]>,
@@ -449,17 +451,28 @@ pub fn synthesize_subset(
     }
     check_output_size(domain)?;
     let run = synthesize_planar(analysis, domain, options, progress, Some(requested))?;
-    let filter = options.color_filter;
-    Ok(SubsetSynthesis {
-        samples: requested.to_vec(),
-        colors: requested
-            .par_iter()
-            .map(|&r| color_lookup(analysis, run.coords[r], filter))
-            .collect(),
-        coords: requested.iter().map(|&r| run.coords[r]).collect(),
-        flips: requested.iter().map(|&r| run.flips[r]).collect(),
-        evaluated_per_level: run.evaluated_per_level,
-    })
+    Ok(run.subset(analysis, requested.to_vec(), options.color_filter))
+}
+
+impl EngineRun {
+    /// The samples `samples` of this run, with their colours.
+    pub(crate) fn subset(
+        self,
+        analysis: &ExemplarAnalysis,
+        samples: Vec<usize>,
+        filter: crate::ColorFilter,
+    ) -> SubsetSynthesis {
+        SubsetSynthesis {
+            colors: samples
+                .par_iter()
+                .map(|&r| color_lookup(analysis, self.coords[r], filter))
+                .collect(),
+            coords: samples.iter().map(|&r| self.coords[r]).collect(),
+            flips: samples.iter().map(|&r| self.flips[r]).collect(),
+            samples,
+            evaluated_per_level: self.evaluated_per_level,
+        }
+    }
 }
 
 /// Whether the correction can run its AVX2 build on this CPU.
