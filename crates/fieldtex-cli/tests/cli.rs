@@ -280,23 +280,7 @@ fn orient_preset_outputs_and_determinism() {
     let limit = Duration::from_secs(300);
     // a small left-loop run into `dir` with extra flags
     let orient = |dir: &std::path::Path, extra: &[&str]| {
-        let mut args = vec![
-            "orient",
-            "--preset",
-            "left-loop",
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--size",
-            "128",
-            "--grid",
-            "32",
-            "--out",
-            dir.to_str().unwrap(),
-            "--quiet",
-        ];
-        args.extend_from_slice(extra);
-        let o = run(&args, limit);
-        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        common::orient_small(dir, "left-loop", extra, limit);
     };
     for (dir, t) in [(&a, "1"), (&b, "2")] {
         orient(dir, &["--threads", t]);
@@ -520,26 +504,17 @@ fn align_outputs_determinism_and_valid_glb() {
     let mesh = shared().join("meshes/fandisk.obj");
     let ex = shared().join("exemplars/stripes_Fabric071.png");
     let (a, b) = (tmp("align-t1"), tmp("align-t2"));
-    for (dir, threads) in [(&a, "1"), (&b, "2")] {
-        let o = run(
-            &[
-                "align",
-                "--mesh",
-                mesh.to_str().unwrap(),
-                "--exemplar",
-                ex.to_str().unwrap(),
-                "--size",
-                "256",
-                "--keep",
-                "--out",
-                dir.to_str().unwrap(),
-                "--threads",
-                threads,
-                "--quiet",
-            ],
-            Duration::from_secs(300),
-        );
+    // fandisk at 256² into `dir` with `extra` flags; must succeed.
+    let align = |dir: &Path, extra: &[&str]| {
+        let mut args = vec!["align", "--mesh", mesh.to_str().unwrap(), "--exemplar"];
+        args.extend([ex.to_str().unwrap(), "--size", "256", "--out", dir.to_str().unwrap()]);
+        args.push("--quiet");
+        args.extend_from_slice(extra);
+        let o = run(&args, Duration::from_secs(300));
         assert_eq!(code(&o), 0, "{}", stderr(&o));
+    };
+    for (dir, threads) in [(&a, "1"), (&b, "2")] {
+        align(dir, &["--keep", "--threads", threads]);
     }
     for f in ["model.glb", "preview.png", "curves.obj", "field.ply"] {
         let x = std::fs::read(a.join(f)).unwrap();
@@ -562,23 +537,7 @@ fn align_outputs_determinism_and_valid_glb() {
     assert!(coverage >= 0.8, "feature coverage {coverage}");
     assert!(error <= 15.0, "surface orientation error {error}°");
     let c = tmp("align-nofa");
-    let o = run(
-        &[
-            "align",
-            "--mesh",
-            mesh.to_str().unwrap(),
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--size",
-            "256",
-            "--no-feature-align",
-            "--out",
-            c.to_str().unwrap(),
-            "--quiet",
-        ],
-        Duration::from_secs(300),
-    );
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    align(&c, &["--no-feature-align"]);
     let ablation =
         report_without_timings(&c)["metrics"]["feature_coverage"]["fraction"].as_f64().unwrap();
     assert!(ablation + 0.3 < coverage, "ablation {ablation} vs aligned {coverage}");

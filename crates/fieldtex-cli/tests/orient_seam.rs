@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{code, run_limited, shared, stderr, tmp_in};
+use common::{code, orient_small, read_json, run_limited, shared, stderr, tmp_in};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -15,31 +15,10 @@ fn tmp(name: &str) -> PathBuf {
     tmp_in("orient_seam", name)
 }
 
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
 /// A whorl on the stripes exemplar at 128², with `extra` flags; returns the report.
 fn orient(dir: &Path, extra: &[&str]) -> serde_json::Value {
-    let ex = shared().join("exemplars/stripes_Fabric071.png");
-    let mut args = vec![
-        "orient",
-        "--preset",
-        "whorl",
-        "--exemplar",
-        ex.to_str().unwrap(),
-        "--size",
-        "128",
-        "--grid",
-        "32",
-        "--out",
-        dir.to_str().unwrap(),
-        "--quiet",
-    ];
-    args.extend_from_slice(extra);
-    let o = run_limited(&args, LIMIT);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
-    json(&dir.join("report.json"))
+    orient_small(dir, "whorl", extra, LIMIT);
+    read_json(&dir.join("report.json"))
 }
 
 #[test]
@@ -71,20 +50,14 @@ fn rosy_fix_keeps_seams_coherent_and_eval_agrees() {
     let ex = shared().join("exemplars/stripes_Fabric071.png");
     let (texture, field, coords) =
         (fix.join("texture.png"), fix.join("field.npy"), fix.join("coords.npy"));
-    let o = run_limited(
-        &[
-            "eval",
-            texture.to_str().unwrap(),
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--field",
-            field.to_str().unwrap(),
-            "--coords",
-            coords.to_str().unwrap(),
-            "--quiet",
-        ],
-        LIMIT,
-    );
+    // `eval TEXTURE --exemplar EX` with `extra` flags.
+    let eval = |extra: &[&str]| {
+        let mut args = vec!["eval", texture.to_str().unwrap(), "--exemplar", ex.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        run_limited(&args, LIMIT)
+    };
+    let (field_s, coords_s) = (field.to_str().unwrap(), coords.to_str().unwrap());
+    let o = eval(&["--field", field_s, "--coords", coords_s, "--quiet"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     // eval has no flips: the same numbers without the flip split.
@@ -95,17 +68,7 @@ fn rosy_fix_keeps_seams_coherent_and_eval_agrees() {
     assert_eq!(v["rosy_seam"], plain, "eval --coords reproduces orient's seam measure");
 
     // --coords without --field, and a coordinate map of the wrong shape: exit 2.
-    let o = run_limited(
-        &[
-            "eval",
-            texture.to_str().unwrap(),
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--coords",
-            coords.to_str().unwrap(),
-        ],
-        LIMIT,
-    );
+    let o = eval(&["--coords", coords_s]);
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     let wrong = tmp("wrong");
     let small = wrong.join("coords.npy");
@@ -118,19 +81,7 @@ fn rosy_fix_keeps_seams_coherent_and_eval_agrees() {
     bytes.push(b'\n');
     bytes.extend(std::iter::repeat_n(0u8, 4 * 4 * 2 * 4));
     std::fs::write(&small, bytes).unwrap();
-    let o = run_limited(
-        &[
-            "eval",
-            texture.to_str().unwrap(),
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--field",
-            field.to_str().unwrap(),
-            "--coords",
-            small.to_str().unwrap(),
-        ],
-        LIMIT,
-    );
+    let o = eval(&["--field", field_s, "--coords", small.to_str().unwrap()]);
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("coords.npy"), "names the file: {}", stderr(&o));
 }

@@ -157,34 +157,30 @@ fn bad_sketches_name_the_curve_and_point() {
         r#"{"curves": [{"points": [[0,0,0],[1,0,0]]}, {"points": [[0,0,0]]}]}"#,
     )
     .unwrap();
-    let o = run(&[
-        "solid",
-        "--mesh",
-        shared().join("meshes/torus.obj").to_str().unwrap(),
-        "--sketch",
-        sketch.to_str().unwrap(),
-        "--exemplar",
-        shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap(),
-        "--out",
-        d.join("out").to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (torus, wood) =
+        (shared().join("meshes/torus.obj"), shared().join("exemplars/woodgrain_Wood022.png"));
+    let out = d.join("out");
+    // The torus with the sketch file as it is now.
+    let solid_run = || {
+        run(&[
+            "solid",
+            "--mesh",
+            torus.to_str().unwrap(),
+            "--sketch",
+            sketch.to_str().unwrap(),
+            "--exemplar",
+            wood.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+    };
+    let o = solid_run();
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("curve 1") && e.contains("s.json"), "{e}");
     std::fs::write(&sketch, r#"{"curves": [{"points": [[0,0,0],[1,0,"x"]]}]}"#).unwrap();
-    let o = run(&[
-        "solid",
-        "--mesh",
-        shared().join("meshes/torus.obj").to_str().unwrap(),
-        "--sketch",
-        sketch.to_str().unwrap(),
-        "--exemplar",
-        shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap(),
-        "--out",
-        d.join("out").to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = solid_run();
     assert_eq!(o.status.code(), Some(2));
 }
 

@@ -61,7 +61,7 @@ use crate::mesh_scale::mean_edge_length_of;
 use crate::sharp_edges::{salient_creases, sharp_edge_chains};
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_core::{NoProgress, Progress, Warning};
-use fieldtex_mesh::{CurvatureOptions, PrincipalCurvatures, Topology, TriMesh};
+use fieldtex_mesh::{CurvatureOptions, MeshGeometry, PrincipalCurvatures, Topology, TriMesh};
 use serde::Serialize;
 
 /// What a line is the crest of. Ridge and valley assume outward-facing triangles
@@ -258,14 +258,25 @@ pub fn crest_lines_with_progress(
     options: &CrestOptions,
     progress: &dyn Progress,
 ) -> Result<CrestLines, FeaturesError> {
+    crest_lines_with_geometry(&MeshGeometry::new(mesh), options, progress)
+}
+
+/// [`crest_lines_with_progress`] taking the topology and face normals from a pipeline's
+/// [`MeshGeometry`] (computed once per mesh; the same values, so the same lines).
+pub fn crest_lines_with_geometry(
+    geometry: &MeshGeometry,
+    options: &CrestOptions,
+    progress: &dyn Progress,
+) -> Result<CrestLines, FeaturesError> {
+    let mesh = geometry.mesh();
     options.validate()?;
     if mesh.triangles.is_empty() {
         return Err(FeaturesError::EmptyMesh);
     }
     mesh.validate()?;
     progress.stage("crest lines: curvature", 4);
-    let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let h = mean_edge_length_of(mesh, &topo)?;
+    let topo = geometry.require_topology();
+    let h = mean_edge_length_of(mesh, topo)?;
     let diagonal = mesh.bounding_box().map_or(0.0, |b| b.diagonal());
     let mut stats = CrestStats { mean_edge_length: h, diagonal, ..Default::default() };
     let curv_opts = CurvatureOptions {
@@ -276,19 +287,19 @@ pub fn crest_lines_with_progress(
     progress.advance(1);
 
     // Creases.
-    let face_normals = fieldtex_mesh::face_normals(mesh);
+    let face_normals = geometry.require_face_normals();
     let sharp = if options.sharp_angle_deg < 180.0 {
         salient_creases(
             mesh,
-            &topo,
-            &face_normals,
+            topo,
+            face_normals,
             options.sharp_angle_deg.to_radians(),
             options.crease_contrast,
         )
     } else {
         Vec::new()
     };
-    let chains = sharp_edge_chains(&topo, &sharp);
+    let chains = sharp_edge_chains(topo, &sharp);
     stats.sharp_edges = sharp.len();
     stats.sharp_chains = chains.len();
     let mut raw: Vec<(RawLine, LineKind, LineSource)> = chains
@@ -304,7 +315,7 @@ pub fn crest_lines_with_progress(
     progress.advance(1);
 
     // Curvature extrema, away from creases and boundaries.
-    let face_allowed = traceable_faces(mesh, &topo, &sharp, options);
+    let face_allowed = traceable_faces(mesh, topo, &sharp, options);
     let corners = vertex_corners(mesh.n_vertices(), &mesh.triangles);
     let flat = if diagonal > 0.0 { options.flat_curvature / diagonal } else { f64::INFINITY };
     let trace = |ridge: bool, raw: &mut Vec<(RawLine, LineKind, LineSource)>| {
@@ -324,7 +335,7 @@ pub fn crest_lines_with_progress(
             anisotropy: options.min_anisotropy,
             sharpness: options.min_sharpness,
         };
-        let (lines, counts): (_, CrossingCounts) = trace_family(mesh, &topo, &fam, &face_allowed);
+        let (lines, counts): (_, CrossingCounts) = trace_family(mesh, topo, &fam, &face_allowed);
         let kind = if ridge { LineKind::Ridge } else { LineKind::Valley };
         raw.extend(lines.into_iter().map(|l| (l, kind, LineSource::Curvature)));
         counts

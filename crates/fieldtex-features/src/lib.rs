@@ -32,7 +32,7 @@ mod test_shapes;
 
 pub use crest_lines::{
     CrestLine, CrestLines, CrestOptions, CrestStats, LineKind, LineSource, crest_lines,
-    crest_lines_with_progress,
+    crest_lines_with_geometry, crest_lines_with_progress,
 };
 pub use curve_preprocessing::{CurvePreprocessOptions, preprocess_lines, preprocess_polylines};
 pub use curve_proximity::{curve_surface_points, distance_to_curves};

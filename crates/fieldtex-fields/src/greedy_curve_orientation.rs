@@ -46,7 +46,7 @@ use std::time::Instant;
 
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_core::{Progress, Warning};
-use fieldtex_mesh::TriMesh;
+use fieldtex_mesh::{MeshGeometry, TriMesh};
 use rand::RngExt;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -197,6 +197,17 @@ pub fn orient_curves<'m>(
     options: &CurveOrientationOptions,
     progress: &dyn Progress,
 ) -> Result<CurveOrientationResult<'m>, FieldsError> {
+    orient_curves_with_geometry(&MeshGeometry::new(mesh), curves, options, progress)
+}
+
+/// [`orient_curves`] over a pipeline's [`MeshGeometry`] (the solver takes its vertex
+/// normals from it: [`CurveFieldSolver::with_geometry`]).
+pub fn orient_curves_with_geometry<'m>(
+    geometry: &MeshGeometry<'m>,
+    curves: &[Vec<V3>],
+    options: &CurveOrientationOptions,
+    progress: &dyn Progress,
+) -> Result<CurveOrientationResult<'m>, FieldsError> {
     let t_start = Instant::now();
     if let Some(tau) = options.batch_consistency
         && !(tau > 0.0 && tau <= 1.0)
@@ -207,7 +218,7 @@ pub fn orient_curves<'m>(
             expected: "a number in (0, 1]",
         });
     }
-    let mut solver = CurveFieldSolver::new(mesh, &options.field)?;
+    let mut solver = CurveFieldSolver::with_geometry(geometry, &options.field)?;
     let sampled: Vec<CurveConstraints> =
         curves.par_iter().map(|c| solver.sample_curve(c)).collect();
     let mut warnings = Vec::new();

@@ -50,8 +50,8 @@ use fieldtex_core::Warning;
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_linalg::{Cholesky, FactorLayout, SparseMatrix, SymbolicCholesky};
 use fieldtex_mesh::{
-    CotanOptions, CurvatureOptions, MeshError, NormalWeighting, SpatialGrid, TriMesh, UnionFind,
-    cotan_laplacian_with, principal_curvatures, vertex_normals,
+    CotanOptions, CurvatureOptions, MeshError, MeshGeometry, NormalWeighting, SpatialGrid, TriMesh,
+    UnionFind, cotan_laplacian_with, principal_curvatures,
 };
 
 use crate::FieldsError;
@@ -112,6 +112,16 @@ impl<'m> CurveFieldSolver<'m> {
     /// Builds `L`, the components and the vertex normals. Errors: invalid mesh (indices,
     /// non-finite positions), a mesh without usable triangles, invalid options.
     pub fn new(mesh: &'m TriMesh, options: &CurveFieldOptions) -> Result<Self, FieldsError> {
+        Self::with_geometry(&MeshGeometry::new(mesh), options)
+    }
+
+    /// [`Self::new`] taking the vertex normals from a pipeline's [`MeshGeometry`]
+    /// (computed once per mesh; the same values, so the same field).
+    pub fn with_geometry(
+        geometry: &MeshGeometry<'m>,
+        options: &CurveFieldOptions,
+    ) -> Result<Self, FieldsError> {
+        let mesh = geometry.mesh();
         options.validate()?;
         mesh.validate()?;
         let nv = mesh.n_vertices();
@@ -184,7 +194,7 @@ impl<'m> CurveFieldSolver<'m> {
                 })
             })
             .collect::<Result<Vec<_>, FieldsError>>()?;
-        let (normals, _) = vertex_normals(mesh, NormalWeighting::Angle);
+        let normals = geometry.require_vertex_normals(NormalWeighting::Angle).0.to_vec();
         let boxes: Vec<(V3, V3)> = (0..nv)
             .map(|v| if used[v] { (p[v], p[v]) } else { ([f64::NAN; 3], [f64::NAN; 3]) })
             .collect();

@@ -94,7 +94,8 @@ pub mod surface_field_metrics;
 pub mod surface_streamlines;
 pub use greedy_curve_orientation::{
     CurveOrientationOptions, CurveOrientationResult, OrientationMode, OrientationScore,
-    OrientationStep, orient_curves, orient_curves_with_signs, orientation_score,
+    OrientationStep, orient_curves, orient_curves_with_geometry, orient_curves_with_signs,
+    orientation_score,
 };
 pub use harmonic_diffusion::{
     AddReport, CurveConstraints, CurveField, CurveFieldOptions, CurveFieldSolver, OverlapPolicy,

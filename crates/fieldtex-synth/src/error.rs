@@ -1,5 +1,6 @@
 //! The error type of the synthesis crate.
 
+use fieldtex_core::ErrorKind;
 use fieldtex_linalg::LinalgError;
 use thiserror::Error;
 
@@ -36,4 +37,40 @@ pub enum SynthError {
     InvalidDomain { reason: String },
     #[error("appearance-space PCA failed at stack level {level}: {source}")]
     Pca { level: usize, source: LinalgError },
+}
+
+impl SynthError {
+    /// Whose fault ([`ErrorKind`]): everything about the exemplar, the options, the
+    /// direction field and the domain the caller built is bad input; a failed
+    /// appearance-space PCA (a numerical breakdown on a valid exemplar) is internal.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            SynthError::Pca { .. } => ErrorKind::Internal,
+            SynthError::ExemplarTooSmall { .. }
+            | SynthError::ExemplarTooLarge { .. }
+            | SynthError::ExemplarBufferSize { .. }
+            | SynthError::NonFiniteExemplar { .. }
+            | SynthError::InvalidOption { .. }
+            | SynthError::FieldSize { .. }
+            | SynthError::NonFiniteField { .. }
+            | SynthError::InvalidJacobian { .. }
+            | SynthError::InvalidDomain { .. } => ErrorKind::BadInput,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_split_input_from_internal_failures() {
+        let small = SynthError::ExemplarTooSmall { width: 3, height: 3, min: 8 };
+        assert_eq!(small.kind(), ErrorKind::BadInput);
+        assert_eq!(small.kind().exit_code(), 2);
+        let source = LinalgError::NonFinite { what: "covariance", index: 0 };
+        let pca = SynthError::Pca { level: 1, source };
+        assert_eq!(pca.kind(), ErrorKind::Internal);
+        assert_eq!(pca.kind().exit_code(), 1);
+    }
 }

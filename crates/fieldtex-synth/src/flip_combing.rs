@@ -13,14 +13,17 @@
 
 use std::collections::VecDeque;
 
-/// Neighbour slots of the 4-neighbours in the engine's 8-neighbour tables
-/// (`[1, 0]`, `[0, 1]`, `[−1, 0]`, `[0, −1]`).
-const AXIS_SLOTS: [usize; 4] = [0, 2, 4, 6];
+use crate::lattice_domain::{Jacobian, frobenius};
 
-/// Combed flips of one level: `nbr[p]` holds the 8 neighbours of `p` (`u32::MAX`:
-/// none) in the order `(1,0), (1,1), (0,1), (−1,1), (−1,0), (−1,−1), (0,−1), (1,−1)`,
-/// `jac[p]` its representative Jacobian (row-major 2×2).
-pub(crate) fn comb_flips(nbr: &[[u32; 8]], jac: &[[f32; 4]]) -> Vec<bool> {
+/// Combed flips of one level: `nbr[p]` holds the neighbours of `p` (`u32::MAX`: none)
+/// in the engine's slot order, `jac[p]` its representative Jacobian, `axes` the slots of
+/// the `2D` axis neighbours the sweep follows (for a 2-D grid `(1,0), (0,1), (−1,0),
+/// (0,−1)`).
+pub(crate) fn comb_flips<const D: usize, const S: usize>(
+    nbr: &[[u32; S]],
+    jac: &[Jacobian<D>],
+    axes: &[usize],
+) -> Vec<bool> {
     let n = jac.len();
     let mut fl = vec![false; n];
     let mut seen = vec![false; n];
@@ -32,15 +35,14 @@ pub(crate) fn comb_flips(nbr: &[[u32; 8]], jac: &[[f32; 4]]) -> Vec<bool> {
         seen[start] = true;
         queue.push_back(start);
         while let Some(p) = queue.pop_front() {
-            for k in AXIS_SLOTS {
+            for &k in axes {
                 let q = nbr[p][k];
                 if q == u32::MAX || seen[q as usize] {
                     continue;
                 }
                 let q = q as usize;
                 seen[q] = true;
-                let (a, b) = (&jac[p], &jac[q]);
-                let opposite = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0.0;
+                let opposite = frobenius(&jac[p], &jac[q]) < 0.0;
                 fl[q] = fl[p] ^ opposite;
                 queue.push_back(q);
             }
@@ -72,9 +74,16 @@ mod tests {
             .collect()
     }
 
+    /// Axis slots of the 8-neighbour order above.
+    const AXIS_SLOTS: [usize; 4] = [0, 2, 4, 6];
+
     fn rot(a: f32) -> [f32; 4] {
         let (s, c) = a.sin_cos();
         [c, s, -s, c]
+    }
+
+    fn rows(jac: &[[f32; 4]]) -> Vec<Jacobian<2>> {
+        jac.iter().map(|j| [[j[0], j[1]], [j[2], j[3]]]).collect()
     }
 
     #[test]
@@ -84,7 +93,7 @@ mod tests {
         let jac: Vec<[f32; 4]> = (0..w * h)
             .map(|i| rot(if i % w < 4 { 0.17 } else { 0.17 + std::f32::consts::PI }))
             .collect();
-        let fl = comb_flips(&grid(w, h), &jac);
+        let fl = comb_flips(&grid(w, h), &rows(&jac), &AXIS_SLOTS);
         for (i, &f) in fl.iter().enumerate() {
             assert_eq!(f, i % w >= 4, "sample {i}");
         }
@@ -99,7 +108,7 @@ mod tests {
         let jac: Vec<[f32; 4]> =
             (0..n * n).map(|i| rot(0.5 * ((i / n) as f32 - c).atan2((i % n) as f32 - c))).collect();
         let nbr = grid(n, n);
-        let fl = comb_flips(&nbr, &jac);
+        let fl = comb_flips(&nbr, &rows(&jac), &AXIS_SLOTS);
         let eff = |p: usize| jac[p].map(|v| if fl[p] { -v } else { v });
         let mut seams = 0;
         for (p, nb) in nbr.iter().enumerate() {

@@ -9,6 +9,12 @@
 //!   sample grids with neighbours, parents and a per-sample Jacobian (domain offsets →
 //!   exemplar offsets). [`ImageDomain`] is the plane (image output) built from an
 //!   `H × W × 2` direction field; atlas charts and other domains implement the trait.
+//! - [`LatticeDomain`] (`lattice_domain.rs`): the dimension-generic domain the engine
+//!   really runs over (`D`-dimensional offsets, a 2 × `D` Jacobian, `2^D` subpass
+//!   classes); [`PlanarDomain`] presents a [`SynthesisDomain`] as one, and
+//!   [`RegularLattice`] is a box of samples in 2-D or 3-D computed arithmetically.
+//!   [`synthesize_volume`] runs the same engine on a 3-D lattice with the one 2-D
+//!   exemplar type.
 //! - [`synthesize`] (`parallel_synthesis.rs`): coarse-to-fine upsampling with the
 //!   Jacobian, seeded jitter, correction passes with 2×2 subpasses over four-corner
 //!   neighbourhoods, and the 2-RoSy flip indicator of paper D §4
@@ -44,11 +50,14 @@ pub mod gaussian_stack;
 pub mod graph_cut;
 pub mod image_quilting;
 pub mod k_coherence;
+pub mod lattice_domain;
 mod level_tables;
 pub mod parallel_synthesis;
+pub mod regular_lattice;
 pub mod solid;
 pub mod synthesis_options;
 mod synthesis_subset;
+pub mod volume_synthesis;
 
 pub use characteristic_scale::{CharacteristicScale, characteristic_scale};
 pub use color_lookup::{ColorFilter, color_lookup};
@@ -57,6 +66,9 @@ pub use error::SynthError;
 pub use exemplar_analysis::{APPEARANCE_DIMS, AnalysisLevel, AnalysisOptions, ExemplarAnalysis};
 pub use exemplar_policy::{FittedExemplar, MAX_EXEMPLAR_SIDE, fit_exemplar};
 pub use image_quilting::{QuiltStats, QuiltTarget, QuiltingOptions, quilt};
+pub use lattice_domain::{Jacobian, LatticeDomain, PlanarDomain};
 pub use parallel_synthesis::{
     SubsetSynthesis, SynthesisOptions, SynthesisResult, synthesize, synthesize_subset,
 };
+pub use regular_lattice::{JacobianField, RegularLattice};
+pub use volume_synthesis::synthesize_volume;

@@ -72,14 +72,13 @@ use rayon::prelude::*;
 use crate::color_lookup::color_lookup;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
 use crate::flip_combing::comb_flips;
-use crate::level_tables::{LevelTables, NONE, OFFS8, frobenius, mat_vec, tabulate};
-use crate::synthesis_subset::SubsetPlan;
-
-/// Corner offsets `Δ` of the four-corner neighbourhood; bit 0 of the index is the x
-/// sign (0 = −1), bit 1 the y sign.
-pub(crate) const CORNERS: [[i32; 2]; 4] = [[-1, -1], [1, -1], [-1, 1], [1, 1]];
+use crate::lattice_domain::{
+    CORNERS, Dim, LatticeDomain, PlanarDomain, Stencil, frobenius, mat_vec, mean, negated,
+};
+use crate::level_tables::{LevelTables, NONE, tabulate};
 pub use crate::synthesis_options::SynthesisOptions;
 use crate::synthesis_options::{MAX_K, validate};
+use crate::synthesis_subset::SubsetPlan;
 use crate::{SynthError, SynthesisDomain};
 
 /// Result of [`synthesize`]: per finest-level sample (row-major over
@@ -96,9 +95,11 @@ pub struct SynthesisResult {
     pub level_timings_ms: Vec<f64>,
 }
 
-/// Candidates of one correction at most: per neighbour its prediction and k jumps, and
-/// p's own k jumps.
-const MAX_CANDIDATES: usize = 8 * (1 + MAX_K) + MAX_K;
+/// Candidates of one correction at most on a lattice with `s` neighbours: per neighbour
+/// its prediction and k jumps, and p's own k jumps.
+pub(crate) const fn max_candidates(s: usize) -> usize {
+    s * (1 + MAX_K) + MAX_K
+}
 /// Lanes of a four-corner neighbourhood vector: 4 corners × [`APPEARANCE_DIMS`].
 const NV: usize = 4 * APPEARANCE_DIMS;
 
@@ -215,10 +216,11 @@ impl ExemplarLevel {
     }
 }
 
-/// Per-level synthesis context.
-struct Pass<'a> {
+/// Per-level synthesis context on a `D`-dimensional lattice with `S` neighbours and room
+/// for `C` ([`max_candidates`]`(S)`) candidates.
+struct Pass<'a, const D: usize, const S: usize, const C: usize> {
     ex: ExemplarLevel,
-    t: &'a LevelTables,
+    t: &'a LevelTables<D, S>,
     spacing: f32,
     k: usize,
     rosy: bool,
@@ -231,7 +233,10 @@ struct Pass<'a> {
     trapezoid: bool,
 }
 
-impl Pass<'_> {
+impl<const D: usize, const S: usize, const C: usize> Pass<'_, D, S, C>
+where
+    Dim<D>: Stencil<D, S>,
+{
     /// [`Self::correct_impl`] compiled for AVX2 (integer distances and the same IEEE
     /// float operations without FMA contraction: bit-identical to the baseline build).
     #[cfg(target_arch = "x86_64")]
@@ -259,9 +264,9 @@ impl Pass<'_> {
         let nb = &self.t.nbr[p];
         // Predictions of p's coordinate by each neighbour: (coordinate, flip, the
         // neighbour's effective offset h F(q) δ).
-        let mut pred = [([0.0f32; 2], false, [0.0f32; 2]); 8];
-        let mut valid = [false; 8];
-        for k in 0..8 {
+        let mut pred = [([0.0f32; 2], false, [0.0f32; 2]); S];
+        let mut valid = [false; S];
+        for k in 0..S {
             let q = nb[k];
             if q == NONE {
                 continue;
@@ -270,7 +275,7 @@ impl Pass<'_> {
             let (mut fq, alpha) = if self.rosy {
                 let jq = self.t.jac[q];
                 let cons = frobenius(&jq, &jp) < 0.0;
-                let fq = if fl[q] { jq.map(|v| -v) } else { jq };
+                let fq = if fl[q] { negated(&jq) } else { jq };
                 (fq, fl[q] ^ cons)
             } else {
                 (jp, false)
@@ -278,11 +283,11 @@ impl Pass<'_> {
             if self.trapezoid {
                 // Trapezoid rule: the mean of q's effective frame and p's frame with the
                 // candidate's flip (sign-aligned with it by the choice of α).
-                let fpa = if alpha { jp.map(|v| -v) } else { jp };
-                fq = std::array::from_fn(|i| 0.5 * (fq[i] + fpa[i]));
+                let fpa = if alpha { negated(&jp) } else { jp };
+                fq = mean(&fq, &fpa);
             }
-            let d = OFFS8[k];
-            let off = mat_vec(&fq, [d[0] as f32 * h, d[1] as f32 * h]);
+            let d = <Dim<D> as Stencil<D, S>>::OFFSETS[k];
+            let off = mat_vec(&fq, d.map(|c| c as f32 * h));
             pred[k] = (ex.wrap([s[q][0] - off[0], s[q][1] - off[1]]), alpha, off);
             valid[k] = true;
         }
@@ -292,12 +297,12 @@ impl Pass<'_> {
         // prediction (domain border) are masked out.
         let mut target = [0i16; NV];
         let mut mask = [0i16; NV];
-        for (ci, &dir) in self.t.corner_dir[p].iter().enumerate() {
+        for (ci, slots) in self.t.corner_slots[p].iter().enumerate() {
             let lanes = ci * APPEARANCE_DIMS..(ci + 1) * APPEARANCE_DIMS;
             let tc = &mut target[lanes.clone()];
             let mut count = 0i16;
-            for t in [dir + 7, dir, dir + 1] {
-                let t = (t % 8) as usize;
+            for &t in slots {
+                let t = t as usize;
                 if !valid[t] {
                     continue;
                 }
@@ -331,9 +336,9 @@ impl Pass<'_> {
         };
         // Gather the eligible candidates (coordinates outside the level's margin band
         // are not), then score them in one branch-free sweep whose table loads overlap.
-        let mut cand_u = [[0.0f32; 2]; MAX_CANDIDATES];
-        let mut cand_nv: [&[i8; NV]; MAX_CANDIDATES] = [&ex.nv[0][0]; MAX_CANDIDATES];
-        let mut cand_b = [false; MAX_CANDIDATES];
+        let mut cand_u = [[0.0f32; 2]; C];
+        let mut cand_nv: [&[i8; NV]; C] = [&ex.nv[0][0]; C];
+        let mut cand_b = [false; C];
         let mut n = 0usize;
         let mut push = |u: [f32; 2], b: bool| {
             let (x, y) = ex.cell(u);
@@ -344,7 +349,7 @@ impl Pass<'_> {
                 n += 1;
             }
         };
-        for k in 0..8 {
+        for k in 0..S {
             if !valid[k] {
                 continue;
             }
@@ -373,7 +378,7 @@ impl Pass<'_> {
                 push(ex.wrap([v[0] + frac[0], v[1] + frac[1]]), b);
             }
         }
-        let mut dist = [0i32; MAX_CANDIDATES];
+        let mut dist = [0i32; C];
         for (d, a) in dist[..n].iter_mut().zip(&cand_nv[..n]) {
             *d = dist_nv(a, &target, &mask);
         }
@@ -398,12 +403,8 @@ pub fn synthesize(
     options: &SynthesisOptions,
     progress: &dyn Progress,
 ) -> Result<SynthesisResult, SynthError> {
-    #[cfg(target_arch = "x86_64")]
-    let avx2 = std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    let avx2 = false;
-    let run = synthesize_with(analysis, domain, options, progress, avx2, None)?;
-    let (out_w, out_h) = domain.output_size();
+    let (out_w, out_h) = check_output_size(domain)?;
+    let run = synthesize_planar(analysis, domain, options, progress, None)?;
     let filter = options.color_filter;
     let pixels = run.coords.par_iter().map(|&u| color_lookup(analysis, u, filter)).collect();
     Ok(SynthesisResult {
@@ -414,10 +415,12 @@ pub fn synthesize(
     })
 }
 
-/// Result of [`synthesize_subset`]: the requested finest samples, in the order given.
+/// Result of [`synthesize_subset`] and [`crate::synthesize_volume`]: the requested
+/// finest samples, in the order given.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SubsetSynthesis {
-    /// The requested sample indices (row-major over [`SynthesisDomain::output_size`]).
+    /// The requested sample indices (row-major over [`SynthesisDomain::output_size`];
+    /// for a volume x fastest, then y, then z).
     pub samples: Vec<usize>,
     /// Exemplar colour of each requested sample.
     pub colors: Vec<[f32; 4]>,
@@ -446,49 +449,94 @@ pub fn synthesize_subset(
             reason: format!("requested sample {bad} ≥ finest sample count {n0}"),
         });
     }
+    check_output_size(domain)?;
+    let run = synthesize_planar(analysis, domain, options, progress, Some(requested))?;
+    Ok(run.subset(analysis, requested.to_vec(), options.color_filter))
+}
+
+impl EngineRun {
+    /// The samples `samples` of this run, with their colours.
+    pub(crate) fn subset(
+        self,
+        analysis: &ExemplarAnalysis,
+        samples: Vec<usize>,
+        filter: crate::ColorFilter,
+    ) -> SubsetSynthesis {
+        SubsetSynthesis {
+            colors: samples
+                .par_iter()
+                .map(|&r| color_lookup(analysis, self.coords[r], filter))
+                .collect(),
+            coords: samples.iter().map(|&r| self.coords[r]).collect(),
+            flips: samples.iter().map(|&r| self.flips[r]).collect(),
+            samples,
+            evaluated_per_level: self.evaluated_per_level,
+        }
+    }
+}
+
+/// Whether the correction can run its AVX2 build on this CPU.
+pub(crate) fn avx2_available() -> bool {
     #[cfg(target_arch = "x86_64")]
-    let avx2 = std::arch::is_x86_feature_detected!("avx2");
+    return std::arch::is_x86_feature_detected!("avx2");
     #[cfg(not(target_arch = "x86_64"))]
-    let avx2 = false;
-    let run = synthesize_with(analysis, domain, options, progress, avx2, Some(requested))?;
-    let filter = options.color_filter;
-    Ok(SubsetSynthesis {
-        samples: requested.to_vec(),
-        colors: requested
-            .par_iter()
-            .map(|&r| color_lookup(analysis, run.coords[r], filter))
-            .collect(),
-        coords: requested.iter().map(|&r| run.coords[r]).collect(),
-        flips: requested.iter().map(|&r| run.flips[r]).collect(),
-        evaluated_per_level: run.evaluated_per_level,
-    })
+    false
 }
 
-/// Finest-level state after the last level (full, or right at the planned samples).
-struct EngineRun {
-    coords: Vec<[f32; 2]>,
-    flips: Vec<bool>,
-    level_timings_ms: Vec<f64>,
-    evaluated_per_level: Vec<usize>,
-}
-
-/// The engine with the AVX2 build of the correction on or off (`avx2` only when the CPU
-/// supports it), over every sample or only the dependency sets of `requested`.
-fn synthesize_with(
+/// The engine over a 2-D [`SynthesisDomain`] (8 neighbours, 4 subpass classes).
+fn synthesize_planar(
     analysis: &ExemplarAnalysis,
     domain: &dyn SynthesisDomain,
     options: &SynthesisOptions,
     progress: &dyn Progress,
-    avx2: bool,
     requested: Option<&[usize]>,
 ) -> Result<EngineRun, SynthError> {
-    validate(options, analysis)?;
+    let avx2 = avx2_available();
+    let planar = PlanarDomain(domain);
+    synthesize_with::<2, 8, { max_candidates(8) }>(
+        analysis, &planar, options, progress, avx2, requested,
+    )
+}
+
+/// The finest level's output image size, checked against its sample count.
+fn check_output_size(domain: &dyn SynthesisDomain) -> Result<(usize, usize), SynthError> {
     let n0 = domain.sample_count(0);
     let (out_w, out_h) = domain.output_size();
     if n0 == 0 || out_w * out_h != n0 {
         return Err(SynthError::InvalidDomain {
             reason: format!("{n0} finest samples but output size {out_w}×{out_h}"),
         });
+    }
+    Ok((out_w, out_h))
+}
+
+/// Finest-level state after the last level (full, or right at the planned samples).
+pub(crate) struct EngineRun {
+    pub(crate) coords: Vec<[f32; 2]>,
+    pub(crate) flips: Vec<bool>,
+    pub(crate) level_timings_ms: Vec<f64>,
+    pub(crate) evaluated_per_level: Vec<usize>,
+}
+
+/// The engine with the AVX2 build of the correction on or off (`avx2` only when the CPU
+/// supports it), over every sample or only the dependency sets of `requested`, on a
+/// `D`-dimensional lattice with `S` neighbours (`C` = [`max_candidates`]`(S)`).
+pub(crate) fn synthesize_with<const D: usize, const S: usize, const C: usize>(
+    analysis: &ExemplarAnalysis,
+    domain: &dyn LatticeDomain<D>,
+    options: &SynthesisOptions,
+    progress: &dyn Progress,
+    avx2: bool,
+    requested: Option<&[usize]>,
+) -> Result<EngineRun, SynthError>
+where
+    Dim<D>: Stencil<D, S>,
+{
+    const { assert!(C >= max_candidates(S)) };
+    validate(options, analysis)?;
+    let n0 = domain.sample_count(0);
+    if n0 == 0 {
+        return Err(SynthError::InvalidDomain { reason: "the domain has no samples".into() });
     }
     if domain.level_count() < 2 {
         return Err(SynthError::InvalidDomain {
@@ -501,7 +549,7 @@ fn synthesize_with(
     progress.stage("parallel synthesis", levels as u64);
 
     // Initialisation level: random coordinates, no flips.
-    let mut parent_tables = tabulate(domain, levels, options.scale, 1, false)?;
+    let mut parent_tables = tabulate::<D, S>(domain, levels, options.scale, 1, false)?;
     let n_init = domain.sample_count(levels);
     let m = analysis.level(levels - 1).margin.min(w.min(h) / 2) as f64;
     let mut s: Vec<[f32; 2]> = (0..n_init)
@@ -516,7 +564,7 @@ fn synthesize_with(
         })
         .collect();
     let mut fl = if options.rosy_fix && options.comb_flips {
-        comb_flips(&parent_tables.nbr, &parent_tables.jac)
+        comb_flips(&parent_tables.nbr, &parent_tables.jac, <Dim<D> as Stencil<D, S>>::AXES)
     } else {
         vec![false; n_init]
     };
@@ -572,15 +620,15 @@ fn synthesize_with(
                 let par = par as usize;
                 let jpar = pj[par];
                 let flip_par = rosy && pf[par];
-                let mut f = if flip_par { jpar.map(|v| -v) } else { jpar };
+                let mut f = if flip_par { negated(&jpar) } else { jpar };
                 if trapezoid {
                     // Trapezoid rule: the mean of the parent's effective frame and the
                     // child's representative frame sign-aligned with it.
                     let jc = tables.jac[i];
-                    let jc = if frobenius(&f, &jc) < 0.0 { jc.map(|v| -v) } else { jc };
-                    f = std::array::from_fn(|k| 0.5 * (f[k] + jc[k]));
+                    let jc = if frobenius(&f, &jc) < 0.0 { negated(&jc) } else { jc };
+                    f = mean(&f, &jc);
                 }
-                let o = mat_vec(&f, [off[0] * spacing, off[1] * spacing]);
+                let o = mat_vec(&f, off.map(|v| v * spacing));
                 let idx = ((level * n0 + i) as u64) * 2;
                 let mut jx = (2.0 * hash_unit(seed, "synthesis-jitter", idx) - 1.0) as f32 * amp;
                 let mut jy =
@@ -594,7 +642,7 @@ fn synthesize_with(
             })
             .unzip();
         // 3. Correction passes with subpasses.
-        let pass = Pass {
+        let pass = Pass::<D, S, C> {
             ex,
             t: &tables,
             spacing,

@@ -5,7 +5,7 @@
 //!
 //! **Dependency sets.** One level's corrections are a fixed sequence of steps
 //! (`passes × subpass classes`); the step of class `C` rewrites the samples of `C` from
-//! the current values of their 8 neighbours and themselves. Walking the steps
+//! the current values of their neighbours (8 in 2-D, 26 in 3-D) and themselves. Walking the steps
 //! backwards from the set `N` needed after the last step, the samples a step must
 //! rewrite are `N ∩ C`, and before it `N ∪ nbrs(N ∩ C)` must be right. What is needed
 //! before the first step is what upsampling must produce, and upsampling reads one
@@ -32,8 +32,8 @@ impl SubsetPlan {
     /// The plan for `requested` finest samples over `tables[level]` (levels `0..L`,
     /// the initialisation level of `n_init` samples excluded), `passes(level)`
     /// correction passes each.
-    pub(crate) fn new(
-        tables: &[LevelTables],
+    pub(crate) fn new<const D: usize, const S: usize>(
+        tables: &[LevelTables<D, S>],
         n_init: usize,
         passes: impl Fn(usize) -> usize,
         requested: &[usize],

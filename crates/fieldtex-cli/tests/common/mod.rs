@@ -73,3 +73,33 @@ pub fn validator_errors(glb: &Path) -> u64 {
     }
     errors
 }
+
+/// `orient --preset PRESET` on the stripes exemplar at 128² (field grid 32) into
+/// `dir`, with `extra` flags; asserts exit 0 and returns the output.
+pub fn orient_small(dir: &Path, preset: &str, extra: &[&str], limit: Duration) -> Output {
+    let ex = shared().join("exemplars/stripes_Fabric071.png");
+    let mut args = vec![
+        "orient",
+        "--preset",
+        preset,
+        "--exemplar",
+        ex.to_str().unwrap(),
+        "--size",
+        "128",
+        "--grid",
+        "32",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    let o = run_limited(&args, limit);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    o
+}
+
+/// A JSON file's value (panics with the path on a missing or malformed file).
+pub fn read_json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}

@@ -28,8 +28,8 @@ use crate::pipelines::atlas::atlas_options;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, Warning};
 use fieldtex_features::{ExemplarFeatureOptions, ExemplarFeatures};
-use fieldtex_fields::{CurveOrientationOptions, OrientationMode, orient_curves};
-use fieldtex_mesh::TriMesh;
+use fieldtex_fields::{CurveOrientationOptions, OrientationMode, orient_curves_with_geometry};
+use fieldtex_mesh::{MeshGeometry, TriMesh};
 use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
 use fieldtex_texopt::{Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions};
 use serde::Serialize;
@@ -84,9 +84,11 @@ impl Default for AlignOptions {
     }
 }
 
-/// The salient curves of `mesh`: read from `path`, or crest lines.
+/// The salient curves of the mesh: read from `path`, or crest lines (over the
+/// pipeline's geometry object). The caller warns when there are none (what the field
+/// then does differs per pipeline).
 pub(crate) fn salient_curves(
-    mesh: &TriMesh,
+    geometry: &MeshGeometry,
     mesh_path: &Path,
     path: Option<&Path>,
     warnings: &mut Vec<Warning>,
@@ -94,9 +96,12 @@ pub(crate) fn salient_curves(
     let (curves, source) = match path {
         Some(p) => (fieldtex_io::read_obj_polylines(p)?, p.display().to_string()),
         None => {
-            let crest =
-                fieldtex_features::crest_lines(mesh, &fieldtex_features::CrestOptions::default())
-                    .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
+            let crest = fieldtex_features::crest_lines_with_geometry(
+                geometry,
+                &fieldtex_features::CrestOptions::default(),
+                &fieldtex_core::NoProgress,
+            )
+            .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
             warnings.extend(crest.warnings.iter().cloned());
             (
                 crest.lines.into_iter().map(|l| l.points).collect(),
@@ -104,14 +109,6 @@ pub(crate) fn salient_curves(
             )
         }
     };
-    if curves.is_empty() {
-        warnings.push(Warning::new(
-            "no-curves",
-            "no feature curve was found or given: the field is the smoothest field (along \
-             curvature where it is clearly anisotropic) or --direction where no curve \
-             constrains it (pass --curves C.obj to steer it)",
-        ));
-    }
     Ok((curves, source))
 }
 
@@ -436,7 +433,7 @@ type VertexVectors = Vec<[f64; 3]>;
 /// The curve-aligned field of paper A §4 (greedy or arbitrary orientation) with its
 /// metrics in `report`; returns the per-vertex field and the normals it was projected on.
 fn oriented_field(
-    mesh: &TriMesh,
+    geometry: &MeshGeometry,
     curves: &[Vec<[f64; 3]>],
     curves_source: &str,
     options: &AlignOptions,
@@ -453,12 +450,12 @@ fn oriented_field(
         copts.field.fallback = fieldtex_fields::UnconstrainedFallback::Direction(d);
     }
     let oriented = report
-        .time("field", || orient_curves(mesh, curves, &copts, progress))
+        .time("field", || orient_curves_with_geometry(geometry, curves, &copts, progress))
         .map_err(|e| Error::Internal(format!("field: {e}")))?;
     report.warnings.extend(oriented.warnings.iter().cloned());
     report.warnings.extend(oriented.field.warnings.iter().cloned());
-    let field_metrics = fieldtex_fields::surface_field_metrics(
-        mesh,
+    let field_metrics = fieldtex_fields::surface_field_metrics_with(
+        geometry,
         &oriented.field.vectors,
         &oriented.solver.constraints(),
     )
@@ -556,13 +553,23 @@ pub(crate) fn align_impl(
     });
     crate::outputs::check_cancelled(progress)?;
     // 2. Salient curves and the oriented field (paper A §3–4).
+    // One geometry object for crest lines, the field solver and its metrics.
+    let geometry = MeshGeometry::new(&mesh);
     let mut warnings = Vec::new();
     let (curves, curves_source) = report.time("curves", || {
-        salient_curves(&mesh, &options.mesh, options.curves.as_deref(), &mut warnings)
+        salient_curves(&geometry, &options.mesh, options.curves.as_deref(), &mut warnings)
     })?;
+    if curves.is_empty() {
+        warnings.push(Warning::new(
+            "no-curves",
+            "no feature curve was found or given: the field is the smoothest field (along \
+             curvature where it is clearly anisotropic) or --direction where no curve \
+             constrains it (pass --curves C.obj to steer it)",
+        ));
+    }
     report.warnings.extend(warnings);
     let (field, normals) =
-        oriented_field(&mesh, &curves, &curves_source, options, &mut report, progress)?;
+        oriented_field(&geometry, &curves, &curves_source, options, &mut report, progress)?;
     crate::outputs::check_cancelled(progress)?;
     // 3. Atlas and colour carriers (covered texels).
     let size = options.size;

@@ -5,7 +5,8 @@
 
 use crate::{Error, Progress, Result};
 use fieldtex_fields::{
-    CurveOrientationOptions, OrientationMode, orient_curves, surface_field_metrics,
+    CurveOrientationOptions, OrientationMode, orient_curves_with_geometry,
+    surface_field_metrics_with,
 };
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -71,19 +72,15 @@ pub fn field_file(
     let repaired = super::repair_stage::repair_mesh(&loaded.mesh, Some(mesh_path), None)?;
     warnings.extend(repaired.warnings);
     let mesh = repaired.mesh;
-    let (curves, source) = match &options.curves {
-        Some(p) => (fieldtex_io::read_obj_polylines(p)?, p.display().to_string()),
-        None => {
-            let crest =
-                fieldtex_features::crest_lines(&mesh, &fieldtex_features::CrestOptions::default())
-                    .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
-            warnings.extend(crest.warnings.iter().cloned());
-            (
-                crest.lines.into_iter().map(|l| l.points).collect(),
-                "crest lines (default options)".to_string(),
-            )
-        }
-    };
+    // One geometry object for crest lines, the solver and the metrics (one topology,
+    // one set of vertex normals).
+    let geometry = fieldtex_mesh::MeshGeometry::new(&mesh);
+    let (curves, source) = super::align::salient_curves(
+        &geometry,
+        mesh_path,
+        options.curves.as_deref(),
+        &mut warnings,
+    )?;
     if curves.is_empty() {
         warnings.push(fieldtex_core::Warning::new(
             "no-curves",
@@ -97,12 +94,13 @@ pub fn field_file(
         OrientationMode::Arbitrary { seed: options.seed }
     };
     let copts = CurveOrientationOptions { mode, ..Default::default() };
-    let result = orient_curves(&mesh, &curves, &copts, progress)
+    let result = orient_curves_with_geometry(&geometry, &curves, &copts, progress)
         .map_err(|e| Error::Internal(format!("field: {e}")))?;
     warnings.extend(result.warnings.iter().cloned());
     warnings.extend(result.field.warnings.iter().cloned());
-    let metrics = surface_field_metrics(&mesh, &result.field.vectors, &result.solver.constraints())
-        .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
+    let metrics =
+        surface_field_metrics_with(&geometry, &result.field.vectors, &result.solver.constraints())
+            .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
     // The metrics' topology gives χ (no second `Topology::build` of the same mesh).
     let chi = metrics.euler_characteristic;
     // field.ply: positions, the solver's normals, the field.

@@ -81,7 +81,7 @@ pub fn synthesize_field_texture_with(
     let fitted = fieldtex_synth::fit_exemplar(exemplar.clone(), fieldtex_synth::MAX_EXEMPLAR_SIDE);
     report.warnings.extend(fitted.warning.clone());
     let per_pixel = orient.exemplar_pixels_per_output_pixel(fitted.factor);
-    let image = super::synthesis::synthesize_image(
+    let image = super::synthesis::synthesize_image_result(
         &fitted.image,
         field,
         width,
@@ -91,6 +91,7 @@ pub fn synthesize_field_texture_with(
         cache,
         &mut report,
         progress,
-    )?;
+    )?
+    .colors;
     Ok((image, report))
 }

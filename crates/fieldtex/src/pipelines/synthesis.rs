@@ -76,27 +76,8 @@ fn analysis_key(exemplar: &Image, options: &AnalysisOptions) -> u64 {
 }
 
 /// Synthesises a `width × height` texture whose exemplar x axis follows `field`, at
-/// `per_pixel` exemplar pixels per output pixel.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn synthesize_image(
-    exemplar: &Image,
-    field: &[[f32; 2]],
-    width: usize,
-    height: usize,
-    per_pixel: f64,
-    options: &OrientOptions,
-    cache: &AnalysisCache,
-    report: &mut Report,
-    progress: &dyn Progress,
-) -> Result<Image> {
-    synthesize_image_result(
-        exemplar, field, width, height, per_pixel, options, cache, report, progress,
-    )
-    .map(|r| r.colors)
-}
-
-/// [`synthesize_image`] with the whole synthesis result: colours, the exemplar
-/// coordinate of every pixel (exemplar pixels) and the flip indicators.
+/// `per_pixel` exemplar pixels per output pixel: the whole synthesis result (colours,
+/// the exemplar coordinate of every pixel in exemplar pixels, the flip indicators).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn synthesize_image_result(
     exemplar: &Image,
