@@ -58,6 +58,13 @@ pub struct SolidArgs {
     /// Block side M of the dual-grid correction.
     #[arg(long, default_value_t = 12)]
     block: usize,
+    /// Neighbourhood side N of the matching (odd; the paper uses 7 and 9).
+    #[arg(long, default_value_t = 5)]
+    neighbourhood: usize,
+    /// Coarsest levels whose correction samples neighbourhoods trilinearly (the finer
+    /// ones take the nearest voxel).
+    #[arg(long, default_value_t = 3)]
+    trilinear_levels: usize,
     /// Synthesis levels.
     #[arg(long, default_value_t = 5)]
     levels: usize,
@@ -120,7 +127,9 @@ pub fn run_solid(
     opts.synthesis.passes = a.passes;
     opts.synthesis.block = a.block;
     opts.synthesis.seed = seed;
+    opts.synthesis.trilinear_levels = a.trilinear_levels;
     opts.analysis.levels = a.levels;
+    opts.analysis.neighbourhood = a.neighbourhood;
     fieldtex::solid(&a.out, &opts, progress)
 }
 

@@ -10,11 +10,15 @@
 //! is the sum over `j` of the squared RGB differences of those stick pairs.
 //!
 //! For each pixel `p` of plane `i` the table keeps the `N_T` triples with `pᵢ = p` of
-//! least crossbar error, best first. Search (a substitute for Dong 2008's full search,
-//! named in the pipeline notes): the `K₁ = 8` best partners in plane `i + 1` (by the
-//! stick shared with `p`) and in plane `i + 2` are found by brute force over a regular
-//! sub-grid *pool* of about [`super::SolidAnalysisOptions::pool`] pixels, then all
-//! `K₁²` pairs are scored with their third stick; each stick pair's error is weighted
+//! least crossbar error, best first. Search (coarse to fine, in place of Dong 2008's
+//! exhaustive search, named in the pipeline notes): the `K₁ = 8` best partners in plane
+//! `i + 1` (by the stick shared with `p`) and in plane `i + 2` are found by brute force
+//! over a regular sub-grid *pool* of about [`super::SolidAnalysisOptions::pool`] pixels
+//! (stride `σ`), then refined at full resolution: every pixel of the `σ × σ` cell
+//! around each pool hit is scored and the `K₁` best of all of them are kept (without
+//! this the partners' coordinates were quantised to the pool stride, which put the
+//! partner planes up to `σ/2` pixels out of phase with a stripe exemplar). All
+//! `K₁²` pairs are then scored with their third stick; each stick pair's error is weighted
 //! by the product of its planes' [`super::SolidAnalysisOptions::plane_weights`]. Dong's extra test that a triple be
 //! consistent with a neighbouring pixel's triple is not applied.
 
@@ -77,7 +81,8 @@ fn dist2(a: &[f32], b: &[f32]) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
-fn pool(w: usize, hgt: usize, size: usize) -> Vec<usize> {
+/// A regular sub-grid of about `size` pixels and its stride.
+fn pool(w: usize, hgt: usize, size: usize) -> (Vec<usize>, usize) {
     let stride = ((w * hgt) as f64 / size.max(1) as f64).sqrt().ceil().max(1.0) as usize;
     let mut out = Vec::new();
     for y in (0..hgt).step_by(stride) {
@@ -85,19 +90,55 @@ fn pool(w: usize, hgt: usize, size: usize) -> Vec<usize> {
             out.push(y * w + x);
         }
     }
-    out
+    (out, stride)
 }
 
-/// The `K₁` pool pixels whose `stick(q)` is nearest `query` (ties to the lower index).
-fn nearest(query: &[f32], sticks: &[f32], len: usize, pool: &[usize]) -> Vec<(f32, usize)> {
-    let mut best: Vec<(f32, usize)> = Vec::with_capacity(K1 + 1);
+/// Keeps `(d, q)` in `best` (sorted, at most `K₁`, ties to the lower index).
+#[inline]
+fn keep(best: &mut Vec<(f32, usize)>, d: f32, q: usize) {
+    if best.len() < K1 || (d, q) < best[best.len() - 1] {
+        let at = best.partition_point(|b| (b.0, b.1) <= (d, q));
+        best.insert(at, (d, q));
+        best.truncate(K1);
+    }
+}
+
+/// The `K₁` pixels whose `stick(q)` is nearest `query`: the best of the pool, then the
+/// best of the full-resolution `stride × stride` cells around those (module docs).
+fn nearest(
+    query: &[f32],
+    sticks: &[f32],
+    len: usize,
+    pool: &(Vec<usize>, usize),
+    w: usize,
+    hgt: usize,
+) -> Vec<(f32, usize)> {
+    let (pool, stride) = (&pool.0, pool.1);
+    let mut coarse: Vec<(f32, usize)> = Vec::with_capacity(K1 + 1);
     for &q in pool {
-        let d = dist2(query, &sticks[q * len..(q + 1) * len]);
-        if best.len() < K1 || d < best[best.len() - 1].0 {
-            let at = best.partition_point(|b| b.0 <= d);
-            best.insert(at, (d, q));
-            best.truncate(K1);
+        keep(&mut coarse, dist2(query, &sticks[q * len..(q + 1) * len]), q);
+    }
+    if stride <= 1 {
+        return coarse;
+    }
+    let mut cells: Vec<usize> = Vec::with_capacity(coarse.len() * stride * stride);
+    let lo = -((stride / 2) as i64);
+    let hi = lo + stride as i64;
+    for &(_, q) in &coarse {
+        let (qx, qy) = ((q % w) as i64, (q / w) as i64);
+        for dy in lo..hi {
+            for dx in lo..hi {
+                let x = (qx + dx).rem_euclid(w as i64) as usize;
+                let y = (qy + dy).rem_euclid(hgt as i64) as usize;
+                cells.push(y * w + x);
+            }
         }
+    }
+    cells.sort_unstable();
+    cells.dedup();
+    let mut best: Vec<(f32, usize)> = Vec::with_capacity(K1 + 1);
+    for q in cells {
+        keep(&mut best, dist2(query, &sticks[q * len..(q + 1) * len]), q);
     }
     best
 }
@@ -117,6 +158,7 @@ pub fn candidate_triples(
     let (ei, ej, ek) = (levels[i].0, levels[j].0, levels[k].0);
     let pool_j = pool(ej.width, ej.height, options.pool);
     let pool_k = pool(ek.width, ek.height, options.pool);
+    let (dj, dk) = ((ej.width, ej.height), (ek.width, ek.height));
     let len = st[0].len;
     let n_t = options.triples;
     // Stick pairs weighted by the product of their planes' weights (the partner
@@ -129,8 +171,10 @@ pub fn candidate_triples(
     triples.par_chunks_mut(n_t).enumerate().for_each(|(p, out)| {
         // Column of plane i ↔ row of plane j; row of plane i ↔ column of plane k;
         // column of plane j ↔ row of plane k.
-        let qs = nearest(&st[i].cols[p * len..(p + 1) * len], &st[j].rows, len, &pool_j);
-        let rs = nearest(&st[i].rows[p * len..(p + 1) * len], &st[k].cols, len, &pool_k);
+        let qs =
+            nearest(&st[i].cols[p * len..(p + 1) * len], &st[j].rows, len, &pool_j, dj.0, dj.1);
+        let rs =
+            nearest(&st[i].rows[p * len..(p + 1) * len], &st[k].cols, len, &pool_k, dk.0, dk.1);
         let mut scored: Vec<(f32, usize, usize)> = Vec::with_capacity(qs.len() * rs.len());
         for &(eq, q) in &qs {
             for &(er, r) in &rs {

@@ -12,8 +12,14 @@
 //! 2. **Upsampling** (eq. 3–4): `T(v) = T(v_p) + R_pᵀ (h_c δ)` with `δ = v − 2 v_p` and
 //!    the 3-vector added to the triple as `(xy + (d_x, d_y), yz + (d_y, d_z), zx + (d_z, d_x))`.
 //! 3. **Correction** (§4.3): three `N × N` neighbourhoods in the planes of the voxel's
-//!    frame (`v + R (s, t, 0)` etc., nearest voxel; the paper's trilinear sampling on
-//!    coarse levels is not implemented), projected by each plane's PCA; the candidates
+//!    frame (`v + R (s, t, 0)` etc.; trilinear interpolation of the voxel colours on the
+//!    [`SolidSynthesisOptions::trilinear_levels`] coarsest levels, nearest voxel on the
+//!    finer ones, as the paper; on the [`SolidSynthesisOptions::integrate_levels`]
+//!    coarsest levels the sample positions follow the field — the paper's numerical
+//!    integration along the directions: unit Euler steps along the first in-plane axis
+//!    from the voxel, then along the second, each step in the frame where it starts —
+//!    elsewhere the centre voxel's frame spans the whole neighbourhood), projected by
+//!    each plane's PCA; the candidates
 //!    are the `k` best triples of the pixels predicted by the in-plane neighbours
 //!    (`[T_P(v + d) − h P_P(d)]`, `d` in the 3 × 3 in-plane offsets, the paper's reduced
 //!    set) plus the current triple; the one of least summed squared appearance
@@ -67,12 +73,28 @@ pub struct SolidSynthesisOptions {
     pub k: usize,
     /// Initialisation subpart side `K`, coarsest-level voxels. Default 64 (the paper's).
     pub subpart: usize,
+    /// The correction samples its neighbourhoods by trilinear interpolation on this many
+    /// coarsest levels and by the nearest voxel below them (paper E §4.3). Default 3.
+    pub trilinear_levels: usize,
+    /// On this many coarsest levels (at most `trilinear_levels`) the neighbourhood
+    /// sample positions are integrated along the field (module docs). Default 2.
+    pub integrate_levels: usize,
     pub seed: u64,
 }
 
 impl Default for SolidSynthesisOptions {
     fn default() -> Self {
-        Self { block: 12, passes: 2, coarse_passes: 4, subpasses: true, k: 2, subpart: 64, seed: 1 }
+        Self {
+            block: 12,
+            passes: 2,
+            coarse_passes: 4,
+            subpasses: true,
+            k: 2,
+            subpart: 64,
+            trilinear_levels: 3,
+            integrate_levels: 2,
+            seed: 1,
+        }
     }
 }
 
@@ -512,8 +534,16 @@ impl<'a> SolidSynthesizer<'a> {
                                 }
                                 let f = &frames[((z * m + y) * m + x) as usize];
                                 let at = [x + r, y + r, z + r];
-                                let (best, evals) =
-                                    self.best_candidate(c, region, &colors, s, at, f, &mut scratch);
+                                let (best, evals) = self.best_candidate(
+                                    c,
+                                    region,
+                                    &colors,
+                                    s,
+                                    at,
+                                    g,
+                                    f,
+                                    &mut scratch,
+                                );
                                 counts.corrections += 1;
                                 counts.evaluations += evals;
                                 let i = idx(at[0], at[1], at[2]);
@@ -541,7 +571,48 @@ impl<'a> SolidSynthesizer<'a> {
         (out, counts)
     }
 
-    /// The best candidate for the voxel at region position `at` (§4.3).
+    /// The frame at level-`c` lattice position `g + q` (`q` in level-`c` voxels).
+    fn frame_near(&self, c: usize, g: [i32; 3], q: [f64; 3]) -> [f64; 9] {
+        let centre = self.lattice.centre(c, g);
+        let step = (1i64 << c) as f64 * self.lattice.spacing;
+        self.frames.frame(std::array::from_fn(|a| centre[a] + q[a] * step))
+    }
+
+    /// Offsets (level-`c` voxels) of the `N × N` samples of plane `(a1, a2)` around
+    /// voxel `g`, integrated along the field (module docs), into `out` (`t`-major).
+    fn integrated_offsets(
+        &self,
+        c: usize,
+        g: [i32; 3],
+        (a1, a2): (usize, usize),
+        row: &mut [[f64; 3]],
+        out: &mut [[f32; 3]],
+    ) {
+        let n = self.exemplar.options.neighbourhood;
+        let half = n / 2;
+        let walk = |from: [f64; 3], axis: usize, dir: f64| -> [f64; 3] {
+            let f = self.frame_near(c, g, from);
+            std::array::from_fn(|a| from[a] + dir * f[3 * a + axis])
+        };
+        row[half] = [0.0; 3];
+        for step in 1..=half {
+            row[half + step] = walk(row[half + step - 1], a1, 1.0);
+            row[half - step] = walk(row[half - step + 1], a1, -1.0);
+        }
+        for (si, start) in row.iter().enumerate().take(n) {
+            out[half * n + si] = start.map(|x| x as f32);
+            let (mut up, mut down) = (*start, *start);
+            for step in 1..=half {
+                up = walk(up, a2, 1.0);
+                down = walk(down, a2, -1.0);
+                out[(half + step) * n + si] = up.map(|x| x as f32);
+                out[(half - step) * n + si] = down.map(|x| x as f32);
+            }
+        }
+    }
+
+    /// The best candidate for the voxel at region position `at`, lattice voxel `g`
+    /// (§4.3).
     #[allow(clippy::too_many_arguments)]
     fn best_candidate(
         &self,
@@ -550,6 +621,7 @@ impl<'a> SolidSynthesizer<'a> {
         colors: &[[f32; 3]],
         s: i32,
         at: [i32; 3],
+        g: [i32; 3],
         f: &[f32; 9],
         scratch: &mut Scratch,
     ) -> (Triple, u64) {
@@ -561,6 +633,10 @@ impl<'a> SolidSynthesizer<'a> {
         scratch.candidates.clear();
         scratch.candidates.push(current);
         let weights = self.exemplar.options.plane_weights;
+        let trilinear = c + self.options.trilinear_levels >= self.cache.len();
+        let integrate = trilinear && c + self.options.integrate_levels >= self.cache.len();
+        // Integrated samples stay where trilinear interpolation has both corners.
+        let reach = self.halo() as f32;
         for p in 0..3 {
             let (a1, a2) = (p, (p + 1) % 3);
             let u = [f[a1], f[3 + a1], f[6 + a1]];
@@ -582,7 +658,45 @@ impl<'a> SolidSynthesizer<'a> {
             let offset =
                 |ss: i32, t: i32| scratch.offsets[((t + half) * n + ss + half) as usize] as usize;
             // A zero-weight plane contributes candidates but no neighbourhood.
-            if weights[p] > 0.0 {
+            if weights[p] > 0.0 && trilinear {
+                // The halo `r ≥ ⌈N_h √2⌉` holds both corners of every axis: each
+                // component of `s u + t w` lies in `[−N_h √2, N_h √2]`; integrated
+                // paths can reach further and are clamped to the halo.
+                if integrate {
+                    self.integrated_offsets(c, g, (a1, a2), &mut scratch.row, &mut scratch.path);
+                }
+                let mut j = 0;
+                for t in -half..=half {
+                    for ss in -half..=half {
+                        let (sf, tf) = (ss as f32, t as f32);
+                        let d: [f32; 3] = if integrate {
+                            scratch.path[j].map(|x| x.clamp(-reach, reach - 1e-3))
+                        } else {
+                            std::array::from_fn(|a| sf * u[a] + tf * w[a])
+                        };
+                        let fl = d.map(f32::floor);
+                        let fr: [f32; 3] = std::array::from_fn(|a| d[a] - fl[a]);
+                        let cell =
+                            base + ((fl[2] as i32 * s + fl[1] as i32) * s + fl[0] as i32) as isize;
+                        let lo = fr.map(|f| 1.0 - f);
+                        let mut acc = [0.0f32; 3];
+                        for corner in 0..8 {
+                            let (cx, cy, cz) = (corner & 1, (corner >> 1) & 1, corner >> 2);
+                            let wx = if cx == 1 { fr[0] } else { lo[0] };
+                            let wy = if cy == 1 { fr[1] } else { lo[1] };
+                            let wz = if cz == 1 { fr[2] } else { lo[2] };
+                            let wt = wx * wy * wz;
+                            let at = cell + ((cz * s + cy) * s + cx) as isize;
+                            let col = &colors[at as usize];
+                            for ch in 0..3 {
+                                acc[ch] += wt * col[ch];
+                            }
+                        }
+                        scratch.buf[3 * j..3 * j + 3].copy_from_slice(&acc);
+                        j += 1;
+                    }
+                }
+            } else if weights[p] > 0.0 {
                 for (j, &o) in scratch.offsets[..(n * n) as usize].iter().enumerate() {
                     scratch.buf[3 * j..3 * j + 3].copy_from_slice(&colors[o as usize]);
                 }
@@ -650,6 +764,9 @@ struct Scratch {
     offsets: Vec<isize>,
     proj: [[f32; 32]; 3],
     candidates: Vec<Triple>,
+    /// Integrated sample offsets (`N × N`) and the first axis's path (`N`).
+    path: Vec<[f32; 3]>,
+    row: Vec<[f64; 3]>,
 }
 
 impl Scratch {
@@ -660,6 +777,8 @@ impl Scratch {
             offsets: vec![0; n * n],
             proj: [[0.0; 32]; 3],
             candidates: Vec::with_capacity(64),
+            path: vec![[0.0; 3]; n * n],
+            row: vec![[0.0; 3]; n],
         }
     }
 }

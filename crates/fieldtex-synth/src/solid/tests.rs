@@ -133,3 +133,49 @@ fn candidate_triples_agree_along_their_crossbars() {
     assert_eq!(ex.triples[0][1].get(5, 9, 0)[1], [5, 9]);
     assert_eq!(ex.triples[0][2].get(5, 9, 0)[2], [5, 9]);
 }
+
+/// The transpose of `im` (the yz exemplar a single `--exemplar` implies).
+fn transpose(im: &Image) -> Image {
+    let mut t = Image::new(im.height, im.width, [0.0; 4]);
+    for y in 0..im.height {
+        for x in 0..im.width {
+            t.set(y, x, im.get(x, y));
+        }
+    }
+    t
+}
+
+#[test]
+fn partner_search_finds_exact_partners_off_the_pool_grid() {
+    // xy = I, yz = Iᵀ, zx weight 0: pixel (x, y) of I has an exact partner (y, x) in Iᵀ
+    // (its column equals that pixel's row). A pool of stride 4 holds only 1/16 of those
+    // partners; the full-resolution refinement must find (nearly) all of them. A smooth
+    // exemplar with unique sticks, so pool hits land next to the exact partner.
+    let a = std::f32::consts::TAU / 32.0;
+    let mut img = Image::new(32, 32, [0.0, 0.0, 0.0, 1.0]);
+    for y in 0..32 {
+        for x in 0..32 {
+            let (xf, yf) = (x as f32, y as f32);
+            let r = 0.5 + 0.35 * (a * xf).sin();
+            let g = 0.5 + 0.35 * (a * yf + 0.7).sin();
+            let b = 0.5 + 0.35 * (a * (xf + yf)).cos();
+            img.set(x, y, [r, g, b, 1.0]);
+        }
+    }
+    let tr = transpose(&img);
+    let ao = SolidAnalysisOptions {
+        levels: 1,
+        pool: 64,
+        plane_weights: [1.0, 1.0, 0.0],
+        ..Default::default()
+    };
+    let ex = SolidExemplar::new([&img, &tr, &img], &ao, &NoProgress).unwrap();
+    let table = &ex.triples[0][0];
+    let mut exact = 0;
+    for y in 0..32 {
+        for x in 0..32 {
+            exact += (table.get(x, y, 0)[1] == [y, x]) as usize;
+        }
+    }
+    assert!(exact >= 1024 * 9 / 10, "{exact} of 1024 pixels have their exact partner");
+}

@@ -179,6 +179,11 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     begin_command();
     let (mesh, _inputs) = read_inputs(options, &mut report)?;
     let (exemplars, single) = read_exemplars(options)?;
+    // The xy exemplar's own stripe direction and its orientation error against it: the
+    // floor of a slice's orientation error (as `orient` reports it).
+    if let Some(own) = super::orient::exemplar_orientation(&exemplars[0]) {
+        report.metric("exemplar_orientation", own);
+    }
     let mut analysis = options.analysis.clone();
     if single {
         analysis.plane_weights = [1.0, 1.0, 0.0];
@@ -560,8 +565,11 @@ fn preview_with_curves(
 
 fn notes(options: &SolidOptions) -> Vec<String> {
     let mut n = vec![
-        "candidate triples: the partners of each pixel are searched by brute force over a regular sub-grid pool of the other exemplars (SolidAnalysisOptions::pool), not Dong 2008's full search; Dong's neighbour-consistency test is not applied".to_string(),
-        "correction neighbourhoods are sampled at the nearest voxel on every level (the paper uses trilinear sampling and integration along the field on coarse levels)".to_string(),
+        "candidate triples: the partners of each pixel are searched coarse to fine (brute force over a regular sub-grid pool of the other exemplars, SolidAnalysisOptions::pool, then every pixel of the pool cells around the best hits), not Dong 2008's exhaustive search; Dong's neighbour-consistency test is not applied".to_string(),
+        format!(
+            "correction neighbourhoods are sampled by trilinear interpolation on the {} coarsest levels and at the nearest voxel below them, as the paper; the paper's numerical integration along the field on coarse levels is not implemented (the centre voxel's frame spans the neighbourhood)",
+            options.synthesis.trilinear_levels
+        ),
         format!(
             "neighbourhood N = {} on every level and {} PCA dimensions per plane (the paper: N = 7 coarse / 9 fine, about 20 dimensions)",
             options.analysis.neighbourhood, options.analysis.pca_dims
