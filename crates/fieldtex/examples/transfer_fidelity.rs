@@ -55,17 +55,8 @@ fn ground_truth(m: &TriMesh) -> Vec<f64> {
             ..Default::default()
         },
     );
-    let sa = mesh::solid_angle_curvature(
-        &bvh,
-        &pts,
-        &[0.05 * diag],
-        &mesh::SolidAngleOptions {
-            directions: 128,
-            epsilon: 1e-4 * diag,
-            seed: 98,
-            ..Default::default()
-        },
-    );
+    let positions: Vec<[f64; 3]> = pts.iter().map(|p| p.position).collect();
+    let sa = mesh::solid_angle_curvature(m, &positions, &[0.05 * diag]).expect("solid angle");
     let span = (bbox.max[1] - bbox.min[1]).max(1e-12);
     (0..pts.len())
         .map(|i| {
