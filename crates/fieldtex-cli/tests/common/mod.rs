@@ -73,3 +73,4 @@ pub fn validator_errors(glb: &Path) -> u64 {
     }
     errors
 }
+pub mod transfer;
