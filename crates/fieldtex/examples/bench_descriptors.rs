@@ -94,6 +94,41 @@ fn main() {
         }
         assert_eq!(sh.len(), coarse.len());
     }
+    // Spacing statistics of the nested sample pyramid (docs/transfer.md, "Samples"):
+    // nearest-neighbour distance over the level's Poisson radius.
+    let pyr =
+        transfer::SamplePyramid::build(&m, samples, 3, 1, "mesh", &NoProgress, &mut w).unwrap();
+    for (l, set) in pyr.levels.iter().enumerate() {
+        let grid = mesh::SpatialGrid::new(&set.positions, set.spacing);
+        let nn: Vec<f64> = (0..set.len())
+            .map(|i| {
+                let mut best = f64::INFINITY;
+                grid.for_each_within(
+                    &set.positions,
+                    set.positions[i],
+                    3.0 * set.spacing,
+                    |j, d2| {
+                        if j as usize != i {
+                            best = best.min(d2.sqrt());
+                        }
+                    },
+                );
+                best / set.spacing
+            })
+            .collect();
+        let finite: Vec<f64> = nn.iter().copied().filter(|x| x.is_finite()).collect();
+        let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+        let sd =
+            (finite.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / finite.len() as f64).sqrt();
+        println!(
+            "level {l}: {} samples, nearest neighbour / radius: min {:.3}, mean {mean:.3}, \
+             coefficient of variation {:.3}, none within 3 radii: {}",
+            set.len(),
+            finite.iter().copied().fold(f64::INFINITY, f64::min),
+            sd / mean,
+            nn.len() - finite.len()
+        );
+    }
     println!(
         "{path}: {} triangles, {samples} samples; medians of {runs} (wall ms): sampling {:.0}, \
          occlusion ({} points) {:.0}, compute_descriptors (all 12) {:.0}",
