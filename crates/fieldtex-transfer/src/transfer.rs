@@ -56,7 +56,7 @@ impl Default for TransferOptions {
             samples: 512_000,
             levels: 3,
             descriptors: DescriptorOptions::default(),
-            reduction: Reduction::Cca,
+            reduction: Reduction::CcaWeighted,
             matching: MatchMode::Multiscale,
             engine: Engine::Parametric,
             parametric: ParametricOptions::default(),

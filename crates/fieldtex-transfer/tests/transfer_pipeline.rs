@@ -33,15 +33,15 @@ fn colour_that_follows_the_normal_transfers_to_another_shape() {
     let truth: Vec<f64> = r.target_samples.normals.iter().map(|n| up_shade(n[1]) as f64).collect();
     let got: Vec<f64> = r.target_colors.chunks_exact(3).map(|c| c[0]).collect();
     let corr = pearson(&truth, &got);
-    // Measured at seed 1: 0.62 (it was > 0.8 with the Monte-Carlo solid angle; see below).
-    assert!(corr > 0.5, "Pearson r {corr}");
-    // Without feature matching. With the earlier Monte-Carlo solid angle this fell to
-    // r = 0.28: the estimator's noise gave the solid-angle columns a spread of ~0.03 on
-    // the sphere (where the exact value is constant), so the torus's real variation
-    // became ±10 standard deviations of guidance, which only matching pulled back. With
-    // the exact values those columns are constant on the sphere and drop out, and the
-    // unmatched guidance does well (0.77 measured, against 0.62 multiscale): on this
-    // pair matching no longer helps (docs/transfer.md, "Feature matching").
+    // Default guidance (CCA weighted by the correlations) with multiscale matching:
+    // measured 0.988 / 0.989 / 0.992 / 0.989 for seeds 0–3.
+    assert!(corr > 0.95, "Pearson r {corr}");
+    // Without feature matching the torus's guidance falls outside what the sphere
+    // taught (height and normal y are one function on a sphere, two on a torus), and
+    // the dependence degrades: measured 0.805 / 0.752 / 0.984 / 0.993 for seeds 0–3
+    // (seed 1 here). With unweighted CCA matching did not help on this pair (means over
+    // the 4 seeds: none 0.75, multiscale 0.55): the rotations mix the uninformative
+    // variates into the informative one (docs/transfer.md, "Feature matching").
     let mut plain = opts.clone();
     plain.matching = MatchMode::None;
     let u = transfer(&src, &tex, None, &tgt, &plain, &NoProgress).unwrap();
@@ -49,7 +49,7 @@ fn colour_that_follows_the_normal_transfers_to_another_shape() {
     let truth_u: Vec<f64> =
         u.target_samples.normals.iter().map(|n| up_shade(n[1]) as f64).collect();
     let corr_u = pearson(&truth_u, &got_u);
-    assert!(corr_u > 0.5, "no matching r {corr_u} vs multiscale r {corr}");
+    assert!(corr_u < corr - 0.1, "no matching r {corr_u} vs multiscale r {corr}");
     // On the source sphere height = (n_y + 1) / 2, so the two collinear descriptors
     // share the weight; together they carry almost all of it.
     let w = &r.descriptor_weights;
