@@ -35,14 +35,15 @@ while [ $# -gt 0 ]; do
 done
 # Two commands: `--example` would restrict a combined build to examples only.
 cargo build --release -p fieldtex-cli
-cargo build --release -p fieldtex --example transfer_fidelity
+cargo build --release -p fieldtex --example transfer_fidelity --example bench_descriptors
 data=../shared/data
 out=out/transfer-bench
 mkdir -p "$out"
 if [ "$fidelity" = 1 ]; then
   echo "== fidelity (samples=$samples)"
   target/release/examples/transfer_fidelity "$out/fidelity" "$data/meshes/stanford-bunny.obj" \
-    "$data/meshes/armadillo.obj" "$data/meshes/fertility.obj" --samples "$samples" | tee "$out/fidelity.txt"
+    "$data/meshes/armadillo.obj" "$data/meshes/fertility.obj" --samples "$samples" --with-weighted \
+    | tee "$out/fidelity.txt"
   if [ -n "$mask_below" ]; then
     echo "== fidelity, source masked below height $mask_below (parametric)"
     target/release/examples/transfer_fidelity "$out/fidelity-masked" "$data/meshes/stanford-bunny.obj" \
@@ -51,6 +52,9 @@ if [ "$fidelity" = 1 ]; then
   fi
 fi
 if [ "$speed" = 1 ]; then
+  echo "== descriptors alone (armadillo, $speed_samples samples, $runs runs), solid-angle accuracy, sample spacing"
+  /usr/bin/time -f "  %e s wall %U s user %S s sys" target/release/examples/bench_descriptors \
+    "$data/meshes/armadillo.obj" --samples "$speed_samples" --runs "$runs"
   for engine in parametric nonparametric; do
     echo "== speed ($engine): blub -> armadillo, $speed_samples samples, $runs runs"
     for i in $(seq 1 "$runs"); do

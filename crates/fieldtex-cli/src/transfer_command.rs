@@ -29,9 +29,10 @@ pub struct TransferArgs {
     /// Up axis for the height descriptor: x, y or z.
     #[arg(long, default_value = "y")]
     up: String,
-    /// Dimensionality reduction: cca (default), cca-weighted (canonical variates weighted
-    /// by their correlations; experimental) or pca (ablation).
-    #[arg(long, default_value = "cca")]
+    /// Dimensionality reduction: cca-weighted (default; canonical variates weighted by
+    /// their correlations, the paper's √Λ Wₓᵀx), cca (unit-variance variates) or pca
+    /// (ablation).
+    #[arg(long, default_value = "cca-weighted")]
     reduce: String,
     /// Feature matching: none, marginals or multiscale.
     #[arg(long = "match", default_value = "multiscale")]

@@ -86,5 +86,5 @@ pub use poisson_disk_sampling::{
     poisson_disk_sampling_nested,
 };
 pub use polygon_triangulation::triangulate_polygons;
-pub use solid_angle_curvature::{OrientedPoint, SolidAngleOptions, solid_angle_curvature};
+pub use solid_angle_curvature::{OrientedPoint, solid_angle_curvature, triangle_solid_angle};
 pub use spatial_grid::{IncrementalGrid, SpatialGrid};

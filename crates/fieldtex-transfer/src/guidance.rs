@@ -8,16 +8,16 @@
 //! descriptors: `descriptor_weights[d]` is `|a₁[d]| / Σ|a₁|` for the first canonical
 //! direction `a₁` (paper Fig. 4).
 //!
-//! **Correlation weighting** (`Reduction::CcaWeighted`, opt-in): guidance dimension `k` is the
+//! **Correlation weighting** (`Reduction::CcaWeighted`, the default): guidance dimension `k` is the
 //! canonical variate scaled by its canonical correlation `ρ_k`, i.e. `√Λ W_xᵀ x` of the
 //! paper's relation `√Λ W_xᵀ x ≈ W_yᵀ y` (§3.3): the guidance then predicts the colour's
 //! canonical variates, and a direction that explains nothing (`ρ ≈ 0`) shrinks to
 //! nothing instead of weighing as much as the informative one in k-means, in feature
 //! matching (whose random rotations would otherwise mix it into the informative axis)
-//! and in neighbourhood distances (the analysis is in `docs/transfer.md`; not yet
-//! measured, so not the default). `Reduction::Cca` (default) keeps unit-variance
-//! canonical variates; PCA dimensions are the principal components scaled to unit
-//! variance.
+//! and in neighbourhood distances. Measured (`docs/transfer.md`): it is the best setting
+//! on the known-answer benchmark and the one with which feature matching helps when the
+//! shapes differ. `Reduction::Cca` keeps unit-variance canonical variates; PCA
+//! dimensions are the principal components scaled to unit variance.
 
 use crate::TransferError;
 use crate::descriptors::N_DESCRIPTORS;
@@ -54,6 +54,9 @@ pub struct Guidance {
     pub descriptor_weights: Vec<f64>,
 }
 
+/// Source standard deviation below which a descriptor counts as constant.
+const CONSTANT_DESCRIPTOR_SD: f64 = 1e-6;
+
 /// Builds the guidance (module docs). `xs` is `#source × 12`, `ys` `#source × 3` (RGB),
 /// `valid` marks the source samples used for fitting, `xt` is `#target × 12`.
 pub fn build_guidance(
@@ -81,9 +84,19 @@ pub fn build_guidance(
             sd[k] += (xs[i * d + k] - mean[k]).powi(2);
         }
     }
-    sd.iter_mut().for_each(|s| *s = (*s / rows.len() as f64).sqrt().max(1e-9));
+    // A descriptor (nearly) constant on the source cannot explain its colour, and
+    // dividing by its rounding-level spread would blow its target values up by orders of
+    // magnitude: it is standardised to 0 on both meshes (weight 0). The descriptors are
+    // all O(1) (height in [0, 1], unit normals, fractions, SH of a visibility function).
+    let scale: Vec<f64> = sd
+        .iter()
+        .map(|s| {
+            let s = (*s / rows.len() as f64).sqrt();
+            if s > CONSTANT_DESCRIPTOR_SD { 1.0 / s } else { 0.0 }
+        })
+        .collect();
     let standardise = |x: &[f64]| -> Vec<f64> {
-        x.chunks_exact(d).flat_map(|r| (0..d).map(|k| (r[k] - mean[k]) / sd[k])).collect()
+        x.chunks_exact(d).flat_map(|r| (0..d).map(|k| (r[k] - mean[k]) * scale[k])).collect()
     };
     let zs = standardise(xs);
     let zt = standardise(xt);

@@ -4,7 +4,7 @@
 //! A textured source mesh teaches how colour depends on shape; the target mesh gets a
 //! new texture with the same dependence. The work happens on uniform surface samples:
 //!
-//! 1. [`surface_samples`]: Poisson-disk samples at several resolutions and Gaussian /
+//! 1. [`surface_samples`]: nested Poisson-disk samples at several resolutions and Gaussian /
 //!    Laplacian pyramids over them (Turk 2001).
 //! 2. [`source_colors`]: source colours through the per-corner UVs, with a mask.
 //! 3. [`descriptors`]: 12 geometric descriptors (height, normal, solid-angle curvature

@@ -1,11 +1,20 @@
 //! Multi-resolution uniform surface samples and Gaussian/Laplacian pyramids over them
 //! (paper B §3.1 after Turk 2001, "Texture synthesis on surfaces").
 //!
-//! Level 0 holds about `finest` Poisson-disk samples (`fieldtex_mesh::poisson_disk_sampling`,
-//! dart throwing — a substitute for Turk's point repulsion with the same purpose: an even,
-//! blue-noise spread); level `l` about `finest / 4^l`, sampled independently (stream
-//! index `l`). Every sample carries its triangle, barycentric point, position and the
-//! interpolated (smooth) vertex normal, plus the triangle's normal.
+//! **Nested levels.** Level 0 holds about `finest` samples, level `l` about
+//! `finest / 4^l`, and every level contains all coarser ones: the coarsest is placed
+//! first, then held fixed while denser samples are added around it, level by level —
+//! the structure of Turk's hierarchy. The spreading rule is Poisson-disk dart throwing
+//! (`fieldtex_mesh::poisson_disk_sampling_nested`: a sample is accepted only when no
+//! sample of its own or a coarser level lies within that level's radius, so each level
+//! is `r_l`-separated and close to maximal) instead of Turk's point repulsion (Turk
+//! 1991/1992: random points pushed apart by a short-range force and re-projected onto
+//! the surface). Both give an even, blue-noise spread; `docs/transfer.md` ("Samples")
+//! gives the measured spacing statistics of these sets. The coarsest radius comes from
+//! the sampler's target-count mode, the finer radii from the density it reached
+//! (`n r² / A`), so counts are within a few percent of the request. Every
+//! sample carries its triangle, barycentric point, position and the interpolated
+//! (smooth) vertex normal, plus the triangle's normal.
 //!
 //! A Gaussian pyramid of any per-sample signal is built by smoothing and down-sampling:
 //! level `l + 1` is the Gaussian-weighted mean (σ = level-`l` spacing) of level `l`
@@ -18,7 +27,7 @@ use crate::TransferError;
 use crate::scattered_interpolation::Interpolator;
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_core::{Progress, Warning};
-use fieldtex_mesh::{PoissonDiskOptions, TriMesh};
+use fieldtex_mesh::{PoissonDiskOptions, PoissonDiskSamples, TriMesh};
 
 /// One resolution of uniform surface samples.
 #[derive(Debug, Clone, PartialEq)]
@@ -62,29 +71,23 @@ pub fn sample_surface(
     which: &'static str,
     warnings: &mut Vec<Warning>,
 ) -> Result<SampleSet, TransferError> {
-    sample_surface_with(mesh, Some(count.max(1)), None, seed, which, warnings)
-}
-
-/// [`sample_surface`] with either a target count (the sampler corrects its radius a few
-/// times) or a fixed radius (one pass).
-fn sample_surface_with(
-    mesh: &TriMesh,
-    count: Option<usize>,
-    radius: Option<f64>,
-    seed: u64,
-    which: &'static str,
-    warnings: &mut Vec<Warning>,
-) -> Result<SampleSet, TransferError> {
-    let opts = PoissonDiskOptions {
-        target_count: count,
-        radius,
-        seed,
-        candidate_factor: 8.0,
-        ..Default::default()
-    };
+    let opts = PoissonDiskOptions { target_count: Some(count.max(1)), ..poisson_options(seed) };
     let (s, w) = fieldtex_mesh::poisson_disk_sampling(mesh, &opts)
         .map_err(|e| TransferError::numeric("surface sampling", e))?;
     warnings.extend(w);
+    to_sample_set(mesh, &s, which)
+}
+
+fn poisson_options(seed: u64) -> PoissonDiskOptions {
+    PoissonDiskOptions { seed, candidate_factor: 8.0, ..Default::default() }
+}
+
+/// Samples with their normals; an empty set is an error naming the mesh.
+fn to_sample_set(
+    mesh: &TriMesh,
+    s: &PoissonDiskSamples,
+    which: &'static str,
+) -> Result<SampleSet, TransferError> {
     if s.samples.is_empty() {
         return Err(TransferError::EmptyMesh { which });
     }
@@ -129,30 +132,39 @@ impl SamplePyramid {
     ) -> Result<Self, TransferError> {
         let levels = levels.max(1);
         progress.stage(&format!("{which} samples"), levels as u64);
-        // The coarsest level is sampled to a target count (the sampler iterates on its
-        // radius); its density `n r² / A` then gives the radius of every finer level
-        // directly, one pass each (counts within a few percent of the request).
+        // The coarsest level's radius comes from a target count (the sampler iterates on
+        // its radius); its density `n r² / A` gives the radius of every finer level.
         let area = fieldtex_mesh::total_area(mesh);
-        let mut sets: Vec<Option<SampleSet>> = vec![None; levels];
-        let mut density: Option<f64> = None;
+        let counts: Vec<usize> = (0..levels).map(|l| (finest >> (2 * l)).max(64)).collect();
+        let s = fieldtex_core::rng::stream_seed(seed, "transfer-samples", 0);
+        let coarsest = sample_surface(mesh, counts[levels - 1], s, which, warnings)?;
+        progress.advance(1);
+        let density =
+            coarsest.len() as f64 * coarsest.spacing * coarsest.spacing / area.max(1e-300);
+        // Radii coarsest first, strictly decreasing (equal counts at the 64 floor are
+        // separated by a hair so the nested sampler accepts them).
+        let mut radii: Vec<f64> = Vec::with_capacity(levels);
         for l in (0..levels).rev() {
-            let count = (finest >> (2 * l)).max(64);
-            let s = fieldtex_core::rng::stream_seed(seed, "transfer-samples", l as u64);
-            let set = match density {
-                Some(k) if area > 0.0 => {
-                    let r = (k * area / count as f64).sqrt();
-                    sample_surface_with(mesh, None, Some(r), s, which, warnings)?
-                }
-                _ => sample_surface_with(mesh, Some(count), None, s, which, warnings)?,
+            let r = if l == levels - 1 {
+                coarsest.spacing
+            } else {
+                (density * area / counts[l] as f64).sqrt()
             };
-            if density.is_none() && area > 0.0 {
-                density = Some(set.len() as f64 * set.spacing * set.spacing / area);
-            }
-            sets[l] = Some(set);
-            progress.advance(1);
+            let r = match radii.last() {
+                Some(&prev) if r >= prev => prev * (1.0 - 1e-6),
+                _ => r,
+            };
+            radii.push(r);
         }
-        let sets: Vec<SampleSet> =
-            sets.into_iter().map(|s| s.expect("every level sampled")).collect();
+        let (nested, w) =
+            fieldtex_mesh::poisson_disk_sampling_nested(mesh, &radii, &poisson_options(s))
+                .map_err(|e| TransferError::numeric("surface sampling", e))?;
+        warnings.extend(w);
+        let mut sets: Vec<SampleSet> = Vec::with_capacity(levels);
+        for level in nested.iter().rev() {
+            sets.push(to_sample_set(mesh, level, which)?);
+        }
+        progress.advance(levels.saturating_sub(1) as u64);
         progress.finish_stage();
         let mut down = Vec::new();
         let mut up = Vec::new();
@@ -244,5 +256,30 @@ mod tests {
         // The coarse band is a smoothed copy: its values stay inside the input range.
         let (lo, hi) = vals.iter().fold((f64::MAX, f64::MIN), |a, &v| (a.0.min(v), a.1.max(v)));
         assert!(bands[2].iter().all(|&v| v >= lo - 1e-9 && v <= hi + 1e-9));
+    }
+
+    /// Turk's hierarchy is nested: every level holds all coarser samples (as its
+    /// prefix), each level keeps its minimum spacing, and counts grow about 4× per level.
+    #[test]
+    fn levels_are_nested_and_keep_their_spacing() {
+        let mesh = fieldtex_mesh::primitives::torus(1.0, 0.4, 48, 24);
+        let mut w = Vec::new();
+        let p = SamplePyramid::build(&mesh, 8000, 3, 5, "test", &NoProgress, &mut w).unwrap();
+        for l in 0..2 {
+            let (fine, coarse) = (&p.levels[l], &p.levels[l + 1]);
+            assert_eq!(&fine.positions[..coarse.len()], &coarse.positions[..]);
+            let ratio = fine.len() as f64 / coarse.len() as f64;
+            assert!((3.0..5.0).contains(&ratio), "level {l}: ratio {ratio}");
+            assert!(fine.spacing < coarse.spacing);
+        }
+        for set in &p.levels {
+            let grid = fieldtex_mesh::SpatialGrid::new(&set.positions, set.spacing);
+            for (i, q) in set.positions.iter().enumerate() {
+                grid.for_each_within(&set.positions, *q, set.spacing * (1.0 - 1e-9), |j, _| {
+                    assert_eq!(j as usize, i, "samples {i} and {j} closer than the spacing");
+                });
+            }
+        }
+        assert!((7600..8400).contains(&p.levels[0].len()), "{}", p.levels[0].len());
     }
 }

@@ -56,7 +56,7 @@ impl Default for TransferOptions {
             samples: 512_000,
             levels: 3,
             descriptors: DescriptorOptions::default(),
-            reduction: Reduction::Cca,
+            reduction: Reduction::CcaWeighted,
             matching: MatchMode::Multiscale,
             engine: Engine::Parametric,
             parametric: ParametricOptions::default(),
@@ -101,6 +101,55 @@ fn timed<T>(timings: &mut Vec<(String, f64)>, stage: &str, f: impl FnOnce() -> T
     let out = f();
     timings.push((stage.to_string(), t0.elapsed().as_secs_f64() * 1e3));
     out
+}
+
+/// The per-mesh stages, identical for source and target up to the mesh, its name
+/// (`"source"` / `"target"`, which also names the random stream and the timing) and its
+/// samples.
+struct Side<'a> {
+    options: &'a TransferOptions,
+    progress: &'a dyn Progress,
+    timings: &'a mut Vec<(String, f64)>,
+    warnings: &'a mut Vec<Warning>,
+}
+
+impl Side<'_> {
+    fn stream(&self, which: &'static str, index: u64) -> u64 {
+        fieldtex_core::rng::stream_seed(self.options.seed, &format!("transfer-{which}"), index)
+    }
+
+    fn samples(
+        &mut self,
+        mesh: &TriMesh,
+        which: &'static str,
+    ) -> Result<SamplePyramid, TransferError> {
+        let seed = self.stream(which, 0);
+        let (o, progress, warnings) = (self.options, self.progress, &mut *self.warnings);
+        timed(self.timings, &format!("{which}_samples"), || {
+            SamplePyramid::build(mesh, o.samples, o.levels, seed, which, progress, warnings)
+        })
+    }
+
+    fn descriptors(
+        &mut self,
+        mesh: &TriMesh,
+        samples: &SamplePyramid,
+        which: &'static str,
+    ) -> Result<Vec<f64>, TransferError> {
+        let seed = self.stream(which, 1);
+        let (o, progress, warnings) = (self.options, self.progress, &mut *self.warnings);
+        timed(self.timings, &format!("{which}_descriptors"), || {
+            compute_descriptors(
+                mesh,
+                &samples.levels[0],
+                &o.descriptors,
+                seed,
+                which,
+                progress,
+                warnings,
+            )
+        })
+    }
 }
 
 /// Transfers the texture of `source` (per-corner UVs + `texture`, optional `mask` of the
@@ -150,28 +199,9 @@ pub fn transfer(
     let seed = options.seed;
     let mut warnings = Vec::new();
     let mut t = Vec::new();
-    let sp = timed(&mut t, "source_samples", || {
-        SamplePyramid::build(
-            source,
-            options.samples,
-            options.levels,
-            fieldtex_core::rng::stream_seed(seed, "transfer-source", 0),
-            "source",
-            progress,
-            &mut warnings,
-        )
-    })?;
-    let tp = timed(&mut t, "target_samples", || {
-        SamplePyramid::build(
-            target,
-            options.samples,
-            options.levels,
-            fieldtex_core::rng::stream_seed(seed, "transfer-target", 0),
-            "target",
-            progress,
-            &mut warnings,
-        )
-    })?;
+    let mut side = Side { options, progress, timings: &mut t, warnings: &mut warnings };
+    let sp = side.samples(source, "source")?;
+    let tp = side.samples(target, "target")?;
     let (source_colors, source_valid) = timed(&mut t, "source_colors", || {
         source_sample_colors(source, texture, mask, &sp.levels[0])
     })?;
@@ -179,28 +209,9 @@ pub fn transfer(
     if usable < 16 {
         return Err(TransferError::TooFewSamples { found: usable, needed: 16 });
     }
-    let xs = timed(&mut t, "source_descriptors", || {
-        compute_descriptors(
-            source,
-            &sp.levels[0],
-            &options.descriptors,
-            fieldtex_core::rng::stream_seed(seed, "transfer-source", 1),
-            "source",
-            progress,
-            &mut warnings,
-        )
-    })?;
-    let xt = timed(&mut t, "target_descriptors", || {
-        compute_descriptors(
-            target,
-            &tp.levels[0],
-            &options.descriptors,
-            fieldtex_core::rng::stream_seed(seed, "transfer-target", 1),
-            "target",
-            progress,
-            &mut warnings,
-        )
-    })?;
+    let mut side = Side { options, progress, timings: &mut t, warnings: &mut warnings };
+    let xs = side.descriptors(source, &sp, "source")?;
+    let xt = side.descriptors(target, &tp, "target")?;
     let g = timed(&mut t, "guidance", || {
         build_guidance(&xs, &source_colors, &source_valid, &xt, options.reduction)
     })?;

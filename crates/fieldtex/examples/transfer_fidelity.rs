@@ -3,7 +3,7 @@
 //! The source colour is a known function of geometry plus noise: a scalar
 //! `s = 0.55·accessibility + 0.30·height + 0.15·(1 − 2·solid_angle(0.05·diag))`
 //! (accessibility = unoccluded fraction of the sphere, 128 rays; height along y in
-//! `[0, 1]`; solid angle by the mesh crate's estimator with 128 rays), mapped to a brown
+//! `[0, 1]`; solid angle by the mesh crate's analytic computation), mapped to a brown
 //! palette, plus white noise (σ = 0.03) per texel. Colours are stored one texel per
 //! triangle (each triangle's colour at its centroid). The same function, without noise,
 //! is evaluated on each target and written as `reference.obj`; every transfer is then
@@ -55,17 +55,8 @@ fn ground_truth(m: &TriMesh) -> Vec<f64> {
             ..Default::default()
         },
     );
-    let sa = mesh::solid_angle_curvature(
-        &bvh,
-        &pts,
-        &[0.05 * diag],
-        &mesh::SolidAngleOptions {
-            directions: 128,
-            epsilon: 1e-4 * diag,
-            seed: 98,
-            ..Default::default()
-        },
-    );
+    let positions: Vec<[f64; 3]> = pts.iter().map(|p| p.position).collect();
+    let sa = mesh::solid_angle_curvature(m, &positions, &[0.05 * diag]).expect("solid angle");
     let span = (bbox.max[1] - bbox.min[1]).max(1e-12);
     (0..pts.len())
         .map(|i| {

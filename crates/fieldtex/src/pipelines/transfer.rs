@@ -271,13 +271,13 @@ pub fn transfer_files(
         report.metric("nonparametric", n);
     }
     report.notes.push(
-        "surface samples: Poisson-disk dart throwing stands in for Turk's point repulsion (same purpose: even blue-noise spread)".into(),
+        "surface samples: nested Poisson-disk dart throwing (each level holds every coarser one, as in Turk's hierarchy) stands in for Turk's point repulsion (same purpose: an even blue-noise spread; spacing statistics in docs/transfer.md)".into(),
     );
     report.notes.push(
-        "solid-angle curvature: Monte-Carlo ray-walk estimate of the fraction of each sphere inside the object (64 directions, s.d. ≤ 0.06), a substitute for the paper's analytic spherical-excess computation".into(),
+        "solid-angle curvature: analytic, as in the paper (signed solid angles of the triangles clipped to each sphere, exact circular segments); each radius evaluated on min(descriptor samples, 64·area/r²) points and interpolated".into(),
     );
     report.notes.push(format!(
-        "ray-cast descriptors (solid angle, SH occlusion) computed on {} samples and interpolated to level 0; height and normal exact per sample",
+        "SH occlusion (ray cast) and the smallest solid-angle radii computed on {} samples and interpolated to level 0; height and normal exact per sample",
         options.transfer.descriptors.samples.min(result.target_samples.len())
     ));
     match options.transfer.engine {
