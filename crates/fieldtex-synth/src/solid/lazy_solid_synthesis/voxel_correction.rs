@@ -1,0 +1,301 @@
+//! The correction step of lazy solid synthesis (paper E §4.3; module docs of
+//! [`super`], step 3): the three in-plane `N × N` neighbourhoods of a voxel's frame,
+//! sampled at nearest voxels, trilinearly, or along positions integrated through the
+//! field, and the best of the predicted candidate triples. Split from the synthesizer's
+//! block and cache logic, which calls [`SolidSynthesizer::correct`] for every pass of a
+//! primary or dual block.
+
+use super::*;
+
+impl SolidSynthesizer<'_> {
+    /// Corrects the block voxels `[r, r + m)³` of the `s³` region starting at voxel
+    /// `origin` for `passes` passes; returns the block (`m³`, x fastest).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn correct(
+        &self,
+        c: usize,
+        origin: [i32; 3],
+        s: i32,
+        r: i32,
+        m: i32,
+        region: &mut [Triple],
+        passes: usize,
+    ) -> (Vec<Triple>, Counts) {
+        let mut counts = Counts { corrections: 0, evaluations: 0 };
+        let idx = |x: i32, y: i32, z: i32| ((z * s + y) * s + x) as usize;
+        if passes > 0 {
+            let mut colors: Vec<[f32; 3]> =
+                region.iter().map(|t| self.triple_color(c, t)).collect();
+            let mut frames = Vec::with_capacity((m * m * m) as usize);
+            for z in 0..m {
+                for y in 0..m {
+                    for x in 0..m {
+                        let v = [origin[0] + r + x, origin[1] + r + y, origin[2] + r + z];
+                        frames.push(self.frame_f32(c, v));
+                    }
+                }
+            }
+            let mut scratch = Scratch::new(self.exemplar);
+            let subpasses = if self.options.subpasses { 8 } else { 1 };
+            let mut updates: Vec<(usize, Triple)> = Vec::new();
+            for _ in 0..passes {
+                for sub in 0..subpasses {
+                    updates.clear();
+                    for z in 0..m {
+                        for y in 0..m {
+                            for x in 0..m {
+                                let g = [origin[0] + r + x, origin[1] + r + y, origin[2] + r + z];
+                                let class = (g[0] & 1) | ((g[1] & 1) << 1) | ((g[2] & 1) << 2);
+                                if subpasses == 8 && class != sub {
+                                    continue;
+                                }
+                                let f = &frames[((z * m + y) * m + x) as usize];
+                                let at = [x + r, y + r, z + r];
+                                let (best, evals) = self.best_candidate(
+                                    c,
+                                    region,
+                                    &colors,
+                                    s,
+                                    at,
+                                    g,
+                                    f,
+                                    &mut scratch,
+                                );
+                                counts.corrections += 1;
+                                counts.evaluations += evals;
+                                let i = idx(at[0], at[1], at[2]);
+                                if best != region[i] {
+                                    updates.push((i, best));
+                                }
+                            }
+                        }
+                    }
+                    for &(i, t) in &updates {
+                        region[i] = t;
+                        colors[i] = self.triple_color(c, &t);
+                    }
+                }
+            }
+        }
+        let mut out = Vec::with_capacity((m * m * m) as usize);
+        for z in 0..m {
+            for y in 0..m {
+                for x in 0..m {
+                    out.push(region[idx(x + r, y + r, z + r)]);
+                }
+            }
+        }
+        (out, counts)
+    }
+
+    /// The frame at level-`c` lattice position `g + q` (`q` in level-`c` voxels).
+    fn frame_near(&self, c: usize, g: [i32; 3], q: [f64; 3]) -> [f64; 9] {
+        let centre = self.lattice.centre(c, g);
+        let step = (1i64 << c) as f64 * self.lattice.spacing;
+        self.frames.frame(std::array::from_fn(|a| centre[a] + q[a] * step))
+    }
+
+    /// Offsets (level-`c` voxels) of the `N × N` samples of plane `(a1, a2)` around
+    /// voxel `g`, integrated along the field (module docs), into `out` (`t`-major).
+    fn integrated_offsets(
+        &self,
+        c: usize,
+        g: [i32; 3],
+        (a1, a2): (usize, usize),
+        row: &mut [[f64; 3]],
+        out: &mut [[f32; 3]],
+    ) {
+        let n = self.exemplar.options.neighbourhood;
+        let half = n / 2;
+        let walk = |from: [f64; 3], axis: usize, dir: f64| -> [f64; 3] {
+            let f = self.frame_near(c, g, from);
+            std::array::from_fn(|a| from[a] + dir * f[3 * a + axis])
+        };
+        row[half] = [0.0; 3];
+        for step in 1..=half {
+            row[half + step] = walk(row[half + step - 1], a1, 1.0);
+            row[half - step] = walk(row[half - step + 1], a1, -1.0);
+        }
+        for (si, start) in row.iter().enumerate().take(n) {
+            out[half * n + si] = start.map(|x| x as f32);
+            let (mut up, mut down) = (*start, *start);
+            for step in 1..=half {
+                up = walk(up, a2, 1.0);
+                down = walk(down, a2, -1.0);
+                out[(half + step) * n + si] = up.map(|x| x as f32);
+                out[(half - step) * n + si] = down.map(|x| x as f32);
+            }
+        }
+    }
+
+    /// The best candidate for the voxel at region position `at`, lattice voxel `g`
+    /// (§4.3).
+    #[allow(clippy::too_many_arguments)]
+    fn best_candidate(
+        &self,
+        c: usize,
+        region: &[Triple],
+        colors: &[[f32; 3]],
+        s: i32,
+        at: [i32; 3],
+        g: [i32; 3],
+        f: &[f32; 9],
+        scratch: &mut Scratch,
+    ) -> (Triple, u64) {
+        let n = self.exemplar.options.neighbourhood as i32;
+        let half = n / 2;
+        let h = 1i32 << c;
+        let idx = |p: [i32; 3]| ((p[2] * s + p[1]) * s + p[0]) as usize;
+        let current = region[idx(at)];
+        scratch.candidates.clear();
+        scratch.candidates.push(current);
+        let weights = self.exemplar.options.plane_weights;
+        let trilinear = c + self.options.trilinear_levels >= self.cache.len();
+        let integrate = trilinear && c + self.options.integrate_levels >= self.cache.len();
+        // Integrated samples stay where trilinear interpolation has both corners.
+        let reach = self.halo() as f32;
+        for p in 0..3 {
+            let (a1, a2) = (p, (p + 1) % 3);
+            let u = [f[a1], f[3 + a1], f[6 + a1]];
+            let w = [f[a2], f[3 + a2], f[6 + a2]];
+            let lvl = &self.exemplar.planes[p].levels[c];
+            // Region index of every in-plane offset `(s, t)` (the voxel nearest
+            // `at + s·u + t·w`), computed once and shared by the neighbourhood and the
+            // candidate prediction below.
+            let base = idx(at) as isize;
+            let mut k = 0;
+            for t in -half..=half {
+                for ss in -half..=half {
+                    let (sf, tf) = (ss as f32, t as f32);
+                    let d: [i32; 3] = std::array::from_fn(|a| round_i32(sf * u[a] + tf * w[a]));
+                    scratch.offsets[k] = base + ((d[2] * s + d[1]) * s + d[0]) as isize;
+                    k += 1;
+                }
+            }
+            let offset =
+                |ss: i32, t: i32| scratch.offsets[((t + half) * n + ss + half) as usize] as usize;
+            // A zero-weight plane contributes candidates but no neighbourhood.
+            if weights[p] > 0.0 && trilinear {
+                // The halo `r ≥ ⌈N_h √2⌉` holds both corners of every axis: each
+                // component of `s u + t w` lies in `[−N_h √2, N_h √2]`; integrated
+                // paths can reach further and are clamped to the halo.
+                if integrate {
+                    self.integrated_offsets(c, g, (a1, a2), &mut scratch.row, &mut scratch.path);
+                }
+                let mut j = 0;
+                for t in -half..=half {
+                    for ss in -half..=half {
+                        let (sf, tf) = (ss as f32, t as f32);
+                        let d: [f32; 3] = if integrate {
+                            scratch.path[j].map(|x| x.clamp(-reach, reach - 1e-3))
+                        } else {
+                            std::array::from_fn(|a| sf * u[a] + tf * w[a])
+                        };
+                        let fl = d.map(f32::floor);
+                        let fr: [f32; 3] = std::array::from_fn(|a| d[a] - fl[a]);
+                        let cell =
+                            base + ((fl[2] as i32 * s + fl[1] as i32) * s + fl[0] as i32) as isize;
+                        let lo = fr.map(|f| 1.0 - f);
+                        let mut acc = [0.0f32; 3];
+                        for corner in 0..8 {
+                            let (cx, cy, cz) = (corner & 1, (corner >> 1) & 1, corner >> 2);
+                            let wx = if cx == 1 { fr[0] } else { lo[0] };
+                            let wy = if cy == 1 { fr[1] } else { lo[1] };
+                            let wz = if cz == 1 { fr[2] } else { lo[2] };
+                            let wt = wx * wy * wz;
+                            let at = cell + ((cz * s + cy) * s + cx) as isize;
+                            let col = &colors[at as usize];
+                            for ch in 0..3 {
+                                acc[ch] += wt * col[ch];
+                            }
+                        }
+                        scratch.buf[3 * j..3 * j + 3].copy_from_slice(&acc);
+                        j += 1;
+                    }
+                }
+            } else if weights[p] > 0.0 {
+                for (j, &o) in scratch.offsets[..(n * n) as usize].iter().enumerate() {
+                    scratch.buf[3 * j..3 * j + 3].copy_from_slice(&colors[o as usize]);
+                }
+            }
+            let dims = if weights[p] > 0.0 { lvl.dims() } else { 0 };
+            let dim = scratch.buf.len();
+            for j in 0..dims {
+                let row = &lvl.basis[j * dim..(j + 1) * dim];
+                let mut acc = 0.0f32;
+                for (a, b) in row.iter().zip(&scratch.buf) {
+                    acc += a * b;
+                }
+                scratch.proj[p][j] = acc - lvl.bias[j];
+            }
+            let table = &self.exemplar.triples[c][p];
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if dx == 0 && dy == 0 {
+                        // The voxel's own coordinate: its table entries.
+                        let pix = current[p];
+                        for kk in 0..self.options.k {
+                            scratch.candidates.push(*table.get(pix[0], pix[1], kk));
+                        }
+                        continue;
+                    }
+                    let nb = region[offset(dx, dy)];
+                    let pred = [nb[p][0] - h * dx, nb[p][1] - h * dy];
+                    for kk in 0..self.options.k {
+                        scratch.candidates.push(*table.get(pred[0], pred[1], kk));
+                    }
+                }
+            }
+        }
+        let mut best = (f32::INFINITY, current);
+        for cand in &scratch.candidates {
+            let mut cost = 0.0f32;
+            for p in 0..3 {
+                if weights[p] == 0.0 {
+                    continue;
+                }
+                let e = &self.exemplar.planes[p];
+                let lvl = &e.levels[c];
+                let dims = lvl.dims();
+                let pix = cand[p][1] as usize * e.width + cand[p][0] as usize;
+                let a = &lvl.appearance[pix * dims..(pix + 1) * dims];
+                let mut plane_cost = 0.0f32;
+                for j in 0..dims {
+                    let d = a[j] - scratch.proj[p][j];
+                    plane_cost += d * d;
+                }
+                cost += weights[p] * plane_cost;
+            }
+            if cost < best.0 {
+                best = (cost, *cand);
+            }
+        }
+        (best.1, scratch.candidates.len() as u64)
+    }
+}
+
+/// Per-block scratch buffers.
+struct Scratch {
+    buf: Vec<f32>,
+    /// Region indices of the `N × N` in-plane offsets of the current plane.
+    offsets: Vec<isize>,
+    proj: [[f32; 32]; 3],
+    candidates: Vec<Triple>,
+    /// Integrated sample offsets (`N × N`) and the first axis's path (`N`).
+    path: Vec<[f32; 3]>,
+    row: Vec<[f64; 3]>,
+}
+
+impl Scratch {
+    fn new(e: &SolidExemplar) -> Self {
+        let n = e.options.neighbourhood;
+        Self {
+            buf: vec![0.0; n * n * 3],
+            offsets: vec![0; n * n],
+            proj: [[0.0; 32]; 3],
+            candidates: Vec::with_capacity(64),
+            path: vec![[0.0; 3]; n * n],
+            row: vec![[0.0; 3]; n],
+        }
+    }
+}
