@@ -20,26 +20,7 @@ pub struct TransferFidelity {
     pub pearson_luma: f64,
 }
 
-/// Pearson correlation of two equally long series (0 when either is constant or the
-/// series are shorter than 2).
-pub fn pearson(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    if n < 2 {
-        return 0.0;
-    }
-    let ma = a[..n].iter().sum::<f64>() / n as f64;
-    let mb = b[..n].iter().sum::<f64>() / n as f64;
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in a[..n].iter().zip(&b[..n]) {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma) * (x - ma);
-        sbb += (y - mb) * (y - mb);
-    }
-    if saa <= 0.0 || sbb <= 0.0 {
-        return 0.0;
-    }
-    sab / (saa * sbb).sqrt()
-}
+pub use fieldtex_linalg::stats::pearson;
 
 /// Fidelity of `colors` against `reference` (paired RGB samples, module docs).
 pub fn transfer_fidelity(colors: &[[f64; 3]], reference: &[[f64; 3]]) -> TransferFidelity {

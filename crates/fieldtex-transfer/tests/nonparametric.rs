@@ -7,7 +7,7 @@ use fieldtex_mesh::primitives;
 use fieldtex_transfer::{Engine, MatchMode, TransferError, TransferOptions, transfer};
 
 mod common;
-use common::{pearson, small_options, textured};
+use common::{pearson, small_options, textured, with_threads};
 
 fn np_options() -> TransferOptions {
     let mut o = small_options();
@@ -65,11 +65,7 @@ fn nonparametric_is_identical_for_one_and_two_threads() {
     opts.samples = 3000;
     opts.matching = MatchMode::Marginals;
     let run = |t: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .unwrap()
-            .install(|| transfer(&src, &tex, None, &tgt, &opts, &NoProgress).unwrap())
+        with_threads(t, || transfer(&src, &tex, None, &tgt, &opts, &NoProgress).unwrap())
     };
     let (a, b) = (run(1), run(2));
     assert_eq!(a.target_colors, b.target_colors);

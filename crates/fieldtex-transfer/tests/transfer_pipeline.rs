@@ -5,7 +5,7 @@ use fieldtex_mesh::{TriMesh, primitives};
 use fieldtex_transfer::{MatchMode, TransferError, transfer};
 
 mod common;
-use common::{pearson, small_options, textured};
+use common::{pearson, small_options, textured, with_threads};
 
 /// Upward-facing parts are light, downward-facing dark: a function of the normal only.
 fn up_shade(n_y: f64) -> f32 {
@@ -87,11 +87,7 @@ fn same_output_for_one_and_two_threads() {
     let mut opts = small_options();
     opts.samples = 3000;
     let run = |t: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .unwrap()
-            .install(|| transfer(&src, &tex, None, &tgt, &opts, &NoProgress).unwrap())
+        with_threads(t, || transfer(&src, &tex, None, &tgt, &opts, &NoProgress).unwrap())
     };
     let (a, b) = (run(1), run(2));
     assert_eq!(a.target_colors, b.target_colors);

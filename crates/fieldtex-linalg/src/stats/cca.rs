@@ -260,19 +260,7 @@ pub fn cca(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stats::hashed_normal;
-
-    fn pearson(a: &[f64], b: &[f64]) -> f64 {
-        let n = a.len() as f64;
-        let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-        let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-        for (x, y) in a.iter().zip(b) {
-            sab += (x - ma) * (y - mb);
-            saa += (x - ma).powi(2);
-            sbb += (y - mb).powi(2);
-        }
-        sab / (saa * sbb).sqrt()
-    }
+    use crate::stats::{hashed_normal, pearson};
 
     /// Planted correlation: y0 = x1 + 0.5 x3 + noise; y1 = x0 + large noise; y2 pure
     /// noise. CCA's first pair must recover the planted direction, its correlation must

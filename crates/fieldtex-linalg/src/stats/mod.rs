@@ -15,6 +15,7 @@ mod cca;
 mod histogram_matching;
 mod kd_tree;
 mod kmeans;
+mod pearson;
 mod quantile_function;
 
 pub use cca::{Cca, CcaOptions, cca};
@@ -24,6 +25,7 @@ pub use histogram_matching::{
 };
 pub use kd_tree::{KD_LEAF, KdScratch, KdTree};
 pub use kmeans::{KMeans, KMeansOptions, kmeans};
+pub use pearson::pearson;
 pub use quantile_function::QuantileFunction;
 
 /// Rows per reduction chunk (fixed: the summation order does not depend on threads).
