@@ -74,3 +74,9 @@ mod tests {
         assert_eq!(pca.kind().exit_code(), 1);
     }
 }
+
+impl fieldtex_core::HasErrorKind for SynthError {
+    fn kind(&self) -> ErrorKind {
+        SynthError::kind(self)
+    }
+}

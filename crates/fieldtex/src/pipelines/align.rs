@@ -101,7 +101,7 @@ pub(crate) fn salient_curves(
                 &fieldtex_features::CrestOptions::default(),
                 &fieldtex_core::NoProgress,
             )
-            .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
+            .map_err(|e| Error::classify(&e, Some(mesh_path), ""))?;
             warnings.extend(crest.warnings.iter().cloned());
             (
                 crest.lines.into_iter().map(|l| l.points).collect(),
@@ -133,13 +133,13 @@ pub(crate) fn carrier_atlas(
 ) -> Result<CarrierAtlas> {
     let atlas = report
         .time("atlas", || fieldtex_param::build_atlas(mesh, aopts, progress))
-        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "atlas"))?;
     report.warnings.extend(atlas.warnings.iter().cloned());
     let map = report
         .time("texel_map", || {
             fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
         })
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+        .map_err(|e| Error::internal("texel map", e))?;
     let (covered, carriers) = atlas_carriers(&map);
     Ok(CarrierAtlas { atlas, map, covered, carriers })
 }
@@ -238,13 +238,13 @@ fn exemplar_feature_lines(
                 &lines,
                 toroidal,
             )
-            .map_err(|e| Error::bad_input(Some(p), e.to_string()))
+            .map_err(|e| Error::classify(&e, Some(p), ""))
         }
         None => fieldtex_features::detect_exemplar_feature_lines(
             exemplar,
             &ExemplarFeatureOptions { toroidal, ..Default::default() },
         )
-        .map_err(|e| Error::bad_input(Some(&options.exemplar), e.to_string())),
+        .map_err(|e| Error::classify(&e, Some(&options.exemplar), "")),
     }
 }
 
@@ -319,10 +319,10 @@ fn align_metrics(
             toroidal: m.exemplar_features.toroidal,
         },
     )
-    .map_err(|e| Error::Internal(format!("feature coverage: {e}")))?;
+    .map_err(|e| Error::internal("feature coverage", e))?;
     report.metric("feature_coverage", &coverage);
     // Orientation error on the surface, by tangent-plane resampling of the baked texture.
-    let internal = |e: fieldtex_eval::EvalError| Error::Internal(format!("metrics: {e}"));
+    let internal = |e: fieldtex_eval::EvalError| Error::internal("metrics", e);
     let (exemplar, texture) = (m.exemplar, m.texture);
     let orientation = report.time("metrics", || -> Result<_> {
         let ebuf = fieldtex_eval::rgb_buffer(exemplar);
@@ -451,7 +451,7 @@ fn oriented_field(
     }
     let oriented = report
         .time("field", || orient_curves_with_geometry(geometry, curves, &copts, progress))
-        .map_err(|e| Error::Internal(format!("field: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "field"))?;
     report.warnings.extend(oriented.warnings.iter().cloned());
     report.warnings.extend(oriented.field.warnings.iter().cloned());
     let field_metrics = fieldtex_fields::surface_field_metrics_with(
@@ -459,7 +459,7 @@ fn oriented_field(
         &oriented.field.vectors,
         &oriented.solver.constraints(),
     )
-    .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
+    .map_err(|e| Error::internal("field metrics", e))?;
     report.metric(
         "field",
         serde_json::json!({
@@ -482,8 +482,8 @@ fn texopt_error(e: TexOptError, exemplar: &Path) -> Error {
     match e {
         TexOptError::ExemplarTooSmall { .. }
         | TexOptError::ExemplarBufferSize { .. }
-        | TexOptError::NonFiniteExemplar { .. } => Error::bad_input(Some(exemplar), e.to_string()),
-        e => Error::Internal(format!("texture optimisation: {e}")),
+        | TexOptError::NonFiniteExemplar { .. } => Error::classify(&e, Some(exemplar), ""),
+        e => Error::classify(&e, None, "texture optimisation"),
     }
 }
 
@@ -577,7 +577,7 @@ pub(crate) fn align_impl(
         carrier_atlas(&mesh, &aopts, size, &mut report, progress)?;
     let (domain, dwarn) = report
         .time("domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
-        .map_err(|e| Error::Internal(format!("surface domain: {e}")))?;
+        .map_err(|e| Error::internal("surface domain", e))?;
     report.warnings.extend(dwarn);
     // Coarse to fine over the exemplar's pyramid: the coarsest patch spans its largest
     // structure (autocorrelation estimate).
@@ -598,7 +598,7 @@ pub(crate) fn align_impl(
     };
     // 4. Feature alignment inputs (§5.2).
     let bvh =
-        fieldtex_mesh::Bvh::build(&atlas.mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+        fieldtex_mesh::Bvh::build(&atlas.mesh).map_err(|e| Error::internal("bvh", e))?;
     let h = topts.pixel_size.unwrap_or(1.0);
     let curve_points = fieldtex_features::curve_surface_points(&bvh, &curves, h);
     let exemplar_features = report

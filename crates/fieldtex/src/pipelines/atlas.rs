@@ -71,7 +71,7 @@ pub(crate) fn repaired_atlas(
     let atlas =
         report.time("atlas", || build_atlas(&repaired, options, progress)).map_err(|e| {
             let what = source.map(|p| format!("{}: ", p.display())).unwrap_or_default();
-            Error::Internal(format!("{what}atlas: {e}"))
+            Error::classify(&e, None, &format!("{what}atlas"))
         })?;
     report.warnings.extend(atlas.warnings.iter().cloned());
     Ok(atlas)

@@ -53,7 +53,7 @@ pub struct SingularitySummary {
 }
 
 pub(crate) fn bad(e: ev::EvalError, what: &Path) -> Error {
-    Error::bad_input(Some(what), e.to_string())
+    Error::classify(&e, Some(what), "")
 }
 
 /// Computes every metric; `field` is `H×W×2` of the output's size when present.

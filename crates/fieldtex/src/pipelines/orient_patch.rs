@@ -140,7 +140,7 @@ pub(crate) fn orient_patch(
     }
     let map = report
         .time("texel_map", || fieldtex_param::build_texel_map(&patch.mesh, n, n, 0))
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+        .map_err(|e| Error::internal("texel map", e))?;
     let (field, designed) = texel_field(options, &patch, &map, &mut report)?;
     let (jac, field, inside) =
         report.time("jacobians", || jacobians(&patch, &map, &field, per_texel));
@@ -155,15 +155,15 @@ pub(crate) fn orient_patch(
         .time("analysis", || {
             super::synthesis::AnalysisCache::process().analysis(&exemplar, &aopts, progress)
         })
-        .map_err(|e| Error::bad_input(Some(&options.exemplar), format!("exemplar: {e}")))?;
+        .map_err(|e| Error::classify(&e, Some(&options.exemplar), "exemplar"))?;
     report.metric("analysis_cached", cached);
     let domain = ImageDomain::new(n, n, jac)
-        .map_err(|e| Error::Internal(format!("synthesis domain: {e}")))?;
+        .map_err(|e| Error::internal("synthesis domain", e))?;
     let sopts =
         SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };
     let texture = report
         .time("synthesis", || synthesize(&analysis, &domain, &sopts, progress))
-        .map_err(|e| Error::Internal(format!("synthesis: {e}")))?
+        .map_err(|e| Error::internal("synthesis", e))?
         .colors;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     fieldtex_io::write_png(&stage.join("texture.png"), &texture)?;
@@ -235,20 +235,17 @@ fn texel_field(
         FieldSource::Design(p) => {
             let text = super::orient::read_design_text(p)?;
             let d = DesignFile::from_toml_str(&text)
-                .map_err(|e| Error::bad_input(Some(p), e.to_string()))?;
+                .map_err(|e| Error::classify(&e, Some(p), ""))?;
             (d, Some(p.as_path()))
         }
         FieldSource::Preset(name) => {
             let r = fieldtex_fields::presets::REFERENCE_SIZE;
             let d = fieldtex_fields::presets::preset(name, r, r, options.grid)
-                .map_err(|e| Error::bad_input(None, format!("--preset {name}: {e}")))?;
+                .map_err(|e| Error::classify(&e, None, &format!("--preset {name}")))?;
             (d, None)
         }
     };
-    let bad = |e: fieldtex_fields::FieldsError| match e {
-        fieldtex_fields::FieldsError::Solve(_) => Error::Internal(e.to_string()),
-        _ => Error::bad_input(src, e.to_string()),
-    };
+    let bad = |e: fieldtex_fields::FieldsError| Error::classify(&e, src, "");
     let mut designed = Vec::new();
     let mut mapping_warnings = Vec::new();
     let fd = report.time("field_factor", || -> Result<FieldDesign> {
@@ -267,7 +264,7 @@ fn texel_field(
     let mut fd = fd;
     let solved = report
         .time("field_solve", || fd.solve())
-        .map_err(|e| Error::Internal(format!("field solve: {e}")))?;
+        .map_err(|e| Error::classify(&e, src, "field solve"))?;
     report.metric("field_residual", solved.residual);
     report.warnings.extend(fd.warnings().iter().cloned());
     for (_, s) in fd.singularities() {

@@ -230,14 +230,14 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
         .time("exemplar_analysis", || {
             SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
         })
-        .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "exemplar"))?;
     let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
     report.metric("grid", grid);
     let frames = FieldFrames(field.as_ref());
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
     let synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
-        .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?;
-    let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "synthesis options"))?;
+    let bvh = Bvh::build(&mesh).map_err(|e| Error::internal("bvh", e))?;
     // The interior region (paper E Fig. 15): its own analysis, same lattice and field.
     let ex_inner = match &options.interior {
         Some(path) => {
@@ -250,7 +250,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
                     .time("interior_exemplar_analysis", || {
                         SolidExemplar::new([&images[0], &images[1], &images[2]], &a, progress)
                     })
-                    .map_err(|e| Error::bad_input(Some(path), format!("interior exemplar: {e}")))?,
+                    .map_err(|e| Error::classify(&e, Some(path), "interior exemplar"))?,
             )
         }
         None => None,
@@ -264,7 +264,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let inner = match &ex_inner {
         Some(e) => Some(Interior {
             synth: SolidSynthesizer::new(e, lattice, &frames, options.synthesis.clone())
-                .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?,
+                .map_err(|e| Error::classify(&e, None, "synthesis options"))?,
             bvh: &bvh,
             depth,
             band,
@@ -438,7 +438,7 @@ pub(crate) fn sketch_frame_field(
     let mut field = FrameField3d::new(grid, FrameFieldOptions::default())
         .map_err(|e| Error::Internal(e.to_string()))?;
     for (i, c) in curves.iter().enumerate() {
-        field.add_curve(c).map_err(|e| Error::bad_input(path, format!("curve {i}: {e}")))?;
+        field.add_curve(c).map_err(|e| Error::classify(&e, path, &format!("curve {i}")))?;
     }
     Ok((field, curves))
 }
@@ -533,10 +533,10 @@ fn textured_atlas(
     progress: &dyn Progress,
 ) -> Result<(TriMesh, Image, Work)> {
     let atlas = fieldtex_param::build_atlas(mesh, aopts, progress)
-        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "atlas"))?;
     let size = aopts.resolution as usize;
     let map = fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+        .map_err(|e| Error::internal("texel map", e))?;
     let (covered, _) = atlas_carriers(&map);
     let points: Vec<[f64; 3]> =
         covered.iter().filter_map(|&i| map.surface_point(&atlas.mesh, i)).collect();

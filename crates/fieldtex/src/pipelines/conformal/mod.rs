@@ -140,7 +140,7 @@ pub fn conformal(
     // 1. Global conformal parameterisation, per component.
     let (mut comps, warnings) = report
         .time("conformal-map", || global_conformal(&mesh, progress))
-        .map_err(|e| Error::Internal(format!("conformal map: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "conformal map"))?;
     report.warnings.extend(warnings);
     crate::outputs::check_cancelled(progress)?;
     // 2. Optional quasi-isometric relaxation.
