@@ -6,7 +6,7 @@
 //! and the facade's own option checks refuse such input first, also with exit 2);
 //! `fieldtex-linalg` errors are always internal.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 mod common;
@@ -18,6 +18,12 @@ fn tmp(name: &str) -> PathBuf {
 
 fn quick(args: &[&str]) -> std::process::Output {
     common::run_limited(args, Duration::from_secs(60))
+}
+
+/// `orient --preset PRESET` of `exemplar` at 64² into `out`.
+fn orient(preset: &str, exemplar: &Path, out: &Path) -> std::process::Output {
+    let (ex, out) = (exemplar.to_str().unwrap(), out.to_str().unwrap());
+    quick(&["orient", "--preset", preset, "--exemplar", ex, "--size", "64", "--out", out, "--quiet"])
 }
 
 #[test]
@@ -34,17 +40,7 @@ fn io_an_unparsable_mesh_exits_2() {
 fn fields_an_unknown_preset_exits_2() {
     let d = tmp("fields");
     let ex = shared().join("exemplars/stripes_Fabric071.png");
-    let out = d.join("o");
-    let o = quick(&[
-        "orient",
-        "--preset",
-        "no-such-preset",
-        "--exemplar",
-        ex.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = orient("no-such-preset", &ex, &d.join("o"));
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("unknown preset"), "{}", stderr(&o));
 }
@@ -65,19 +61,7 @@ fn synth_an_exemplar_below_the_stack_minimum_exits_2() {
         "--quiet",
     ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
-    let out = d.join("o");
-    let o = quick(&[
-        "orient",
-        "--preset",
-        "whorl",
-        "--exemplar",
-        tiny.to_str().unwrap(),
-        "--size",
-        "64",
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let o = orient("whorl", &tiny, &d.join("o"));
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     let e = stderr(&o);
     assert!(e.contains("tiny.png") && e.contains("synthesis needs at least"), "{e}");

@@ -132,11 +132,11 @@ pub(crate) fn carrier_atlas(
     progress: &dyn Progress,
 ) -> Result<CarrierAtlas> {
     let atlas = report
-        .time("atlas", || fieldtex_param::build_atlas(mesh, aopts, progress))
+        .stage(progress, "atlas", || fieldtex_param::build_atlas(mesh, aopts, progress))
         .map_err(|e| Error::classify(&e, None, "atlas"))?;
     report.warnings.extend(atlas.warnings.iter().cloned());
     let map = report
-        .time("texel_map", || {
+        .stage(progress, "texel_map", || {
             fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
         })
         .map_err(|e| Error::internal("texel map", e))?;
@@ -450,7 +450,7 @@ fn oriented_field(
         copts.field.fallback = fieldtex_fields::UnconstrainedFallback::Direction(d);
     }
     let oriented = report
-        .time("field", || orient_curves_with_geometry(geometry, curves, &copts, progress))
+        .stage(progress, "field", || orient_curves_with_geometry(geometry, curves, &copts, progress))
         .map_err(|e| Error::classify(&e, None, "field"))?;
     report.warnings.extend(oriented.warnings.iter().cloned());
     report.warnings.extend(oriented.field.warnings.iter().cloned());
@@ -556,7 +556,7 @@ pub(crate) fn align_impl(
     // One geometry object for crest lines, the field solver and its metrics.
     let geometry = MeshGeometry::new(&mesh);
     let mut warnings = Vec::new();
-    let (curves, curves_source) = report.time("curves", || {
+    let (curves, curves_source) = report.stage(progress, "curves", || {
         salient_curves(&geometry, &options.mesh, options.curves.as_deref(), &mut warnings)
     })?;
     if curves.is_empty() {
@@ -576,13 +576,13 @@ pub(crate) fn align_impl(
     let CarrierAtlas { atlas, map, covered, carriers } =
         carrier_atlas(&mesh, &aopts, size, &mut report, progress)?;
     let (domain, dwarn) = report
-        .time("domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
+        .stage(progress, "domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
         .map_err(|e| Error::internal("surface domain", e))?;
     report.warnings.extend(dwarn);
     // Coarse to fine over the exemplar's pyramid: the coarsest patch spans its largest
     // structure (autocorrelation estimate).
     let structure =
-        report.time("exemplar_scale", || fieldtex_synth::characteristic_scale(&exemplar));
+        report.stage(progress, "exemplar_scale", || fieldtex_synth::characteristic_scale(&exemplar));
     let patch_sizes =
         fieldtex_texopt::pyramid_patch_sizes(structure.pixels, exemplar.width.min(exemplar.height));
     report.metric("exemplar_scale", &structure);
@@ -602,14 +602,14 @@ pub(crate) fn align_impl(
     let h = topts.pixel_size.unwrap_or(1.0);
     let curve_points = fieldtex_features::curve_surface_points(&bvh, &curves, h);
     let exemplar_features = report
-        .time("exemplar_features", || exemplar_feature_lines(options, &exemplar, topts.toroidal))?;
+        .stage(progress, "exemplar_features", || exemplar_feature_lines(options, &exemplar, topts.toroidal))?;
     report.warnings.extend(exemplar_features.warnings.iter().cloned());
     let features = if options.feature_align && !curve_points.is_empty() {
         // Paper A constrains samples within half a patch of a curve; coarse levels
         // (w > 32) span whole structures, so the band is half a 32-px patch plus 2 px.
         let w = topts.patch_sizes.iter().copied().max().unwrap_or(8).min(32) as f64;
         let band = (0.5 * w + 2.0) * h;
-        let carrier_curve_distance = report.time("curve_distance", || {
+        let carrier_curve_distance = report.stage(progress, "curve_distance", || {
             fieldtex_features::distance_to_curves(domain.positions(), &curves, 0.25 * h, band)
         });
         Some(FeatureAlignment {
@@ -621,7 +621,7 @@ pub(crate) fn align_impl(
     };
     // 5. Texture optimisation (§5.1).
     let result = report
-        .time("synthesis", || {
+        .stage(progress, "synthesis", || {
             fieldtex_texopt::optimise(&domain, &exemplar, &topts, features.as_ref(), progress)
         })
         .map_err(|e| texopt_error(e, &options.exemplar))?;
@@ -644,8 +644,8 @@ pub(crate) fn align_impl(
     };
     align_metrics(&inputs, &result, features.is_some(), carriers.len(), &mut report)?;
     // 7. Outputs.
-    report.time("write", || super::write_model(stage, &atlas.mesh, Some(&texture)))?;
-    let preview = report.time("preview", || {
+    report.stage(progress, "write", || super::write_model(stage, &atlas.mesh, Some(&texture)))?;
+    let preview = report.stage(progress, "preview", || {
         preview_with_curves(&atlas.mesh, &texture, options.draw_curves.then_some(&curves[..]), 800)
     });
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;

@@ -70,7 +70,11 @@ pub(crate) fn image_metrics(
     exact: bool,
     progress: &dyn Progress,
 ) -> std::result::Result<ImageMetrics, ev::EvalError> {
-    progress.stage(if exact { "metrics (exact)" } else { "metrics" }, 6);
+    let stage = fieldtex_core::StageGuard::begin(
+        progress,
+        if exact { "metrics (exact)" } else { "metrics" },
+        6,
+    );
     let ob = ev::rgb_buffer(output);
     let eb = ev::rgb_buffer(exemplar);
     let o = ev::ImageView::new(&ob, output.width, output.height, 3)?;
@@ -112,7 +116,7 @@ pub(crate) fn image_metrics(
         phase_defects,
         skipped,
     ) = rest?;
-    progress.finish_stage();
+    drop(stage);
     Ok(ImageMetrics {
         coherence,
         guided_coherence,

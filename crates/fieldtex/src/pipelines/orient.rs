@@ -128,8 +128,7 @@ fn build_field(
         }
         FieldSource::Design(p) => {
             let text = read_design_text(p)?;
-            DesignFile::from_toml_str(&text)
-                .map_err(|e| Error::classify(&e, Some(p), ""))?
+            DesignFile::from_toml_str(&text).map_err(|e| Error::classify(&e, Some(p), ""))?
         }
         FieldSource::Preset(name) => {
             fieldtex_fields::presets::preset(name, n as f64, n as f64, options.grid)
@@ -206,7 +205,7 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     }
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let fitted = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = report.stage(progress, "read", || fieldtex_io::read_image(&options.exemplar))?;
     let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
     report.warnings.extend(fitted.warning.clone());
     let per_pixel = options.exemplar_pixels_per_output_pixel(fitted.factor);
@@ -340,7 +339,7 @@ pub(crate) fn texture_metrics(
         report.metric("exemplar_orientation", own);
     }
     let metrics = report
-        .time("metrics", || {
+        .stage(progress, "metrics", || {
             image_metrics(texture, exemplar, Some(flat), None, angle, seed, exact, progress)
         })
         .map_err(|e| Error::internal("metrics", e))?;

@@ -199,7 +199,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
         .bounding_box()
         .ok_or_else(|| Error::bad_input(Some(&options.mesh), "the mesh has no vertex"))?;
     // 1. Sketch and frame field (§3).
-    let (field, curves) = report.time("frame_field", || match &options.sketch {
+    let (field, curves) = report.stage(progress, "frame_field", || match &options.sketch {
         Some(path) => {
             solid_frame_field(&mesh, path, options.field_cells).map(|(f, c)| (Some(f), c))
         }
@@ -221,13 +221,14 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
                 "residual": f.last_residual(),
             }),
         );
-        let edit_ms = report.time("frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
+        let edit_ms = report
+            .stage(progress, "frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
         report.metric("frame_field_edit_ms", edit_ms);
     }
     crate::outputs::check_cancelled(progress)?;
     // 2. Exemplar analysis and the synthesizer.
     let ex = report
-        .time("exemplar_analysis", || {
+        .stage(progress, "exemplar_analysis", || {
             SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
         })
         .map_err(|e| Error::classify(&e, None, "exemplar"))?;
@@ -247,7 +248,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
             a.plane_weights = [1.0, 1.0, 0.0];
             Some(
                 report
-                    .time("interior_exemplar_analysis", || {
+                    .stage(progress, "interior_exemplar_analysis", || {
                         SolidExemplar::new([&images[0], &images[1], &images[2]], &a, progress)
                     })
                     .map_err(|e| Error::classify(&e, Some(path), "interior exemplar"))?,
@@ -278,22 +279,23 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let mut synth = SolidRegions { outer: synth, inner, grid };
     crate::outputs::check_cancelled(progress)?;
     // 3. Surface shell → atlas texture → model.glb.
-    let (atlas_mesh, texture, shell) =
-        report.time("shell", || textured_atlas(&mesh, &aopts, &grid, &mut synth, progress))?;
+    let (atlas_mesh, texture, shell) = report
+        .stage(progress, "shell", || textured_atlas(&mesh, &aopts, &grid, &mut synth, progress))?;
     report.metric("shell", &shell);
     report.metric(
         "shell_voxels_per_second",
         shell.computed_all_levels as f64 / shell.seconds.max(1e-9),
     );
     report.metric("shell_share_of_full_volume", shell.computed_finest as f64 / grid.len() as f64);
-    report.time("write", || super::write_model(out_dir, &atlas_mesh, Some(&texture)))?;
-    let preview = report.time("preview", || preview_with_curves(&atlas_mesh, &texture, &curves));
+    report.stage(progress, "write", || super::write_model(out_dir, &atlas_mesh, Some(&texture)))?;
+    let preview =
+        report.stage(progress, "preview", || preview_with_curves(&atlas_mesh, &texture, &curves));
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     crate::outputs::check_cancelled(progress)?;
     // 4. Cuts.
     let mut cut_reports = Vec::new();
     for (i, cut) in options.cuts.iter().enumerate() {
-        let r = report.time(&format!("cut_{}", i + 1), || {
+        let r = report.stage(progress, &format!("cut_{}", i + 1), || {
             let keep_field = options.keep.then_some(&frames);
             write_cut(
                 out_dir,
@@ -313,7 +315,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     report.metric("cuts", cut_reports);
     // 5. Volume and frames.
     if options.volume {
-        let w = report.time("volume", || write_volume(out_dir, &grid, &mut synth, progress))?;
+        let w = report
+            .stage(progress, "volume", || write_volume(out_dir, &grid, &mut synth, progress))?;
         report.metric("volume", w);
     }
     if options.keep

@@ -42,8 +42,8 @@ pub fn transfer_fidelity_files(
         &mut warnings,
     )
     .map_err(|e| Error::classify(&e, Some(mesh), ""))?;
-    let bvh = fieldtex_mesh::Bvh::build(&b.mesh)
-        .map_err(|e| Error::classify(&e, Some(reference), ""))?;
+    let bvh =
+        fieldtex_mesh::Bvh::build(&b.mesh).map_err(|e| Error::classify(&e, Some(reference), ""))?;
     let closest = bvh.closest_points(&s.positions);
     let (mut tri_b, mut bary_b, mut keep) = (Vec::new(), Vec::new(), Vec::new());
     for (i, c) in closest.iter().enumerate() {
