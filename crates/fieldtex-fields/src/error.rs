@@ -59,7 +59,7 @@ pub enum FieldsError {
 /// internal.
 impl fieldtex_core::HasErrorKind for FieldsError {
     fn kind(&self) -> fieldtex_core::ErrorKind {
-        use fieldtex_core::{ErrorKind, HasErrorKind};
+        use fieldtex_core::ErrorKind;
         match self {
             FieldsError::InvalidMesh(e) => e.kind(),
             FieldsError::Solve(_) | FieldsError::StaleSolution { .. } => ErrorKind::Internal,

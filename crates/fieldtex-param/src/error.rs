@@ -40,7 +40,7 @@ pub enum ParamError {
 /// its mesh is a caller's bug, and a failed conformal solve is internal.
 impl fieldtex_core::HasErrorKind for ParamError {
     fn kind(&self) -> fieldtex_core::ErrorKind {
-        use fieldtex_core::{ErrorKind, HasErrorKind};
+        use fieldtex_core::ErrorKind;
         match self {
             ParamError::InvalidMesh(e) => e.kind(),
             ParamError::InvalidOption { .. } | ParamError::PackingFailed { .. } => {
