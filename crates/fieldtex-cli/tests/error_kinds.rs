@@ -23,7 +23,18 @@ fn quick(args: &[&str]) -> std::process::Output {
 /// `orient --preset PRESET` of `exemplar` at 64² into `out`.
 fn orient(preset: &str, exemplar: &Path, out: &Path) -> std::process::Output {
     let (ex, out) = (exemplar.to_str().unwrap(), out.to_str().unwrap());
-    quick(&["orient", "--preset", preset, "--exemplar", ex, "--size", "64", "--out", out, "--quiet"])
+    quick(&[
+        "orient",
+        "--preset",
+        preset,
+        "--exemplar",
+        ex,
+        "--size",
+        "64",
+        "--out",
+        out,
+        "--quiet",
+    ])
 }
 
 #[test]
@@ -48,19 +59,7 @@ fn fields_an_unknown_preset_exits_2() {
 #[test]
 fn synth_an_exemplar_below_the_stack_minimum_exits_2() {
     let d = tmp("synth");
-    // A 4×4 exemplar written by the tool itself (a render of the torus).
-    let tiny = d.join("tiny.png");
-    let torus = shared().join("meshes/torus.obj");
-    let o = quick(&[
-        "render",
-        torus.to_str().unwrap(),
-        "--out",
-        tiny.to_str().unwrap(),
-        "--size",
-        "4",
-        "--quiet",
-    ]);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let tiny = common::tiny_exemplar(&d);
     let o = orient("whorl", &tiny, &d.join("o"));
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     let e = stderr(&o);
