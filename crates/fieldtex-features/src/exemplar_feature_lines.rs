@@ -49,7 +49,6 @@ use crate::distance_transform::euclidean_distance_transform;
 use crate::error::check_option;
 use crate::line_response::{Response, responses, select_scale};
 use fieldtex_core::{Image, Warning};
-use rayon::prelude::*;
 use serde::Serialize;
 
 /// Which luminance extrema count as lines.
@@ -167,12 +166,6 @@ impl ExemplarFeatures {
         top * (1.0 - ty) + bottom * ty
     }
 }
-
-/// Largest sub-pixel offset (per axis) of a line point from its pixel centre. Steger's
-/// ½ leaves one-pixel gaps where a slanted line passes between two pixel centres (the
-/// extremum, found along the slanted normal, then lies just outside both pixels);
-/// 0.6 closes them, and the duplicates it creates are consumed while linking.
-const POINT_TOLERANCE: f64 = 0.6;
 
 const NEIGHBOURS: [[i64; 2]; 8] =
     [[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1]];

@@ -6,6 +6,12 @@
 use crate::exemplar_feature_lines::{ExemplarFeatureOptions, LinePolarity};
 use rayon::prelude::*;
 
+/// Largest sub-pixel offset (per axis) of a line point from its pixel centre. Steger's
+/// ½ leaves one-pixel gaps where a slanted line passes between two pixel centres (the
+/// extremum, found along the slanted normal, then lies just outside both pixels);
+/// 0.6 closes them, and the duplicates it creates are consumed while linking.
+const POINT_TOLERANCE: f64 = 0.6;
+
 /// Gaussian smoothing, first and second derivative kernels for correlation
 /// (`Σ k[j] f(x + j − r)`), radius `⌈4σ⌉`, normalised to be exact on 1, x and x²/2.
 fn gaussian_kernels(sigma: f64) -> [Vec<f64>; 3] {

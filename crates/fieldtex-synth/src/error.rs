@@ -59,6 +59,12 @@ impl SynthError {
     }
 }
 
+impl fieldtex_core::HasErrorKind for SynthError {
+    fn kind(&self) -> ErrorKind {
+        SynthError::kind(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,11 +78,5 @@ mod tests {
         let pca = SynthError::Pca { level: 1, source };
         assert_eq!(pca.kind(), ErrorKind::Internal);
         assert_eq!(pca.kind().exit_code(), 1);
-    }
-}
-
-impl fieldtex_core::HasErrorKind for SynthError {
-    fn kind(&self) -> ErrorKind {
-        SynthError::kind(self)
     }
 }
