@@ -297,6 +297,21 @@ const MAX_THREADS: usize = 256;
 
 /// Prints a line to stdout; a closed pipe (`fieldtex inspect M --json | head -1`) ends
 /// the output quietly instead of panicking.
+/// With `--json` the pretty JSON that `pretty` makes, else the summary lines.
+fn print_json_or_lines(
+    json: bool,
+    pretty: impl FnOnce() -> serde_json::Result<String>,
+    lines: Vec<String>,
+) {
+    if json {
+        print_stdout(&pretty().unwrap_or_default());
+    } else {
+        for line in lines {
+            print_stdout(&line);
+        }
+    }
+}
+
 fn print_stdout(text: &str) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
@@ -370,24 +385,16 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Inspect { mesh, json } => {
             let (report, warnings) = fieldtex::inspect_file(&mesh)?;
             print_warnings(&warnings, g.quiet);
-            if json {
-                print_stdout(&serde_json::to_string_pretty(&report).unwrap_or_default());
-            } else {
-                for line in report.summary_lines() {
-                    print_stdout(&line);
-                }
-            }
+            print_json_or_lines(
+                json,
+                || serde_json::to_string_pretty(&report),
+                report.summary_lines(),
+            );
         }
         Command::Repair { mesh, out, weld_epsilon, json } => {
             let opts = fieldtex::RepairCommandOptions { weld_epsilon };
             let summary = fieldtex::repair_file(&mesh, &out, &opts)?;
-            if json {
-                print_stdout(&serde_json::to_string_pretty(&summary).unwrap_or_default());
-            } else {
-                for line in summary.lines() {
-                    print_stdout(&line);
-                }
-            }
+            print_json_or_lines(json, || serde_json::to_string_pretty(&summary), summary.lines());
         }
         Command::Atlas { mesh, out, size, gutter } => {
             let opts = fieldtex::AtlasCommandOptions { size, gutter, seed: g.seed };

@@ -43,6 +43,13 @@ fn exemplar_in(dir: &Path, name: &str) -> PathBuf {
     p
 }
 
+/// Exit 2 with a message that says `has` and not `lacks`.
+fn assert_refused_naming(o: &Output, has: &str, lacks: &str) {
+    assert_eq!(code(o), 2, "{}", stderr(o));
+    let e = stderr(o);
+    assert!(e.contains(has) && !e.contains(lacks), "{e}");
+}
+
 fn assert_refused_unchanged(o: &Output, file: &Path, before: &[u8]) {
     assert_eq!(code(o), 2, "{}", stderr(o));
     assert!(stderr(o).contains("refusing to overwrite an input"), "{}", stderr(o));
@@ -339,14 +346,9 @@ fn warnings_were_printed_twice_in_library_words() {
 fn eval_with_a_tiny_exemplar_named_the_image() {
     let d = tmp("eval-tiny");
     let img = exemplar_in(&d, "img.png");
-    // 4×4 exemplar written by the tool: render a torus at 4 px.
-    let tiny = d.join("tiny.png");
-    let o = quick(&["render", s(&torus_in(&d)), "--out", s(&tiny), "--size", "4", "--quiet"]);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let tiny = common::tiny_exemplar(&d);
     let o = quick(&["eval", s(&img), "--exemplar", s(&tiny)]);
-    assert_eq!(code(&o), 2);
-    let e = stderr(&o);
-    assert!(e.contains("tiny.png") && !e.contains("img.png"), "{e}");
+    assert_refused_naming(&o, "tiny.png", "img.png");
 }
 
 #[test]
@@ -356,9 +358,7 @@ fn empty_png_was_told_to_reexport_the_mesh() {
     std::fs::File::create(&empty).unwrap().flush().unwrap();
     let o =
         quick(&["orient", "--preset", "whorl", "--exemplar", s(&empty), "--out", s(&d.join("o"))]);
-    assert_eq!(code(&o), 2);
-    let e = stderr(&o);
-    assert!(e.contains("image") && !e.contains("mesh"), "{e}");
+    assert_refused_naming(&o, "image", "mesh");
 }
 
 #[test]

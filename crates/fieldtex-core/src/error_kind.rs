@@ -21,3 +21,12 @@ impl ErrorKind {
         }
     }
 }
+
+/// An error type that says, per variant, whose fault it is. Every crate error of the
+/// workspace implements it; the facade turns any of them into its own error through one
+/// function (`fieldtex::Error::classify`), so the exit code follows the variant.
+pub trait HasErrorKind: std::error::Error {
+    /// Bad input (the user can fix a file or an option) or internal (our bug or a
+    /// numerical breakdown on valid input).
+    fn kind(&self) -> ErrorKind;
+}

@@ -19,7 +19,7 @@ pub mod stage_guard;
 pub mod vec3;
 pub mod warnings;
 
-pub use error_kind::ErrorKind;
+pub use error_kind::{ErrorKind, HasErrorKind};
 pub use image::Image;
 pub use progress::{NoProgress, Progress};
 pub use rng::{stream, stream_seed};

@@ -45,3 +45,11 @@ pub enum EvalError {
     #[error("option {name} = {value} is invalid: {reason}")]
     InvalidOption { name: &'static str, value: String, reason: &'static str },
 }
+
+/// Every metric error is the caller's data or option (bad input). A pipeline that
+/// measures its own outputs decides for itself that such a failure is internal.
+impl fieldtex_core::HasErrorKind for EvalError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        fieldtex_core::ErrorKind::BadInput
+    }
+}

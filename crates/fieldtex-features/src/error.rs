@@ -1,5 +1,6 @@
 //! Errors of the salient-curve crate.
 
+use fieldtex_core::HasErrorKind;
 use fieldtex_mesh::MeshError;
 use thiserror::Error;
 
@@ -34,5 +35,19 @@ pub(crate) fn check_option(
         Ok(())
     } else {
         Err(FeaturesError::InvalidOption { name, value, requirement })
+    }
+}
+
+/// The mesh's own kind for mesh errors; everything else (an empty or degenerate mesh, an
+/// option, a curve point) is bad input.
+impl HasErrorKind for FeaturesError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        match self {
+            FeaturesError::Mesh(e) => e.kind(),
+            FeaturesError::EmptyMesh
+            | FeaturesError::NoLengthScale { .. }
+            | FeaturesError::InvalidOption { .. }
+            | FeaturesError::NonFiniteCurvePoint { .. } => fieldtex_core::ErrorKind::BadInput,
+        }
     }
 }

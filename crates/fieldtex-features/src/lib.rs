@@ -24,6 +24,7 @@ pub mod exemplar_feature_lines;
 pub mod extremality;
 pub mod feature_quality;
 pub mod given_curves;
+mod line_response;
 pub mod mesh_scale;
 mod segment_grid;
 pub mod sharp_edges;

@@ -41,36 +41,6 @@ fn median(mut v: Vec<f64>) -> f64 {
     if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
 }
 
-/// Polylines of an OBJ file's `l` elements (1-based or negative vertex indices).
-fn read_obj_polylines(path: &Path) -> Vec<Vec<V3>> {
-    let text = std::fs::read_to_string(path).expect("read curves");
-    let mut verts: Vec<V3> = Vec::new();
-    let mut lines = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).filter_map(|s| s.parse().ok()).collect();
-                if c.len() == 3 {
-                    verts.push([c[0], c[1], c[2]]);
-                }
-            }
-            Some("l") => {
-                let pl: Vec<V3> = it
-                    .filter_map(|s| s.split('/').next()?.parse::<i64>().ok())
-                    .filter_map(|i| {
-                        let k = if i < 0 { verts.len() as i64 + i } else { i - 1 };
-                        verts.get(usize::try_from(k).ok()?).copied()
-                    })
-                    .collect();
-                lines.push(pl);
-            }
-            _ => {}
-        }
-    }
-    lines
-}
-
 /// Chains of edges whose dihedral angle exceeds `min_angle_deg`, broken at vertices of
 /// sharp-degree ≠ 2 and at turns sharper than `max_turn_deg`, kept if ≥ `min_edges` long.
 fn sharp_edge_chains(
@@ -198,7 +168,7 @@ fn main() {
     let detect = |mesh: &TriMesh| {
         let t_curves = Instant::now();
         let (curves, source) = match &curves_path {
-            Some(p) => (read_obj_polylines(p), "file"),
+            Some(p) => (fieldtex_io::read_obj_polylines(p).expect("read curves"), "file"),
             None if sharp => (sharp_edge_chains(mesh, 30.0, 60.0, 3), "sharp-edge chains"),
             None => {
                 let crest = fieldtex_features::crest_lines(

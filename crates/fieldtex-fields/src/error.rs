@@ -53,3 +53,29 @@ pub enum FieldsError {
     )]
     StaleSolution { stale: usize },
 }
+
+/// The design's mesh, options, constraints, strokes, design files and presets are bad
+/// input; a failed solve, and asking a solver for a stale solution (a caller's bug), are
+/// internal.
+impl fieldtex_core::HasErrorKind for FieldsError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        use fieldtex_core::ErrorKind;
+        match self {
+            FieldsError::InvalidMesh(e) => e.kind(),
+            FieldsError::Solve(_) | FieldsError::StaleSolution { .. } => ErrorKind::Internal,
+            FieldsError::DegenerateTriangle { .. }
+            | FieldsError::NonManifoldEdge { .. }
+            | FieldsError::InconsistentOrientation { .. }
+            | FieldsError::InvalidOption { .. }
+            | FieldsError::NonFinite { .. }
+            | FieldsError::OutsideDomain { .. }
+            | FieldsError::StrokeTooShort { .. }
+            | FieldsError::StrokeMissesDomain { .. }
+            | FieldsError::UnknownId { .. }
+            | FieldsError::WrongSymmetry { .. }
+            | FieldsError::DesignFile { .. }
+            | FieldsError::UnknownPreset { .. }
+            | FieldsError::FieldSize { .. } => ErrorKind::BadInput,
+        }
+    }
+}

@@ -38,7 +38,8 @@
 //! right-hand sides (`fieldtex_linalg::Cholesky::solve_many`).
 //!
 //! Files: options, constraints and reports in `curve_field_types.rs`; constraint
-//! sampling from curves in `curve_constraint_sampling.rs`; the solver here.
+//! sampling from curves in `curve_constraint_sampling.rs`; the per-component block
+//! systems and their first factorisation in `curve_field_blocks.rs`; the solver here.
 //!
 //! Not implemented: removing curves (multiple-rank downdates exist in `fieldtex_linalg`,
 //! `Cholesky::remove_diagonal_penalties`, but no caller needs them yet).
@@ -48,13 +49,14 @@ use std::time::Instant;
 
 use fieldtex_core::Warning;
 use fieldtex_core::vec3::{self, V3};
-use fieldtex_linalg::{Cholesky, FactorLayout, SparseMatrix, SymbolicCholesky};
+use fieldtex_linalg::Cholesky;
 use fieldtex_mesh::{
     CotanOptions, CurvatureOptions, MeshError, MeshGeometry, NormalWeighting, SpatialGrid, TriMesh,
     UnionFind, cotan_laplacian_with, principal_curvatures,
 };
 
 use crate::FieldsError;
+use crate::curve_field_blocks::{Block, block_rhs, extract_block, factor_block, penalised_matrix};
 pub use crate::curve_field_types::{
     AddReport, CurveConstraints, CurveField, CurveFieldOptions, FillOrdering, OverlapPolicy,
     SolveReport, UnconstrainedFallback, VertexFieldStatus,
@@ -62,25 +64,6 @@ pub use crate::curve_field_types::{
 
 /// Sentinel for "no component" (a vertex used by no usable triangle).
 const NONE: u32 = u32::MAX;
-
-struct Block {
-    /// Global vertex indices, increasing (local index = position).
-    vertices: Vec<u32>,
-    laplacian: SparseMatrix,
-    symbolic: Option<SymbolicCholesky>,
-    factor: Option<Cholesky>,
-    dirty: bool,
-    failed: bool,
-    /// Vertices that got their first penalty since the last solve (global indices).
-    fresh: Vec<u32>,
-    /// No full solve since the first factorisation, or a change an incremental solve
-    /// does not cover (a target moved by `Average`): the next solve of the block is a
-    /// full one. While false, `raw` solves the system of the last solve at the vertices
-    /// marked in `CurveFieldSolver::current`.
-    needs_full: bool,
-    /// The last solve was incremental: `raw` is stale outside its `needed` vertices.
-    partial: bool,
-}
 
 /// The diffusion system of one mesh with its kept factorisations (module docs).
 ///
@@ -597,99 +580,4 @@ fn project_unit(x: V3, n: V3) -> Option<V3> {
     let t = vec3::sub(x, vec3::scale(n, vec3::dot(x, n)));
     let len = vec3::norm(t);
     (len > 1e-9 && len.is_finite()).then(|| vec3::scale(t, 1.0 / len))
-}
-
-/// The block of `l` on `verts` (increasing global indices). Entries reaching outside the
-/// block are structural zeros of skipped triangles and are dropped.
-fn extract_block(
-    l: &SparseMatrix,
-    verts: &[u32],
-    local: &[u32],
-    component: &[u32],
-    c: u32,
-) -> Result<SparseMatrix, FieldsError> {
-    let (cp, ri, va) = (l.col_ptr(), l.row_idx(), l.values());
-    let mut col_ptr = Vec::with_capacity(verts.len() + 1);
-    let mut row_idx = Vec::new();
-    let mut values = Vec::new();
-    col_ptr.push(0);
-    let mut has_diag = true;
-    for (j, &g) in verts.iter().enumerate() {
-        let g = g as usize;
-        let mut diag = false;
-        for k in cp[g]..cp[g + 1] {
-            if component[ri[k]] != c {
-                continue;
-            }
-            let r = local[ri[k]];
-            diag |= r as usize == j;
-            row_idx.push(r as usize);
-            values.push(va[k]);
-        }
-        has_diag &= diag;
-        col_ptr.push(row_idx.len());
-    }
-    if !has_diag {
-        return Err(FieldsError::InvalidMesh(MeshError::Precondition {
-            operation: "curve-constrained field",
-            requirement: "a cotan Laplacian with a stored diagonal",
-            found: "a column without diagonal entry".into(),
-        }));
-    }
-    Ok(SparseMatrix::from_csc(verts.len(), verts.len(), col_ptr, row_idx, values)?)
-}
-
-/// `L_c + α diag(constrained)` of one block.
-fn penalised_matrix(block: &Block, targets: &[Option<(V3, V3)>], alpha: f64) -> SparseMatrix {
-    let d: Vec<f64> = block
-        .vertices
-        .iter()
-        .map(|&v| if targets[v as usize].is_some() { alpha } else { 0.0 })
-        .collect();
-    block.laplacian.add_diagonal(&d)
-}
-
-/// The three right-hand sides `α b` of one block.
-fn block_rhs(verts: &[u32], targets: &[Option<(V3, V3)>], alpha: f64) -> Vec<Vec<f64>> {
-    (0..3)
-        .map(|k| {
-            verts.iter().map(|&v| targets[v as usize].map_or(0.0, |(t, _)| alpha * t[k])).collect()
-        })
-        .collect()
-}
-
-/// First factorisation of a block (symbolic analysis kept for later comparisons).
-fn factor_block(
-    block: &mut Block,
-    targets: &[Option<(V3, V3)>],
-    alpha: f64,
-    ordering: FillOrdering,
-    mesh: &TriMesh,
-) -> Result<(), FieldsError> {
-    let a = penalised_matrix(block, targets, alpha);
-    // The pattern of `L + P` is that of `L` (diagonal present), so a kept analysis serves
-    // every later refactorisation.
-    let symbolic = match block.symbolic.take() {
-        Some(s) => s,
-        None => match ordering {
-            FillOrdering::Amd => SymbolicCholesky::analyze(&a)?,
-            FillOrdering::NestedDissection => {
-                let positions: Vec<V3> =
-                    block.vertices.iter().map(|&v| mesh.positions[v as usize]).collect();
-                let l = &block.laplacian;
-                let perm = crate::nested_dissection::nested_dissection_order(
-                    &positions,
-                    l.col_ptr(),
-                    l.row_idx(),
-                );
-                SymbolicCholesky::analyze_with_ordering(&a, FactorLayout::Auto, &perm)?
-            }
-        },
-    };
-    let mut factor = Cholesky::factor_with(&symbolic, &a)?;
-    // later constraints are rank-1 updates: prepare the factor for them now
-    factor.prepare_updates()?;
-    block.symbolic = Some(symbolic);
-    block.factor = Some(factor);
-    Ok(())
 }

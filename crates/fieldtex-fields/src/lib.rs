@@ -85,6 +85,7 @@ pub use sketch::Sketch;
 
 // Paper A §4: curve-constrained harmonic diffusion, greedy curve orientation, metrics.
 mod curve_constraint_sampling;
+mod curve_field_blocks;
 mod curve_field_types;
 pub mod greedy_curve_orientation;
 pub mod harmonic_diffusion;

@@ -7,15 +7,8 @@ use fieldtex_fields::harmonic_diffusion::{CurveFieldOptions, CurveFieldSolver};
 use fieldtex_fields::{CurveOrientationOptions, FieldsError, orient_curves};
 use fieldtex_mesh::primitives::icosphere;
 
-/// Arc on the unit sphere at longitude `lon` from latitude `lat0` to `lat1` (radians).
-fn meridian(lon: f64, lat0: f64, lat1: f64, n: usize) -> Vec<V3> {
-    (0..=n)
-        .map(|i| {
-            let lat = lat0 + (lat1 - lat0) * i as f64 / n as f64;
-            [lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin()]
-        })
-        .collect()
-}
+mod common;
+use common::meridian;
 
 fn curves() -> Vec<Vec<V3>> {
     (0..7)

@@ -12,19 +12,8 @@ use fieldtex_fields::{
 use fieldtex_mesh::primitives::{grid, icosphere, torus};
 use fieldtex_mesh::{Topology, TriMesh};
 
-fn line(a: V3, b: V3, n: usize) -> Vec<V3> {
-    (0..=n).map(|i| vec3::lerp(a, b, i as f64 / n as f64)).collect()
-}
-
-/// Arc on the unit sphere at longitude `lon` from latitude `lat0` to `lat1` (radians).
-fn meridian(lon: f64, lat0: f64, lat1: f64, n: usize) -> Vec<V3> {
-    (0..=n)
-        .map(|i| {
-            let lat = lat0 + (lat1 - lat0) * i as f64 / n as f64;
-            [lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin()]
-        })
-        .collect()
-}
+mod common;
+use common::{line, meridian};
 
 #[test]
 fn score_of_a_straight_curve_against_a_constant_field() {

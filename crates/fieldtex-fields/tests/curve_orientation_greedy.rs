@@ -8,18 +8,8 @@ use fieldtex_fields::{
 use fieldtex_mesh::TriMesh;
 use fieldtex_mesh::primitives::{grid, icosphere};
 
-fn line(a: V3, b: V3, n: usize) -> Vec<V3> {
-    (0..=n).map(|i| vec3::lerp(a, b, i as f64 / n as f64)).collect()
-}
-
-fn meridian(lon: f64, lat0: f64, lat1: f64, n: usize) -> Vec<V3> {
-    (0..=n)
-        .map(|i| {
-            let lat = lat0 + (lat1 - lat0) * i as f64 / n as f64;
-            [lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin()]
-        })
-        .collect()
-}
+mod common;
+use common::{line, meridian};
 
 /// Signs, singular (or undetermined) faces and transported Dirichlet energy.
 fn measure(mesh: &TriMesh, curves: &[Vec<V3>], mode: OrientationMode) -> (Vec<i8>, usize, f64) {

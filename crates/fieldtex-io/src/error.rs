@@ -130,3 +130,11 @@ impl IoError {
         IoError::InvalidData { file: file.display().to_string(), message: message.into() }
     }
 }
+
+/// Every reader and writer error is bad input: each names a file the user can fix,
+/// replace or move (the OS refusing a path included).
+impl fieldtex_core::HasErrorKind for IoError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        fieldtex_core::ErrorKind::BadInput
+    }
+}

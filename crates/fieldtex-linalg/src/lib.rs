@@ -84,3 +84,11 @@ pub enum LinalgError {
     #[error("invalid argument {what} = {value:e}: {reason}")]
     InvalidArgument { what: &'static str, value: f64, reason: &'static str },
 }
+
+/// Every solver failure is internal: the workspace builds its matrices itself, so a
+/// failed factorisation or a bad argument is our bug or a numerical breakdown.
+impl fieldtex_core::HasErrorKind for LinalgError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        fieldtex_core::ErrorKind::Internal
+    }
+}

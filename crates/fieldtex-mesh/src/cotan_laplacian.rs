@@ -298,9 +298,9 @@ pub fn hodge_star1(
     (star1, clamped)
 }
 
-/// Corners grouped by vertex (counting sort): `items[offsets[v]..offsets[v + 1]]` are
-/// the corners `3 f + i` with `triangles[f][i] == v`, in triangle order.
-pub(crate) fn vertex_corners(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
+/// The counting step of the two groupings below: `offsets[v]..offsets[v + 1]` is the
+/// range of vertex `v`'s corners (`n + 1` prefix sums of the corner counts).
+fn corner_offsets(n: usize, triangles: &[[u32; 3]]) -> Vec<u32> {
     let mut offsets = vec![0u32; n + 1];
     for t in triangles {
         for &v in t {
@@ -310,6 +310,13 @@ pub(crate) fn vertex_corners(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec
     for v in 0..n {
         offsets[v + 1] += offsets[v];
     }
+    offsets
+}
+
+/// Corners grouped by vertex (counting sort): `items[offsets[v]..offsets[v + 1]]` are
+/// the corners `3 f + i` with `triangles[f][i] == v`, in triangle order.
+pub(crate) fn vertex_corners(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
+    let offsets = corner_offsets(n, triangles);
     let mut next = offsets.clone();
     let mut items = vec![0u32; 3 * triangles.len()];
     for (f, t) in triangles.iter().enumerate() {
@@ -326,15 +333,7 @@ pub(crate) fn vertex_corners(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec
 /// `items[offsets[v]..offsets[v + 1]]` are `[next, prev, 3 f + i]` for every corner `i`
 /// of triangle `f` at `v`, in triangle order (`u32::MAX` for a neighbour equal to `v`).
 fn vertex_corner_neighbours(n: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec<[u32; 3]>) {
-    let mut offsets = vec![0u32; n + 1];
-    for t in triangles {
-        for &v in t {
-            offsets[v as usize + 1] += 1;
-        }
-    }
-    for v in 0..n {
-        offsets[v + 1] += offsets[v];
-    }
+    let offsets = corner_offsets(n, triangles);
     let mut next = offsets.clone();
     let mut items = vec![[0u32; 3]; 3 * triangles.len()];
     for (f, t) in triangles.iter().enumerate() {

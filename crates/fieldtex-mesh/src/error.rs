@@ -24,3 +24,20 @@ pub enum MeshError {
     #[error(transparent)]
     Linalg(#[from] fieldtex_linalg::LinalgError),
 }
+
+/// A mesh that breaks an invariant or a precondition is bad input (repair or re-export
+/// it); a failed solve inside a mesh operator is internal.
+impl fieldtex_core::HasErrorKind for MeshError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        use fieldtex_core::ErrorKind;
+        match self {
+            MeshError::Linalg(_) => ErrorKind::Internal,
+            MeshError::Empty
+            | MeshError::NonFinitePosition { .. }
+            | MeshError::IndexOutOfRange { .. }
+            | MeshError::UvIndexOutOfRange { .. }
+            | MeshError::AttributeLength { .. }
+            | MeshError::Precondition { .. } => ErrorKind::BadInput,
+        }
+    }
+}

@@ -154,16 +154,10 @@ fn flipped_face_in_sphere() {
 
 #[test]
 fn bowtie_and_zero_area() {
-    let p = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [-1.0, -1.0, 0.0],
-        [2.0, 0.0, 0.0],
-    ];
     // Bowtie at vertex 0, plus a collinear triangle 0-1-5.
-    let m = TriMesh::new(p, vec![[0, 1, 2], [0, 3, 4], [0, 5, 1]]);
+    let mut m = crate::test_meshes::bowtie();
+    m.positions.push([2.0, 0.0, 0.0]);
+    m.triangles.push([0, 5, 1]);
     let r = inspect(&m, &InspectOptions::default());
     assert_eq!(r.non_manifold_vertices.count, 1);
     assert_eq!(r.non_manifold_vertices.examples[0].fans, 2);

@@ -186,14 +186,7 @@ fn nan_vertex_and_bad_indices() {
 
 #[test]
 fn bowtie_splits_and_empty_results_warn() {
-    let p = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [-1.0, -1.0, 0.0],
-    ];
-    let r = fix(&TriMesh::new(p, vec![[0, 1, 2], [0, 3, 4]]));
+    let r = fix(&crate::test_meshes::bowtie());
     assert_eq!(count(&r, "non-manifold-vertices-split"), 1);
     assert_eq!(r.mesh.n_vertices(), 6);
     assert_eq!(r.mesh.triangles[1], [5, 3, 4]);

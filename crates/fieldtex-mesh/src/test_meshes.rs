@@ -74,6 +74,19 @@ pub fn defective_patch() -> TriMesh {
     m
 }
 
+/// Two triangles meeting only at vertex 0 (a bowtie: one non-manifold vertex, two
+/// fans): positions `0..5`, triangles `[0, 1, 2]` and `[0, 3, 4]`.
+pub fn bowtie() -> TriMesh {
+    let p = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [-1.0, -1.0, 0.0],
+    ];
+    TriMesh::new(p, vec![[0, 1, 2], [0, 3, 4]])
+}
+
 /// Two components: an icosphere and a torus beside it.
 pub fn two_components() -> TriMesh {
     let mut m = icosphere(2);

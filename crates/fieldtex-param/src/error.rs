@@ -34,3 +34,22 @@ pub enum ParamError {
     #[error("global conformal parameterisation failed: {reason}")]
     Conformal { reason: String },
 }
+
+/// The mesh's own kind for mesh errors; options and a packing that does not fit (raise
+/// the resolution) are bad input; an attribute, texel map or UV set that does not match
+/// its mesh is a caller's bug, and a failed conformal solve is internal.
+impl fieldtex_core::HasErrorKind for ParamError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        use fieldtex_core::ErrorKind;
+        match self {
+            ParamError::InvalidMesh(e) => e.kind(),
+            ParamError::InvalidOption { .. } | ParamError::PackingFailed { .. } => {
+                ErrorKind::BadInput
+            }
+            ParamError::AttributeLength { .. }
+            | ParamError::TriangleOutOfRange { .. }
+            | ParamError::MissingUvs { .. }
+            | ParamError::Conformal { .. } => ErrorKind::Internal,
+        }
+    }
+}

@@ -10,35 +10,8 @@ use crate::draw2d::{blend, fill_sdf, marker_sdf, segment_distance};
 use crate::scene::MarkerShape;
 use fieldtex_core::Image;
 
-/// A 2-D polyline.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Polyline2 {
-    pub points: Vec<[f64; 2]>,
-    pub closed: bool,
-    /// sRGB colour with alpha.
-    pub color: [f32; 4],
-    /// Width in pixels of the output image.
-    pub width: f64,
-}
-
-impl Polyline2 {
-    /// Open, dark red, 2 px.
-    pub fn new(points: Vec<[f64; 2]>) -> Self {
-        Self { points, closed: false, color: [0.85, 0.1, 0.1, 1.0], width: 2.0 }
-    }
-    pub fn with_color(mut self, color: [f32; 4]) -> Self {
-        self.color = color;
-        self
-    }
-    pub fn with_width(mut self, width: f64) -> Self {
-        self.width = width;
-        self
-    }
-    pub fn closed(mut self, closed: bool) -> Self {
-        self.closed = closed;
-        self
-    }
-}
+/// A 2-D polyline on an image (width in pixels of the output image).
+pub type Polyline2 = crate::scene::Polyline<2>;
 
 /// A 2-D marker.
 #[derive(Debug, Clone, PartialEq)]

@@ -30,6 +30,6 @@ pub use image_overlay::{
 };
 pub use render::{render, scene_camera};
 pub use scene::{
-    FieldGlyphs, GlyphStyle, Light, MarkerShape, Markers, Overlay, Polyline3, RenderOptions, Scene,
-    Shading, UpAxis,
+    FieldGlyphs, GlyphStyle, Light, MarkerShape, Markers, Overlay, Polyline, Polyline3,
+    RenderOptions, Scene, Shading, UpAxis,
 };

@@ -53,11 +53,13 @@ pub enum MarkerShape {
     Plus,
 }
 
-/// A polyline in 3-D drawn over the mesh (crest lines, user curves, streamlines).
+/// A polyline in `D` dimensions: [`Polyline3`] is drawn over the mesh (crest lines, user
+/// curves, streamlines), [`crate::Polyline2`] on an image.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Polyline3 {
-    /// Vertices in world coordinates; non-finite ones break the line.
-    pub points: Vec<[f64; 3]>,
+pub struct Polyline<const D: usize> {
+    /// Vertices (world coordinates in 3-D, pixel coordinates in 2-D); in 3-D non-finite
+    /// ones break the line.
+    pub points: Vec<[f64; D]>,
     /// Join the last point back to the first.
     pub closed: bool,
     /// sRGB colour, alpha used for blending.
@@ -66,9 +68,12 @@ pub struct Polyline3 {
     pub width: f64,
 }
 
-impl Polyline3 {
+/// A polyline in 3-D drawn over the mesh.
+pub type Polyline3 = Polyline<3>;
+
+impl<const D: usize> Polyline<D> {
     /// An open polyline, dark red, 2 px wide.
-    pub fn new(points: Vec<[f64; 3]>) -> Self {
+    pub fn new(points: Vec<[f64; D]>) -> Self {
         Self { points, closed: false, color: [0.85, 0.1, 0.1, 1.0], width: 2.0 }
     }
     pub fn with_color(mut self, color: [f32; 4]) -> Self {

@@ -8,31 +8,20 @@
 //! browser's drawing of the streamlines (the page prints that separately).
 
 use fieldtex_studio::{Studio, StudioOptions};
-use std::io::{Read, Write};
-use std::net::{SocketAddr, TcpStream};
+use std::net::SocketAddr;
 use std::time::Instant;
 
+/// The server tests' HTTP helpers (one request per connection, as the page does).
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 fn request(addr: SocketAddr, method: &str, path: &str, body: &[u8]) -> (u16, Vec<u8>) {
-    let mut s = TcpStream::connect(addr).expect("connect");
-    s.set_nodelay(true).ok();
-    let mut r = format!(
-        "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
-        addr.port(),
-        body.len()
-    )
-    .into_bytes();
-    r.extend_from_slice(body);
-    s.write_all(&r).expect("write");
-    let mut out = Vec::new();
-    s.read_to_end(&mut out).expect("read");
-    let end = out.windows(4).position(|w| w == b"\r\n\r\n").expect("head");
-    let status = String::from_utf8_lossy(&out[..end]).split(' ').nth(1).unwrap().parse().unwrap();
-    (status, out[end + 4..].to_vec())
+    let r = common::request(addr, method, path, body);
+    (r.status, r.body)
 }
 
 fn state_json(body: &[u8]) -> serde_json::Value {
-    let n = u32::from_le_bytes(body[..4].try_into().unwrap()) as usize;
-    serde_json::from_slice(&body[4..4 + n]).unwrap()
+    common::Reply { status: 200, head: String::new(), body: body.to_vec() }.state().0
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

@@ -6,7 +6,7 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 
 mod common;
-use common::{raw, request, temp_dir};
+use common::{raw, request, temp_dir, write_stripes};
 
 fn start(tag: &str) -> (SocketAddr, PathBuf) {
     common::start(tag, 64 * 1024)
@@ -15,19 +15,6 @@ fn start(tag: &str) -> (SocketAddr, PathBuf) {
 fn new_session(addr: SocketAddr, body: &str) -> (String, serde_json::Value, Vec<f32>) {
     let (json, field) = request(addr, "POST", "/api/session", body.as_bytes()).state();
     (json["session"].as_str().unwrap().to_string(), json, field)
-}
-
-/// A small striped exemplar written into the workspace.
-fn write_exemplar(ws: &std::path::Path, name: &str) {
-    let n = 32;
-    let mut img = fieldtex_core::Image::new(n, n, [0.0, 0.0, 0.0, 1.0]);
-    for y in 0..n {
-        for x in 0..n {
-            let v = if (x / 4) % 2 == 0 { 0.9 } else { 0.1 };
-            img.pixels[y * n + x] = [v, v * 0.8, 0.3, 1.0];
-        }
-    }
-    fieldtex_io::write_png(&ws.join(name), &img).unwrap();
 }
 
 #[test]
@@ -210,7 +197,7 @@ fn uploads_are_checked_and_limited() {
         let r = request(addr, "POST", &format!("/api/upload?name={name}"), b"abc");
         assert_eq!(r.status, 400, "{name}");
     }
-    write_exemplar(&ws, "ex.png");
+    write_stripes(&ws, "ex.png");
     let png = std::fs::read(ws.join("ex.png")).unwrap();
     let r = request(addr, "POST", "/api/upload?name=stripes.png", &png);
     assert_eq!(r.status, 200, "{}", r.error());
@@ -225,7 +212,7 @@ fn uploads_are_checked_and_limited() {
 #[test]
 fn texture_and_export() {
     let (addr, ws) = start("texture");
-    write_exemplar(&ws, "ex.png");
+    write_stripes(&ws, "ex.png");
     let (id, json, _) =
         new_session(addr, r#"{"preset":"left-loop","grid": 32, "view": 32, "size": 64}"#);
     assert_eq!(json["singularities"].as_array().unwrap().len(), 2);

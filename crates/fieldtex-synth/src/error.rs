@@ -59,6 +59,12 @@ impl SynthError {
     }
 }
 
+impl fieldtex_core::HasErrorKind for SynthError {
+    fn kind(&self) -> ErrorKind {
+        SynthError::kind(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

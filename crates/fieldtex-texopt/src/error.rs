@@ -46,3 +46,27 @@ pub enum TexOptError {
     #[error("PCA of the exemplar patches of the {patch}×{patch} level failed: {source}")]
     Pca { patch: usize, source: LinalgError },
 }
+
+/// The exemplar, the options, an empty mesh or carrier set and a zero direction field are
+/// bad input; carriers, triangles and per-carrier arrays that do not match (built by the
+/// caller's code) and a failed patch PCA are internal.
+impl fieldtex_core::HasErrorKind for TexOptError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        use fieldtex_core::ErrorKind;
+        match self {
+            TexOptError::NoCarriers
+            | TexOptError::EmptyMesh
+            | TexOptError::DegenerateField { .. }
+            | TexOptError::ExemplarTooSmall { .. }
+            | TexOptError::ExemplarBufferSize { .. }
+            | TexOptError::NonFiniteExemplar { .. }
+            | TexOptError::InvalidOption { .. } => ErrorKind::BadInput,
+            TexOptError::CarrierTriangle { .. }
+            | TexOptError::CarrierBarycentric { .. }
+            | TexOptError::TriangleVertex { .. }
+            | TexOptError::Length { .. }
+            | TexOptError::NonFinite { .. }
+            | TexOptError::Pca { .. } => ErrorKind::Internal,
+        }
+    }
+}

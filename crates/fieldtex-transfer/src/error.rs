@@ -40,3 +40,14 @@ impl TransferError {
         !matches!(self, TransferError::Numeric { .. })
     }
 }
+
+/// [`TransferError::is_bad_input`] as an [`fieldtex_core::ErrorKind`].
+impl fieldtex_core::HasErrorKind for TransferError {
+    fn kind(&self) -> fieldtex_core::ErrorKind {
+        if self.is_bad_input() {
+            fieldtex_core::ErrorKind::BadInput
+        } else {
+            fieldtex_core::ErrorKind::Internal
+        }
+    }
+}

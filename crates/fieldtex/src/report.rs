@@ -4,10 +4,9 @@
 //! Everything in a report is deterministic except the `timings_ms` section, so two
 //! runs with the same inputs and seed differ only there.
 
-use fieldtex_core::Warning;
+use fieldtex_core::{NoProgress, Progress, StageGuard, StageTimings, Warning};
 use serde::Serialize;
 use serde_json::Value;
-use std::time::Instant;
 
 /// The JSON report every command writes.
 #[derive(Debug, Clone, Serialize)]
@@ -54,12 +53,28 @@ impl Report {
         }
     }
 
-    /// Runs `f`, recording its wall time under `stage`.
-    pub fn time<T>(&mut self, stage: &str, f: impl FnOnce() -> T) -> T {
-        let t0 = Instant::now();
-        let out = f();
-        self.timings_ms.push((stage.to_string(), t0.elapsed().as_secs_f64() * 1e3));
+    /// Runs `f` as the progress stage `name` through a [`StageGuard`]: reported to
+    /// `progress` when it begins, finished when `f` returns (an early `?` inside `f`
+    /// included), its wall time recorded under `name` in `timings_ms`.
+    pub fn stage<T>(&mut self, progress: &dyn Progress, name: &str, f: impl FnOnce() -> T) -> T {
+        let timings = StageTimings::default();
+        let out = {
+            let _stage = StageGuard::begin(progress, name, 0).timed(&timings);
+            f()
+        };
+        self.record(&timings);
         out
+    }
+
+    /// [`Report::stage`] for a step that has no progress to report to (timed only).
+    pub fn time<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
+        self.stage(&NoProgress, name, f)
+    }
+
+    /// Appends the finished stages of `timings` (children before their parent) to
+    /// `timings_ms`, under their full names.
+    pub fn record(&mut self, timings: &StageTimings) {
+        self.timings_ms.extend(timings.entries().into_iter().map(|t| (t.name, t.ms)));
     }
 
     pub fn to_json_pretty(&self) -> String {

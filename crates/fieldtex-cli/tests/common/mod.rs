@@ -104,4 +104,16 @@ pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
+/// A 4×4 exemplar written by the tool itself (`render` of the shared torus at 4 px) as
+/// `dir/tiny.png`: below every engine's minimum size.
+pub fn tiny_exemplar(dir: &Path) -> PathBuf {
+    let tiny = dir.join("tiny.png");
+    let torus = shared().join("meshes/torus.obj");
+    let (torus, out) = (torus.to_str().unwrap(), tiny.to_str().unwrap());
+    let args = ["render", torus, "--out", out, "--size", "4", "--quiet"];
+    let o = run_limited(&args, Duration::from_secs(60));
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    tiny
+}
+
 pub mod transfer;

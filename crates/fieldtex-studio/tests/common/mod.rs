@@ -70,6 +70,7 @@ impl Reply {
 /// Sends `request` as given and reads the whole reply.
 pub fn raw(addr: SocketAddr, request: &[u8]) -> Reply {
     let mut s = TcpStream::connect(addr).unwrap();
+    s.set_nodelay(true).ok();
     let _ = s.write_all(request);
     let mut out = Vec::new();
     let _ = s.read_to_end(&mut out);
@@ -96,6 +97,11 @@ pub fn request(addr: SocketAddr, method: &str, path: &str, body: &[u8]) -> Reply
 pub fn write_inputs(ws: &Path) {
     let mesh = fieldtex_mesh::primitives::torus(1.0, 0.4, 24, 12);
     fieldtex_io::write_obj(&ws.join("torus.obj"), &mesh, None).unwrap();
+    write_stripes(ws, "stripes.png");
+}
+
+/// A 32² striped exemplar (stripes 4 pixels wide) written into the workspace as `name`.
+pub fn write_stripes(ws: &Path, name: &str) {
     let n = 32;
     let mut img = fieldtex_core::Image::new(n, n, [0.0, 0.0, 0.0, 1.0]);
     for y in 0..n {
@@ -104,5 +110,5 @@ pub fn write_inputs(ws: &Path) {
             img.pixels[y * n + x] = [v, v * 0.8, 0.3, 1.0];
         }
     }
-    fieldtex_io::write_png(&ws.join("stripes.png"), &img).unwrap();
+    fieldtex_io::write_png(&ws.join(name), &img).unwrap();
 }

@@ -22,6 +22,8 @@
 //! largest structure (`fieldtex_synth::characteristic_scale`,
 //! `fieldtex_texopt::pyramid_patch_sizes`), and ends with the crisp pass and the
 //! histogram step (`TexOptOptions::histogram_match`).
+//!
+//! Files: the metrics of a run in `align_metrics.rs`; the stages and the pipeline here.
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::atlas::atlas_options;
@@ -34,6 +36,10 @@ use fieldtex_render::{Overlay, Polyline3, RenderOptions, Scene, render};
 use fieldtex_texopt::{Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+
+#[path = "align_metrics.rs"]
+mod metrics;
+use metrics::{MetricInputs, align_metrics};
 
 /// Options of [`align`].
 #[derive(Debug, Clone, Serialize)]
@@ -101,7 +107,7 @@ pub(crate) fn salient_curves(
                 &fieldtex_features::CrestOptions::default(),
                 &fieldtex_core::NoProgress,
             )
-            .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
+            .map_err(|e| Error::classify(&e, Some(mesh_path), ""))?;
             warnings.extend(crest.warnings.iter().cloned());
             (
                 crest.lines.into_iter().map(|l| l.points).collect(),
@@ -132,14 +138,14 @@ pub(crate) fn carrier_atlas(
     progress: &dyn Progress,
 ) -> Result<CarrierAtlas> {
     let atlas = report
-        .time("atlas", || fieldtex_param::build_atlas(mesh, aopts, progress))
-        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+        .stage(progress, "atlas", || fieldtex_param::build_atlas(mesh, aopts, progress))
+        .map_err(|e| Error::classify(&e, None, "atlas"))?;
     report.warnings.extend(atlas.warnings.iter().cloned());
     let map = report
-        .time("texel_map", || {
+        .stage(progress, "texel_map", || {
             fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
         })
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+        .map_err(|e| Error::internal("texel map", e))?;
     let (covered, carriers) = atlas_carriers(&map);
     Ok(CarrierAtlas { atlas, map, covered, carriers })
 }
@@ -238,130 +244,14 @@ fn exemplar_feature_lines(
                 &lines,
                 toroidal,
             )
-            .map_err(|e| Error::bad_input(Some(p), e.to_string()))
+            .map_err(|e| Error::classify(&e, Some(p), ""))
         }
         None => fieldtex_features::detect_exemplar_feature_lines(
             exemplar,
             &ExemplarFeatureOptions { toroidal, ..Default::default() },
         )
-        .map_err(|e| Error::bad_input(Some(&options.exemplar), e.to_string())),
+        .map_err(|e| Error::classify(&e, Some(&options.exemplar), "")),
     }
-}
-
-/// What [`align_metrics`] measures on.
-struct MetricInputs<'a> {
-    atlas_mesh: &'a TriMesh,
-    map: &'a fieldtex_param::TexelMap,
-    covered: &'a [usize],
-    carrier_of_texel: &'a [u32],
-    curve_points: &'a [((u32, [f64; 3]), f64)],
-    exemplar: &'a Image,
-    exemplar_features: &'a ExemplarFeatures,
-    texture: &'a Image,
-    field: &'a [[f64; 3]],
-    texels_per_pixel: f64,
-    seed: u64,
-}
-
-/// The metrics of an align run: texture optimisation levels, feature-line coverage,
-/// orientation error on the surface and contrast, into `report`.
-fn align_metrics(
-    m: &MetricInputs<'_>,
-    result: &fieldtex_texopt::TexOptResult,
-    feature_align: bool,
-    n_carriers: usize,
-    report: &mut Report,
-) -> Result<()> {
-    let size = m.map.width;
-    let coverage_samples: Vec<fieldtex_eval::CurveSample> = m
-        .curve_points
-        .iter()
-        .filter_map(|&((f, b), w)| {
-            let texel = m.map.texel_at(m.atlas_mesh, f, b)?;
-            let src = m.map.source[texel];
-            let k = *m.carrier_of_texel.get(src as usize)?;
-            // texopt puts pixel centres at i + 0.5, the distance map at i.
-            (k != u32::MAX).then(|| {
-                let c = result.source[k as usize];
-                fieldtex_eval::CurveSample {
-                    exemplar_xy: [c[0] as f64 - 0.5, c[1] as f64 - 0.5],
-                    length: w,
-                }
-            })
-        })
-        .collect();
-    // Per-level wall times belong to the (nondeterministic) timings section.
-    let mut levels = serde_json::to_value(&result.levels).unwrap_or_default();
-    for (l, stats) in levels.as_array_mut().into_iter().flatten().zip(&result.levels) {
-        if let Some(o) = l.as_object_mut() {
-            o.remove("seconds");
-        }
-        report.timings_ms.push((format!("synthesis_w{}", stats.patch_size), stats.seconds * 1e3));
-    }
-    report.metric(
-        "texopt",
-        serde_json::json!({
-            "pixel_size": result.pixel_size,
-            "carriers": n_carriers,
-            "histogram_distance": result.histogram_distance,
-            "levels": levels,
-            "feature_align": feature_align,
-            "exemplar_feature_lines": m.exemplar_features.lines.len(),
-        }),
-    );
-    let coverage = fieldtex_eval::feature_line_coverage(
-        &coverage_samples,
-        &m.exemplar_features.distance,
-        m.exemplar_features.width,
-        m.exemplar_features.height,
-        &fieldtex_eval::FeatureCoverageOptions {
-            tolerance_px: 1.0,
-            toroidal: m.exemplar_features.toroidal,
-        },
-    )
-    .map_err(|e| Error::Internal(format!("feature coverage: {e}")))?;
-    report.metric("feature_coverage", &coverage);
-    // Orientation error on the surface, by tangent-plane resampling of the baked texture.
-    let internal = |e: fieldtex_eval::EvalError| Error::Internal(format!("metrics: {e}"));
-    let (exemplar, texture) = (m.exemplar, m.texture);
-    let orientation = report.time("metrics", || -> Result<_> {
-        let ebuf = fieldtex_eval::rgb_buffer(exemplar);
-        let eview = fieldtex_eval::ImageView::new(&ebuf, exemplar.width, exemplar.height, 3)
-            .map_err(internal)?;
-        let (exemplar_angle_deg, exemplar_coherence) =
-            fieldtex_eval::dominant_orientation(&eview).map_err(internal)?;
-        let tbuf = fieldtex_eval::rgb_buffer(texture);
-        let tview = fieldtex_eval::ImageView::new(&tbuf, size, size, 3).map_err(internal)?;
-        let uvs =
-            m.atlas_mesh.uvs.as_ref().ok_or_else(|| Error::Internal("atlas without UVs".into()))?;
-        let opts = fieldtex_eval::SurfaceOrientationOptions {
-            exemplar_angle_deg,
-            seed: m.seed,
-            ..Default::default()
-        };
-        let r = fieldtex_eval::surface_orientation_error(m.atlas_mesh, uvs, &tview, m.field, &opts)
-            .map_err(internal)?;
-        Ok(serde_json::json!({
-            "exemplar_angle_deg": exemplar_angle_deg,
-            "exemplar_coherence": exemplar_coherence,
-            "surface": r,
-        }))
-    })?;
-    report.metric("orientation_error", orientation);
-    // Contrast and crispness of the covered texels against the exemplar.
-    let sharpness = report.time("metrics_contrast", || -> Result<_> {
-        let tbuf = fieldtex_eval::rgb_buffer(texture);
-        let tview = fieldtex_eval::ImageView::new(&tbuf, size, size, 3).map_err(internal)?;
-        let ebuf = fieldtex_eval::rgb_buffer(exemplar);
-        let eview = fieldtex_eval::ImageView::new(&ebuf, exemplar.width, exemplar.height, 3)
-            .map_err(internal)?;
-        let mut mask = vec![false; size * size];
-        m.covered.iter().for_each(|&i| mask[i] = true);
-        fieldtex_eval::contrast_sharpness(&tview, Some(&mask), &eview, m.texels_per_pixel)
-            .map_err(internal)
-    })?;
-    report.metric("contrast", sharpness);
-    Ok(())
 }
 
 /// `--keep`: the salient curves as OBJ polylines and the field as a PLY with vertex
@@ -450,8 +340,10 @@ fn oriented_field(
         copts.field.fallback = fieldtex_fields::UnconstrainedFallback::Direction(d);
     }
     let oriented = report
-        .time("field", || orient_curves_with_geometry(geometry, curves, &copts, progress))
-        .map_err(|e| Error::Internal(format!("field: {e}")))?;
+        .stage(progress, "field", || {
+            orient_curves_with_geometry(geometry, curves, &copts, progress)
+        })
+        .map_err(|e| Error::classify(&e, None, "field"))?;
     report.warnings.extend(oriented.warnings.iter().cloned());
     report.warnings.extend(oriented.field.warnings.iter().cloned());
     let field_metrics = fieldtex_fields::surface_field_metrics_with(
@@ -459,7 +351,7 @@ fn oriented_field(
         &oriented.field.vectors,
         &oriented.solver.constraints(),
     )
-    .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
+    .map_err(|e| Error::internal("field metrics", e))?;
     report.metric(
         "field",
         serde_json::json!({
@@ -482,8 +374,8 @@ fn texopt_error(e: TexOptError, exemplar: &Path) -> Error {
     match e {
         TexOptError::ExemplarTooSmall { .. }
         | TexOptError::ExemplarBufferSize { .. }
-        | TexOptError::NonFiniteExemplar { .. } => Error::bad_input(Some(exemplar), e.to_string()),
-        e => Error::Internal(format!("texture optimisation: {e}")),
+        | TexOptError::NonFiniteExemplar { .. } => Error::classify(&e, Some(exemplar), ""),
+        e => Error::classify(&e, None, "texture optimisation"),
     }
 }
 
@@ -556,7 +448,7 @@ pub(crate) fn align_impl(
     // One geometry object for crest lines, the field solver and its metrics.
     let geometry = MeshGeometry::new(&mesh);
     let mut warnings = Vec::new();
-    let (curves, curves_source) = report.time("curves", || {
+    let (curves, curves_source) = report.stage(progress, "curves", || {
         salient_curves(&geometry, &options.mesh, options.curves.as_deref(), &mut warnings)
     })?;
     if curves.is_empty() {
@@ -576,13 +468,13 @@ pub(crate) fn align_impl(
     let CarrierAtlas { atlas, map, covered, carriers } =
         carrier_atlas(&mesh, &aopts, size, &mut report, progress)?;
     let (domain, dwarn) = report
-        .time("domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
-        .map_err(|e| Error::Internal(format!("surface domain: {e}")))?;
+        .stage(progress, "domain", || SurfaceDomain::new(&atlas.mesh, &field, &carriers))
+        .map_err(|e| Error::internal("surface domain", e))?;
     report.warnings.extend(dwarn);
     // Coarse to fine over the exemplar's pyramid: the coarsest patch spans its largest
     // structure (autocorrelation estimate).
-    let structure =
-        report.time("exemplar_scale", || fieldtex_synth::characteristic_scale(&exemplar));
+    let structure = report
+        .stage(progress, "exemplar_scale", || fieldtex_synth::characteristic_scale(&exemplar));
     let patch_sizes =
         fieldtex_texopt::pyramid_patch_sizes(structure.pixels, exemplar.width.min(exemplar.height));
     report.metric("exemplar_scale", &structure);
@@ -597,19 +489,19 @@ pub(crate) fn align_impl(
         ..Default::default()
     };
     // 4. Feature alignment inputs (§5.2).
-    let bvh =
-        fieldtex_mesh::Bvh::build(&atlas.mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+    let bvh = fieldtex_mesh::Bvh::build(&atlas.mesh).map_err(|e| Error::internal("bvh", e))?;
     let h = topts.pixel_size.unwrap_or(1.0);
     let curve_points = fieldtex_features::curve_surface_points(&bvh, &curves, h);
-    let exemplar_features = report
-        .time("exemplar_features", || exemplar_feature_lines(options, &exemplar, topts.toroidal))?;
+    let exemplar_features = report.stage(progress, "exemplar_features", || {
+        exemplar_feature_lines(options, &exemplar, topts.toroidal)
+    })?;
     report.warnings.extend(exemplar_features.warnings.iter().cloned());
     let features = if options.feature_align && !curve_points.is_empty() {
         // Paper A constrains samples within half a patch of a curve; coarse levels
         // (w > 32) span whole structures, so the band is half a 32-px patch plus 2 px.
         let w = topts.patch_sizes.iter().copied().max().unwrap_or(8).min(32) as f64;
         let band = (0.5 * w + 2.0) * h;
-        let carrier_curve_distance = report.time("curve_distance", || {
+        let carrier_curve_distance = report.stage(progress, "curve_distance", || {
             fieldtex_features::distance_to_curves(domain.positions(), &curves, 0.25 * h, band)
         });
         Some(FeatureAlignment {
@@ -621,7 +513,7 @@ pub(crate) fn align_impl(
     };
     // 5. Texture optimisation (§5.1).
     let result = report
-        .time("synthesis", || {
+        .stage(progress, "synthesis", || {
             fieldtex_texopt::optimise(&domain, &exemplar, &topts, features.as_ref(), progress)
         })
         .map_err(|e| texopt_error(e, &options.exemplar))?;
@@ -644,8 +536,8 @@ pub(crate) fn align_impl(
     };
     align_metrics(&inputs, &result, features.is_some(), carriers.len(), &mut report)?;
     // 7. Outputs.
-    report.time("write", || super::write_model(stage, &atlas.mesh, Some(&texture)))?;
-    let preview = report.time("preview", || {
+    report.stage(progress, "write", || super::write_model(stage, &atlas.mesh, Some(&texture)))?;
+    let preview = report.stage(progress, "preview", || {
         preview_with_curves(&atlas.mesh, &texture, options.draw_curves.then_some(&curves[..]), 800)
     });
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;

@@ -68,10 +68,11 @@ pub(crate) fn repaired_atlas(
     progress: &dyn Progress,
 ) -> Result<Atlas> {
     let repaired = super::repair_stage::repair_into_report(mesh, source, None, report)?;
-    let atlas =
-        report.time("atlas", || build_atlas(&repaired, options, progress)).map_err(|e| {
+    let atlas = report
+        .stage(progress, "atlas", || build_atlas(&repaired, options, progress))
+        .map_err(|e| {
             let what = source.map(|p| format!("{}: ", p.display())).unwrap_or_default();
-            Error::Internal(format!("{what}atlas: {e}"))
+            Error::classify(&e, None, &format!("{what}atlas"))
         })?;
     report.warnings.extend(atlas.warnings.iter().cloned());
     Ok(atlas)
@@ -89,7 +90,7 @@ pub fn atlas_file(
     let aopts = atlas_options(options.size, options.gutter)?;
     let mut report =
         Report::new("atlas", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let loaded = report.time("read", || fieldtex_io::read_mesh(mesh_path))?;
+    let loaded = report.stage(progress, "read", || fieldtex_io::read_mesh(mesh_path))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
     report.input = serde_json::json!({
         "mesh": mesh_path.display().to_string(),
@@ -100,9 +101,10 @@ pub fn atlas_file(
     let stage = out.staging();
     let atlas = repaired_atlas(&loaded.mesh, Some(mesh_path), &aopts, &mut report, progress)?;
     let checker = uv_checker(options.size.min(2048), 32);
-    report.time("write", || super::write_model(stage, &atlas.mesh, Some(&checker)))?;
-    let preview =
-        report.time("preview", || super::render::preview(&atlas.mesh, Some(&checker), 800, None));
+    report.stage(progress, "write", || super::write_model(stage, &atlas.mesh, Some(&checker)))?;
+    let preview = report.stage(progress, "preview", || {
+        super::render::preview(&atlas.mesh, Some(&checker), 800, None)
+    });
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     report.metric("atlas", atlas.stats);
     commit_outputs(out, &mut report)?;

@@ -55,7 +55,7 @@ pub fn crest_file(
     }
     let repaired = super::repair_stage::repair_mesh(&loaded.mesh, Some(mesh_path), None)?;
     let crest = crest_lines(&repaired.mesh, &copts)
-        .map_err(|e| Error::bad_input(Some(mesh_path), e.to_string()))?;
+        .map_err(|e| Error::classify(&e, Some(mesh_path), ""))?;
     let kept: Vec<_> = crest.lines.iter().filter(|l| l.level >= options.min_level).collect();
     let polylines: Vec<Vec<[f64; 3]>> = kept.iter().map(|l| l.points.clone()).collect();
     fieldtex_io::write_obj_polylines(out, &polylines)?;

@@ -85,7 +85,7 @@ pub fn demo(out_dir: &Path, options: &DemoOptions, progress: &dyn Progress) -> R
             format!("--size must be in 64..=2048 texels for the demo, got {}", options.size),
         ));
     }
-    let t0 = std::time::Instant::now();
+    let total = fieldtex_core::StageGuard::begin(progress, "demo", 0);
     let mesh = demo_mesh(options.cells);
     let exemplar = demo_exemplar(options.exemplar_size, options.seed);
     let (w, h) = (exemplar.width, exemplar.height);
@@ -127,7 +127,7 @@ pub fn demo(out_dir: &Path, options: &DemoOptions, progress: &dyn Progress) -> R
                     .to_string(),
             );
         }
-        report.timings_ms.push(("demo_total".to_string(), t0.elapsed().as_secs_f64() * 1e3));
+        report.timings_ms.push(("demo_total".to_string(), total.elapsed_ms()));
         Ok(())
     };
     // The aligned cube: the real align pipeline; model.glb, preview.png, orient.png and

@@ -53,7 +53,7 @@ pub struct SingularitySummary {
 }
 
 pub(crate) fn bad(e: ev::EvalError, what: &Path) -> Error {
-    Error::bad_input(Some(what), e.to_string())
+    Error::classify(&e, Some(what), "")
 }
 
 /// Computes every metric; `field` is `H×W×2` of the output's size when present.
@@ -70,7 +70,11 @@ pub(crate) fn image_metrics(
     exact: bool,
     progress: &dyn Progress,
 ) -> std::result::Result<ImageMetrics, ev::EvalError> {
-    progress.stage(if exact { "metrics (exact)" } else { "metrics" }, 6);
+    let stage = fieldtex_core::StageGuard::begin(
+        progress,
+        if exact { "metrics (exact)" } else { "metrics" },
+        6,
+    );
     let ob = ev::rgb_buffer(output);
     let eb = ev::rgb_buffer(exemplar);
     let o = ev::ImageView::new(&ob, output.width, output.height, 3)?;
@@ -112,7 +116,7 @@ pub(crate) fn image_metrics(
         phase_defects,
         skipped,
     ) = rest?;
-    progress.finish_stage();
+    drop(stage);
     Ok(ImageMetrics {
         coherence,
         guided_coherence,

@@ -95,12 +95,12 @@ pub fn field_file(
     };
     let copts = CurveOrientationOptions { mode, ..Default::default() };
     let result = orient_curves_with_geometry(&geometry, &curves, &copts, progress)
-        .map_err(|e| Error::Internal(format!("field: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "field"))?;
     warnings.extend(result.warnings.iter().cloned());
     warnings.extend(result.field.warnings.iter().cloned());
     let metrics =
         surface_field_metrics_with(&geometry, &result.field.vectors, &result.solver.constraints())
-            .map_err(|e| Error::Internal(format!("field metrics: {e}")))?;
+            .map_err(|e| Error::internal("field metrics", e))?;
     // The metrics' topology gives χ (no second `Topology::build` of the same mesh).
     let chi = metrics.euler_characteristic;
     // field.ply: positions, the solver's normals, the field.

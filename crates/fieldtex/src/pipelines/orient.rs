@@ -128,12 +128,11 @@ fn build_field(
         }
         FieldSource::Design(p) => {
             let text = read_design_text(p)?;
-            DesignFile::from_toml_str(&text)
-                .map_err(|e| Error::bad_input(Some(p), e.to_string()))?
+            DesignFile::from_toml_str(&text).map_err(|e| Error::classify(&e, Some(p), ""))?
         }
         FieldSource::Preset(name) => {
             fieldtex_fields::presets::preset(name, n as f64, n as f64, options.grid)
-                .map_err(|e| Error::bad_input(None, format!("--preset {name}: {e}")))?
+                .map_err(|e| Error::classify(&e, None, &format!("--preset {name}")))?
         }
     };
     let src = match &options.source {
@@ -142,10 +141,10 @@ fn build_field(
     };
     let mut fd = report
         .time("field_factor", || design.build(None))
-        .map_err(|e| Error::bad_input(src, e.to_string()))?;
+        .map_err(|e| Error::classify(&e, src, ""))?;
     let solved = report
         .time("field_solve", || fd.solve())
-        .map_err(|e| Error::Internal(format!("field solve: {e}")))?;
+        .map_err(|e| Error::classify(&e, src, "field solve"))?;
     report.metric("field_residual", solved.residual);
     let grid = fd.plane().copied().ok_or_else(|| {
         Error::bad_input(src, "orient needs a plane design here ([domain] kind = \"plane\")")
@@ -154,7 +153,7 @@ fn build_field(
         .time("field_sample", || {
             fieldtex_fields::orientation_field::sample_plane(&fd, &solved, n, n)
         })
-        .map_err(|e| Error::Internal(format!("field sampling: {e}")))?;
+        .map_err(|e| Error::internal("field sampling", e))?;
     // Design coordinates → pixels.
     let (sx, sy) = (n as f64 / grid.width, n as f64 / grid.height);
     let designed = fd
@@ -206,7 +205,7 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     }
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let fitted = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = report.stage(progress, "read", || fieldtex_io::read_image(&options.exemplar))?;
     let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
     report.warnings.extend(fitted.warning.clone());
     let per_pixel = options.exemplar_pixels_per_output_pixel(fitted.factor);
@@ -305,7 +304,7 @@ fn seam_metric(
     per_pixel: f64,
 ) -> Result<fieldtex_eval::RosySeamReport> {
     let size = [exemplar.width, exemplar.height];
-    let fail = |e: fieldtex_eval::EvalError| Error::Internal(format!("seam metric: {e}"));
+    let fail = |e: fieldtex_eval::EvalError| Error::internal("seam metric", e);
     let fv = fieldtex_eval::FieldView::new(flat, n, n).map_err(fail)?;
     let options = fieldtex_eval::RosySeamOptions::default();
     fieldtex_eval::rosy_seam_coherence_with_flips(
@@ -340,10 +339,10 @@ pub(crate) fn texture_metrics(
         report.metric("exemplar_orientation", own);
     }
     let metrics = report
-        .time("metrics", || {
+        .stage(progress, "metrics", || {
             image_metrics(texture, exemplar, Some(flat), None, angle, seed, exact, progress)
         })
-        .map_err(|e| Error::Internal(format!("metrics: {e}")))?;
+        .map_err(|e| Error::internal("metrics", e))?;
     if let Some(pd) = &metrics.phase_defects {
         let near = fieldtex_eval::count_defects_near(&pd.defects, points, 3.0 * pd.period_px);
         report.metric("phase_defects_near_singularities", near);

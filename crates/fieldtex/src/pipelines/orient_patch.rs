@@ -91,12 +91,12 @@ pub(crate) fn orient_patch(
     let n = options.size;
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let fitted = report.time("read", || fieldtex_io::read_image(&options.exemplar))?;
+    let fitted = report.stage(progress, "read", || fieldtex_io::read_image(&options.exemplar))?;
     let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
     report.warnings.extend(fitted.warning.clone());
     let per_texel = options.exemplar_pixels_per_output_pixel(fitted.factor);
     let exemplar = fitted.image;
-    let loaded = report.time("read_mesh", || fieldtex_io::read_mesh(mesh_path))?;
+    let loaded = report.stage(progress, "read_mesh", || fieldtex_io::read_mesh(mesh_path))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
     let repaired = fieldtex_mesh::repair(&loaded.mesh, &fieldtex_mesh::RepairOptions::default());
     report.warnings.extend(repaired.warnings.iter().cloned());
@@ -104,7 +104,7 @@ pub(crate) fn orient_patch(
     mesh.uvs = None;
     mesh.vertex_colors = None;
     if let Some(cut) = options.patch {
-        mesh = report.time("cut", || cut_ball(&mesh, cut, mesh_path))?;
+        mesh = report.stage(progress, "cut", || cut_ball(&mesh, cut, mesh_path))?;
     }
     check_disk(&mesh, mesh_path, options.patch.is_some())?;
     report.input = serde_json::json!({
@@ -120,7 +120,8 @@ pub(crate) fn orient_patch(
     )?;
     let stage = out.staging();
     let mut param_warnings = Vec::new();
-    let patch = report.time("parameterize", || parameterize(mesh, n, &mut param_warnings))?;
+    let patch =
+        report.stage(progress, "parameterize", || parameterize(mesh, n, &mut param_warnings))?;
     report.warnings.extend(param_warnings);
     if let Some(uvs) = &patch.mesh.uvs
         && let Ok(stats) = fieldtex_param::parameterization_distortion(&patch.mesh, uvs)
@@ -139,11 +140,11 @@ pub(crate) fn orient_patch(
         report.metric("parameterization", stats);
     }
     let map = report
-        .time("texel_map", || fieldtex_param::build_texel_map(&patch.mesh, n, n, 0))
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+        .stage(progress, "texel_map", || fieldtex_param::build_texel_map(&patch.mesh, n, n, 0))
+        .map_err(|e| Error::internal("texel map", e))?;
     let (field, designed) = texel_field(options, &patch, &map, &mut report)?;
     let (jac, field, inside) =
-        report.time("jacobians", || jacobians(&patch, &map, &field, per_texel));
+        report.stage(progress, "jacobians", || jacobians(&patch, &map, &field, per_texel));
     let n_inside = inside.iter().filter(|&&b| b).count();
     if n_inside == 0 {
         return Err(Error::Internal("the patch covers no texel of the texture".into()));
@@ -152,23 +153,22 @@ pub(crate) fn orient_patch(
     report.metric("chart_coverage", n_inside as f64 / (n * n) as f64);
     let aopts = fieldtex_synth::AnalysisOptions::default();
     let (analysis, cached) = report
-        .time("analysis", || {
+        .stage(progress, "analysis", || {
             super::synthesis::AnalysisCache::process().analysis(&exemplar, &aopts, progress)
         })
-        .map_err(|e| Error::bad_input(Some(&options.exemplar), format!("exemplar: {e}")))?;
+        .map_err(|e| Error::classify(&e, Some(&options.exemplar), "exemplar"))?;
     report.metric("analysis_cached", cached);
-    let domain = ImageDomain::new(n, n, jac)
-        .map_err(|e| Error::Internal(format!("synthesis domain: {e}")))?;
+    let domain = ImageDomain::new(n, n, jac).map_err(|e| Error::internal("synthesis domain", e))?;
     let sopts =
         SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };
     let texture = report
-        .time("synthesis", || synthesize(&analysis, &domain, &sopts, progress))
-        .map_err(|e| Error::Internal(format!("synthesis: {e}")))?
+        .stage(progress, "synthesis", || synthesize(&analysis, &domain, &sopts, progress))
+        .map_err(|e| Error::internal("synthesis", e))?
         .colors;
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     fieldtex_io::write_png(&stage.join("texture.png"), &texture)?;
     fieldtex_io::write_npy_f32(&stage.join("field.npy"), &[n, n, 2], &flat)?;
-    report.time("model", || super::write_model(stage, &patch.mesh, Some(&texture)))?;
+    report.stage(progress, "model", || super::write_model(stage, &patch.mesh, Some(&texture)))?;
     let marks: Vec<DesignedSingularity> = designed
         .iter()
         .map(|s| DesignedSingularity { x: s.texel[0], y: s.texel[1], index: kind_index(s.kind) })
@@ -199,7 +199,7 @@ pub(crate) fn orient_patch(
     } else {
         report.notes.push("image metrics skipped (--no-metrics)".into());
     }
-    let preview = report.time("preview", || preview(&patch.mesh, &texture, &designed));
+    let preview = report.stage(progress, "preview", || preview(&patch.mesh, &texture, &designed));
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     commit_outputs(out, &mut report)?;
     Ok(report)
@@ -234,21 +234,18 @@ fn texel_field(
         }
         FieldSource::Design(p) => {
             let text = super::orient::read_design_text(p)?;
-            let d = DesignFile::from_toml_str(&text)
-                .map_err(|e| Error::bad_input(Some(p), e.to_string()))?;
+            let d =
+                DesignFile::from_toml_str(&text).map_err(|e| Error::classify(&e, Some(p), ""))?;
             (d, Some(p.as_path()))
         }
         FieldSource::Preset(name) => {
             let r = fieldtex_fields::presets::REFERENCE_SIZE;
             let d = fieldtex_fields::presets::preset(name, r, r, options.grid)
-                .map_err(|e| Error::bad_input(None, format!("--preset {name}: {e}")))?;
+                .map_err(|e| Error::classify(&e, None, &format!("--preset {name}")))?;
             (d, None)
         }
     };
-    let bad = |e: fieldtex_fields::FieldsError| match e {
-        fieldtex_fields::FieldsError::Solve(_) => Error::Internal(e.to_string()),
-        _ => Error::bad_input(src, e.to_string()),
-    };
+    let bad = |e: fieldtex_fields::FieldsError| Error::classify(&e, src, "");
     let mut designed = Vec::new();
     let mut mapping_warnings = Vec::new();
     let fd = report.time("field_factor", || -> Result<FieldDesign> {
@@ -267,7 +264,7 @@ fn texel_field(
     let mut fd = fd;
     let solved = report
         .time("field_solve", || fd.solve())
-        .map_err(|e| Error::Internal(format!("field solve: {e}")))?;
+        .map_err(|e| Error::classify(&e, src, "field solve"))?;
     report.metric("field_residual", solved.residual);
     report.warnings.extend(fd.warnings().iter().cloned());
     for (_, s) in fd.singularities() {

@@ -199,7 +199,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
         .bounding_box()
         .ok_or_else(|| Error::bad_input(Some(&options.mesh), "the mesh has no vertex"))?;
     // 1. Sketch and frame field (§3).
-    let (field, curves) = report.time("frame_field", || match &options.sketch {
+    let (field, curves) = report.stage(progress, "frame_field", || match &options.sketch {
         Some(path) => {
             solid_frame_field(&mesh, path, options.field_cells).map(|(f, c)| (Some(f), c))
         }
@@ -221,23 +221,24 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
                 "residual": f.last_residual(),
             }),
         );
-        let edit_ms = report.time("frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
+        let edit_ms = report
+            .stage(progress, "frame_field_edit", || edit_timing(f.grid().clone(), &curves))?;
         report.metric("frame_field_edit_ms", edit_ms);
     }
     crate::outputs::check_cancelled(progress)?;
     // 2. Exemplar analysis and the synthesizer.
     let ex = report
-        .time("exemplar_analysis", || {
+        .stage(progress, "exemplar_analysis", || {
             SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
         })
-        .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "exemplar"))?;
     let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
     report.metric("grid", grid);
     let frames = FieldFrames(field.as_ref());
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
     let synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
-        .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?;
-    let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "synthesis options"))?;
+    let bvh = Bvh::build(&mesh).map_err(|e| Error::internal("bvh", e))?;
     // The interior region (paper E Fig. 15): its own analysis, same lattice and field.
     let ex_inner = match &options.interior {
         Some(path) => {
@@ -247,10 +248,10 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
             a.plane_weights = [1.0, 1.0, 0.0];
             Some(
                 report
-                    .time("interior_exemplar_analysis", || {
+                    .stage(progress, "interior_exemplar_analysis", || {
                         SolidExemplar::new([&images[0], &images[1], &images[2]], &a, progress)
                     })
-                    .map_err(|e| Error::bad_input(Some(path), format!("interior exemplar: {e}")))?,
+                    .map_err(|e| Error::classify(&e, Some(path), "interior exemplar"))?,
             )
         }
         None => None,
@@ -264,7 +265,7 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let inner = match &ex_inner {
         Some(e) => Some(Interior {
             synth: SolidSynthesizer::new(e, lattice, &frames, options.synthesis.clone())
-                .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?,
+                .map_err(|e| Error::classify(&e, None, "synthesis options"))?,
             bvh: &bvh,
             depth,
             band,
@@ -278,22 +279,23 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let mut synth = SolidRegions { outer: synth, inner, grid };
     crate::outputs::check_cancelled(progress)?;
     // 3. Surface shell → atlas texture → model.glb.
-    let (atlas_mesh, texture, shell) =
-        report.time("shell", || textured_atlas(&mesh, &aopts, &grid, &mut synth, progress))?;
+    let (atlas_mesh, texture, shell) = report
+        .stage(progress, "shell", || textured_atlas(&mesh, &aopts, &grid, &mut synth, progress))?;
     report.metric("shell", &shell);
     report.metric(
         "shell_voxels_per_second",
         shell.computed_all_levels as f64 / shell.seconds.max(1e-9),
     );
     report.metric("shell_share_of_full_volume", shell.computed_finest as f64 / grid.len() as f64);
-    report.time("write", || super::write_model(out_dir, &atlas_mesh, Some(&texture)))?;
-    let preview = report.time("preview", || preview_with_curves(&atlas_mesh, &texture, &curves));
+    report.stage(progress, "write", || super::write_model(out_dir, &atlas_mesh, Some(&texture)))?;
+    let preview =
+        report.stage(progress, "preview", || preview_with_curves(&atlas_mesh, &texture, &curves));
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     crate::outputs::check_cancelled(progress)?;
     // 4. Cuts.
     let mut cut_reports = Vec::new();
     for (i, cut) in options.cuts.iter().enumerate() {
-        let r = report.time(&format!("cut_{}", i + 1), || {
+        let r = report.stage(progress, &format!("cut_{}", i + 1), || {
             let keep_field = options.keep.then_some(&frames);
             write_cut(
                 out_dir,
@@ -313,7 +315,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     report.metric("cuts", cut_reports);
     // 5. Volume and frames.
     if options.volume {
-        let w = report.time("volume", || write_volume(out_dir, &grid, &mut synth, progress))?;
+        let w = report
+            .stage(progress, "volume", || write_volume(out_dir, &grid, &mut synth, progress))?;
         report.metric("volume", w);
     }
     if options.keep
@@ -438,7 +441,7 @@ pub(crate) fn sketch_frame_field(
     let mut field = FrameField3d::new(grid, FrameFieldOptions::default())
         .map_err(|e| Error::Internal(e.to_string()))?;
     for (i, c) in curves.iter().enumerate() {
-        field.add_curve(c).map_err(|e| Error::bad_input(path, format!("curve {i}: {e}")))?;
+        field.add_curve(c).map_err(|e| Error::classify(&e, path, &format!("curve {i}")))?;
     }
     Ok((field, curves))
 }
@@ -533,10 +536,10 @@ fn textured_atlas(
     progress: &dyn Progress,
 ) -> Result<(TriMesh, Image, Work)> {
     let atlas = fieldtex_param::build_atlas(mesh, aopts, progress)
-        .map_err(|e| Error::Internal(format!("atlas: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "atlas"))?;
     let size = aopts.resolution as usize;
     let map = fieldtex_param::build_texel_map(&atlas.mesh, size, size, atlas.gutter)
-        .map_err(|e| Error::Internal(format!("texel map: {e}")))?;
+        .map_err(|e| Error::internal("texel map", e))?;
     let (covered, _) = atlas_carriers(&map);
     let points: Vec<[f64; 3]> =
         covered.iter().filter_map(|&i| map.surface_point(&atlas.mesh, i)).collect();

@@ -128,9 +128,9 @@ impl SolidSession {
         crate::outputs::check_cancelled(progress)?;
         let exemplar =
             SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
-                .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
+                .map_err(|e| Error::classify(&e, None, "exemplar"))?;
         let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
-        let bvh = Bvh::build(&mesh).map_err(|e| Error::Internal(format!("bvh: {e}")))?;
+        let bvh = Bvh::build(&mesh).map_err(|e| Error::internal("bvh", e))?;
         let session = Self {
             scale: bbox.diagonal(),
             mesh,
@@ -291,7 +291,7 @@ fn synthesizer<'a>(
 ) -> Result<SolidSynthesizer<'a>> {
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
     let s = SolidSynthesizer::new(exemplar, lattice, frames, options.clone())
-        .map_err(|e| Error::bad_input(None, format!("synthesis options: {e}")))?;
+        .map_err(|e| Error::classify(&e, None, "synthesis options"))?;
     Ok(match cache {
         Some(c) => s.with_cache(c),
         None => s,

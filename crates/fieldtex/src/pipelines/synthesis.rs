@@ -92,16 +92,16 @@ pub(crate) fn synthesize_image_result(
 ) -> Result<fieldtex_synth::SynthesisResult> {
     let aopts = AnalysisOptions::default();
     let (analysis, cached) = report
-        .time("analysis", || cache.analysis(exemplar, &aopts, progress))
-        .map_err(|e| Error::bad_input(None, format!("exemplar: {e}")))?;
+        .stage(progress, "analysis", || cache.analysis(exemplar, &aopts, progress))
+        .map_err(|e| Error::classify(&e, None, "exemplar"))?;
     report.metric("analysis_cached", cached);
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     let domain = ImageDomain::from_direction_field(width, height, &flat, per_pixel as f32)
-        .map_err(|e| Error::Internal(format!("synthesis domain: {e}")))?;
+        .map_err(|e| Error::internal("synthesis domain", e))?;
     let sopts =
         SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };
     let result = report
-        .time("synthesis", || synthesize(&analysis, &domain, &sopts, progress))
-        .map_err(|e| Error::Internal(format!("synthesis: {e}")))?;
+        .stage(progress, "synthesis", || synthesize(&analysis, &domain, &sopts, progress))
+        .map_err(|e| Error::internal("synthesis", e))?;
     Ok(result)
 }

@@ -143,10 +143,12 @@ pub fn transfer_files(
         serde_json::to_value(options).unwrap_or_default(),
     );
     begin_command();
-    let src = report.time("read_source", || fieldtex_io::read_mesh(&options.source))?;
+    let src = report.stage(progress, "read_source", || fieldtex_io::read_mesh(&options.source))?;
     report.warnings.extend(src.warnings.iter().cloned());
     let given_texture = match &options.source_texture {
-        Some(p) => Some(report.time("read_source_texture", || fieldtex_io::read_image(p))?),
+        Some(p) => {
+            Some(report.stage(progress, "read_source_texture", || fieldtex_io::read_image(p))?)
+        }
         None => None,
     };
     let Some(texture) = given_texture.as_ref().or(src.base_color.as_ref()) else {
@@ -161,7 +163,7 @@ pub fn transfer_files(
             "the source has no texture coordinates; transfer needs per-corner UVs to read its texture",
         ));
     }
-    let tgt = report.time("read_target", || fieldtex_io::read_mesh(&options.target))?;
+    let tgt = report.stage(progress, "read_target", || fieldtex_io::read_mesh(&options.target))?;
     report.warnings.extend(tgt.warnings.iter().cloned());
     if tgt.mesh.n_triangles() == 0 {
         return Err(Error::bad_input(
@@ -222,7 +224,7 @@ pub fn transfer_files(
     // Atlas of the target and baking.
     let CarrierAtlas { atlas, map, covered, carriers } =
         carrier_atlas(&target_mesh, &aopts, options.size, &mut report, progress)?;
-    let texture_out = report.time("bake", || {
+    let texture_out = report.stage(progress, "bake", || {
         let points: Vec<(u32, [f64; 3])> =
             carriers.iter().map(|c| (c.triangle, c.barycentric)).collect();
         let v = values_at_surface_points(
@@ -295,8 +297,10 @@ pub fn transfer_files(
     }
     report.notes.push("colours are processed as sRGB-encoded values".into());
     // Outputs.
-    report.time("write", || super::write_model(out_dir, &atlas.mesh, Some(&texture_out)))?;
-    let preview = report.time("preview", || {
+    report.stage(progress, "write", || {
+        super::write_model(out_dir, &atlas.mesh, Some(&texture_out))
+    })?;
+    let preview = report.stage(progress, "preview", || {
         let opts = RenderOptions { size: 600, ..Default::default() };
         let left = render(&Scene::new(&source_mesh).with_texture(texture), &opts);
         let right = render(&Scene::new(&atlas.mesh).with_texture(&texture_out), &opts);
@@ -304,7 +308,7 @@ pub fn transfer_files(
     });
     fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
     if options.keep {
-        report.time("keep", || {
+        report.stage(progress, "keep", || {
             write_guidance_ply(&out_dir.join("guidance.ply"), &target_mesh, &result)
         })?;
     }

@@ -41,9 +41,9 @@ pub fn transfer_fidelity_files(
         "evaluated",
         &mut warnings,
     )
-    .map_err(|e| Error::bad_input(Some(mesh), e.to_string()))?;
-    let bvh = fieldtex_mesh::Bvh::build(&b.mesh)
-        .map_err(|e| Error::bad_input(Some(reference), e.to_string()))?;
+    .map_err(|e| Error::classify(&e, Some(mesh), ""))?;
+    let bvh =
+        fieldtex_mesh::Bvh::build(&b.mesh).map_err(|e| Error::classify(&e, Some(reference), ""))?;
     let closest = bvh.closest_points(&s.positions);
     let (mut tri_b, mut bary_b, mut keep) = (Vec::new(), Vec::new(), Vec::new());
     for (i, c) in closest.iter().enumerate() {
@@ -55,9 +55,9 @@ pub fn transfer_fidelity_files(
     }
     let (ca, va) =
         fieldtex_transfer::surface_colors(&a.mesh, &ta, None, &s.triangles, &s.barycentric)
-            .map_err(|e| Error::bad_input(Some(mesh), e.to_string()))?;
+            .map_err(|e| Error::classify(&e, Some(mesh), ""))?;
     let (cb, vb) = fieldtex_transfer::surface_colors(&b.mesh, &tb, None, &tri_b, &bary_b)
-        .map_err(|e| Error::bad_input(Some(reference), e.to_string()))?;
+        .map_err(|e| Error::classify(&e, Some(reference), ""))?;
     let mut x = Vec::new();
     let mut y = Vec::new();
     for (j, &i) in keep.iter().enumerate() {

@@ -106,7 +106,7 @@ pub fn conformal(
     let mut report =
         Report::new("conformal", options.seed, serde_json::to_value(options).unwrap_or_default());
     begin_command();
-    let loaded = report.time("read", || fieldtex_io::read_mesh(&options.mesh))?;
+    let loaded = report.stage(progress, "read", || fieldtex_io::read_mesh(&options.mesh))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
     let exemplar = fieldtex_io::read_image(&options.exemplar)?;
     if exemplar.width < options.patch_size || exemplar.height < options.patch_size {
@@ -139,14 +139,14 @@ pub fn conformal(
 
     // 1. Global conformal parameterisation, per component.
     let (mut comps, warnings) = report
-        .time("conformal-map", || global_conformal(&mesh, progress))
-        .map_err(|e| Error::Internal(format!("conformal map: {e}")))?;
+        .stage(progress, "conformal-map", || global_conformal(&mesh, progress))
+        .map_err(|e| Error::classify(&e, None, "conformal map"))?;
     report.warnings.extend(warnings);
     crate::outputs::check_cancelled(progress)?;
     // 2. Optional quasi-isometric relaxation.
     let mut relax_stats = Vec::new();
     if options.quasi_isometric {
-        report.time("mass-spring", || {
+        report.stage(progress, "mass-spring", || {
             for c in comps.iter_mut() {
                 if let Some(s) = c.relax_quasi_isometric(&MassSpringOptions::default()) {
                     relax_stats.push(json!({"component": c.component, "stats": s}));
@@ -157,7 +157,7 @@ pub fn conformal(
     // 3. Geometry images and their τ maps; components without a map go to the atlas.
     let total_area: Vec<f64> = comps.iter().map(|c| component_area(&mesh, c)).collect();
     let max_area = total_area.iter().cloned().fold(0.0, f64::max);
-    let images: Vec<Option<GeometryImage>> = report.time("geometry-images", || {
+    let images: Vec<Option<GeometryImage>> = report.stage(progress, "geometry-images", || {
         comps
             .iter()
             .zip(&total_area)
@@ -175,7 +175,7 @@ pub fn conformal(
     let fallback = if fallback_faces.is_empty() {
         None
     } else {
-        Some(report.time("fallback-atlas", || {
+        Some(report.stage(progress, "fallback-atlas", || {
             fallback_atlas(&mesh, &fallback_faces, options.size, progress)
         })?)
     };
@@ -218,7 +218,7 @@ pub fn conformal(
     } else {
         (vec![1.0], vec![1.0])
     };
-    let levels: Vec<Image> = report.time("exemplar-levels", || {
+    let levels: Vec<Image> = report.stage(progress, "exemplar-levels", || {
         scales.iter().map(|s| resample(&exemplar, s * options.scale)).collect()
     });
     let level_for = |t: f64| -> usize {
@@ -239,7 +239,7 @@ pub fn conformal(
     };
     let mut blocks: Vec<Block> = Vec::new();
     let mut quilt_stats = Vec::new();
-    let t_quilt = std::time::Instant::now();
+    let quilting = fieldtex_core::StageGuard::begin(progress, "quilting", 0);
     for (c, img) in comps.iter().zip(&images) {
         let Some(img) = img else { continue };
         let partners = |i: usize, j: usize, out: &mut Vec<(usize, usize)>| img.partners(i, j, out);
@@ -286,14 +286,16 @@ pub fn conformal(
             label: "fallback_atlas".into(),
         });
     }
-    report.timings_ms.push(("quilting".into(), t_quilt.elapsed().as_secs_f64() * 1e3));
+    report.timings_ms.push(("quilting".into(), quilting.elapsed_ms()));
+    drop(quilting);
     crate::outputs::check_cancelled(progress)?;
     // 6. One texture: blocks stacked vertically; per-corner UVs.
-    let (texture, out_mesh) = report.time("assemble", || assemble(&mesh, &blocks));
+    let (texture, out_mesh) = report.stage(progress, "assemble", || assemble(&mesh, &blocks));
     // 7. Outputs.
-    report.time("write", || super::write_model(&stage, &out_mesh, Some(&texture)))?;
-    let preview =
-        report.time("preview", || super::render::preview(&out_mesh, Some(&texture), 800, None));
+    report.stage(progress, "write", || super::write_model(&stage, &out_mesh, Some(&texture)))?;
+    let preview = report.stage(progress, "preview", || {
+        super::render::preview(&out_mesh, Some(&texture), 800, None)
+    });
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     // 8. Metrics.
     let comp_json: Vec<serde_json::Value> =
@@ -304,10 +306,11 @@ pub fn conformal(
     if options.quasi_isometric {
         report.metric("mass_spring", relax_stats);
     }
-    let seams = report
-        .time("eval-seams", || fieldtex_eval::seam_metrics::seam_metrics(&out_mesh, &texture));
+    let seams = report.stage(progress, "eval-seams", || {
+        fieldtex_eval::seam_metrics::seam_metrics(&out_mesh, &texture)
+    });
     report.metric("seams", seams);
-    let feature = report.time("eval-feature-size", || {
+    let feature = report.stage(progress, "eval-feature-size", || {
         fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24)
     });
     report.metric("feature_size", feature);
@@ -323,7 +326,7 @@ pub fn conformal(
     report.metric("texel_density", texel_density(&tau_w));
     add_notes(&mut report, &comps, options);
     if options.keep {
-        report.time("keep", || write_keep(&stage, &mesh, &comps, &blocks))?;
+        report.stage(progress, "keep", || write_keep(&stage, &mesh, &comps, &blocks))?;
     }
     commit_outputs(out, &mut report)?;
     Ok(report)
