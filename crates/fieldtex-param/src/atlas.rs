@@ -18,7 +18,7 @@ use crate::distortion::parameterization_distortion;
 use crate::face_graph::FaceGraph;
 use crate::lscm::{flattening_defects, lscm, planar_projection};
 use crate::min_area_rectangle::min_area_rectangle_angle;
-use crate::packing::{PackChart, PackingOptions, pack_charts};
+use crate::packing::{PackChart, PackingOptions, SEQUENTIAL_BELOW_TRIANGLES, pack_charts};
 use fieldtex_core::{Progress, Warning, Warnings};
 use fieldtex_mesh::{CornerUvs, MeshError, TriMesh};
 use rayon::prelude::*;
@@ -194,12 +194,19 @@ pub fn build_atlas(
     progress.finish_stage();
 
     progress.stage("atlas: flattening charts", mesh.n_triangles() as u64);
+    // Small meshes: a few charts of a few hundred triangles each, less work than
+    // waking the thread pool (the result is the same either way).
+    let sequential = mesh.n_triangles() < SEQUENTIAL_BELOW_TRIANGLES;
     let mut work = seg.charts;
     let mut done: Vec<FlatChart> = Vec::new();
     let mut unresolved = 0usize;
     while !work.is_empty() {
-        let results: Vec<Flattened> =
-            std::mem::take(&mut work).into_par_iter().map(|f| flatten(f, mesh, &graph)).collect();
+        let batch = std::mem::take(&mut work);
+        let results: Vec<Flattened> = if sequential {
+            batch.into_iter().map(|f| flatten(f, mesh, &graph)).collect()
+        } else {
+            batch.into_par_iter().map(|f| flatten(f, mesh, &graph)).collect()
+        };
         for r in results {
             match r {
                 Flattened::Done(fc, bad) => {
@@ -222,31 +229,32 @@ pub fn build_atlas(
 
     progress.stage("atlas: packing charts", 0);
     // Uniform texel density and tight bounding boxes.
-    let pack_charts_in: Vec<PackChart> = done
-        .par_iter()
-        .map(|fc| {
-            let a3: f64 = fc.chart.faces.iter().map(|&f| graph.areas[f as usize]).sum();
-            let auv: f64 = fc
-                .chart
-                .corners
-                .iter()
-                .map(|c| {
-                    let (p, q, r) =
-                        (fc.uv[c[0] as usize], fc.uv[c[1] as usize], fc.uv[c[2] as usize]);
-                    0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs()
-                })
-                .sum();
-            let s = if auv > 0.0 && a3 > 0.0 { (a3 / auv).sqrt() } else { 1.0 };
-            let theta = min_area_rectangle_angle(&fc.uv);
-            let (c, sn) = (theta.cos(), theta.sin());
-            let points = fc
-                .uv
-                .iter()
-                .map(|p| [s * (c * p[0] + sn * p[1]), s * (-sn * p[0] + c * p[1])])
-                .collect();
-            PackChart { points, triangles: fc.chart.corners.clone(), simple_outline: fc.clean }
-        })
-        .collect();
+    let prepare = |fc: &FlatChart| {
+        let a3: f64 = fc.chart.faces.iter().map(|&f| graph.areas[f as usize]).sum();
+        let auv: f64 = fc
+            .chart
+            .corners
+            .iter()
+            .map(|c| {
+                let (p, q, r) = (fc.uv[c[0] as usize], fc.uv[c[1] as usize], fc.uv[c[2] as usize]);
+                0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs()
+            })
+            .sum();
+        let s = if auv > 0.0 && a3 > 0.0 { (a3 / auv).sqrt() } else { 1.0 };
+        let theta = min_area_rectangle_angle(&fc.uv);
+        let (c, sn) = (theta.cos(), theta.sin());
+        let points = fc
+            .uv
+            .iter()
+            .map(|p| [s * (c * p[0] + sn * p[1]), s * (-sn * p[0] + c * p[1])])
+            .collect();
+        PackChart { points, triangles: fc.chart.corners.clone(), simple_outline: fc.clean }
+    };
+    let pack_charts_in: Vec<PackChart> = if sequential {
+        done.iter().map(prepare).collect()
+    } else {
+        done.par_iter().map(prepare).collect()
+    };
     let packing = pack_charts(&pack_charts_in, &pack_opts)?;
     progress.finish_stage();
 

@@ -26,7 +26,8 @@
 //! chart fits. Each trial packs into a grid twice as tall as the atlas and reports the
 //! height it used; the height grows roughly like the square of the scale, which gives
 //! the next guess, and the bracket between the best fitting and the smallest failing
-//! scale is then narrowed with three trial scales per round, evaluated in parallel.
+//! scale is then narrowed with three trial scales per round, evaluated in parallel
+//! (one after the other for inputs under `SEQUENTIAL_BELOW_TRIANGLES` triangles).
 //! The search runs first on cells twice as large (a quarter of the work per trial)
 //! and then, from just above the scale found there, for at most three rounds on the
 //! final cells; the coarse packing is valid as it stands and is kept if no finer one
@@ -37,8 +38,8 @@
 //! waste of a coarse cell along a chart's outline is small against the chart's area,
 //! so the trials run on a coarser working raster. The final cells are four times as
 //! large, at most 1/128 of the atlas side (8×8 texels at 1024²), the bracket runs on
-//! cells of 1/64 of the atlas side (16 texels at 1024²), and the final search stops
-//! after two rounds. This costs a few points of packing efficiency (numbers in
+//! cells of 1/64 of the atlas side (16 texels at 1024²) to a relative precision of
+//! 3 % (1 % elsewhere), and the final search stops after two rounds. This costs a few points of packing efficiency (numbers in
 //! `docs/perf/atlas.md`).
 //!
 //! **Packing efficiency** (reported by the atlas) is the charts' UV triangle area in
@@ -156,6 +157,16 @@ pub struct Packing {
 /// side over the square root of the chart count: at most 16 charts at 1024²) pack on
 /// the coarser cells of the small-input shortcut (module docs).
 pub const SMALL_INPUT_CHART_SIDE: f64 = 256.0;
+
+/// Relative precision of the coarse bracket of the small-input shortcut (the final
+/// cells then refine it; 0.01 elsewhere).
+const SMALL_INPUT_COARSE_TOLERANCE: f64 = 0.03;
+
+/// Inputs with fewer triangles than this (all charts together) run their trial
+/// packings one after the other on the calling thread: a trial takes a fraction of a
+/// millisecond there, less than handing it to the thread pool costs (results do not
+/// depend on it). The atlas flattens such meshes on the calling thread too.
+pub(crate) const SEQUENTIAL_BELOW_TRIANGLES: usize = 4096;
 
 /// Footprints of at most this many cells are remembered per shape within a trial (the
 /// lowest row still worth testing; this only skips rows that cannot fit, so results
@@ -398,36 +409,26 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
     } else {
         (2 * fine.k, fine, 3)
     };
-    if options.resolution as i64 / coarse_k >= 64 {
-        let coarse = CellGrid::new(options, coarse_k);
-        search_scale(
-            charts,
-            &outlines,
-            &origins,
-            &order,
-            options,
-            coarse,
-            &mut state,
-            tol.max(0.01),
-            40,
-        );
-        if let Some(lo) = &state.lo {
+    let coarse_tol = if small { SMALL_INPUT_COARSE_TOLERANCE } else { 0.01 };
+    // Stages: (cells, tolerance, round limit). Each later stage restarts the bracket
+    // from just above the scale the previous one found.
+    let stages: Vec<(CellGrid, f64, usize)> = if options.resolution as i64 / coarse_k >= 64 {
+        vec![(CellGrid::new(options, coarse_k), tol.max(coarse_tol), 40), (fine, tol, fine_rounds)]
+    } else {
+        vec![(fine, tol, 40)]
+    };
+    let parallel =
+        charts.iter().map(|c| c.triangles.len()).sum::<usize>() >= SEQUENTIAL_BELOW_TRIANGLES;
+    for (k, &(cells, stage_tol, rounds)) in stages.iter().enumerate() {
+        if k > 0
+            && let Some(lo) = &state.lo
+        {
             state.hi = upper * (1.0 + 1e-9);
             state.guess = lo.scale * 1.03;
         }
-        search_scale(
-            charts,
-            &outlines,
-            &origins,
-            &order,
-            options,
-            fine,
-            &mut state,
-            tol,
-            fine_rounds,
-        );
-    } else {
-        search_scale(charts, &outlines, &origins, &order, options, fine, &mut state, tol, 40);
+        let search =
+            Search { charts, outlines: &outlines, origins: &origins, order: &order, options };
+        search_scale(&search, cells, &mut state, stage_tol, rounds, parallel);
     }
     let Some(found) = state.lo else { return Err(fail(state.guess)) };
     if found.scale < upper * 1e-9 {
@@ -440,6 +441,16 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
         placements: found.placements,
         inset: found.inset,
     })
+}
+
+/// The inputs every trial of a scale search packs.
+#[derive(Clone, Copy)]
+struct Search<'a> {
+    charts: &'a [PackChart],
+    outlines: &'a [Option<Vec<[u32; 2]>>],
+    origins: &'a [[f64; 2]],
+    order: &'a [usize],
+    options: &'a PackingOptions,
 }
 
 /// The best packing found so far.
@@ -459,18 +470,15 @@ struct SearchState {
 /// Narrows the scale on `cells` until `hi ≤ lo·(1 + tol)` or `max_rounds` rounds.
 /// Each trial's packing height h(s) ∝ s² roughly, so `s·√(limit / h)` estimates the
 /// best scale.
-#[allow(clippy::too_many_arguments)]
 fn search_scale(
-    charts: &[PackChart],
-    outlines: &[Option<Vec<[u32; 2]>>],
-    origins: &[[f64; 2]],
-    order: &[usize],
-    options: &PackingOptions,
+    search: &Search,
     cells: CellGrid,
     st: &mut SearchState,
     tol: f64,
     max_rounds: usize,
+    parallel: bool,
 ) {
+    let Search { charts, outlines, origins, order, options } = *search;
     let limit = (cells.size - cells.margin) as f64;
     let upper = st.hi;
     for _round in 0..max_rounds {
@@ -488,10 +496,12 @@ fn search_scale(
         if trials.is_empty() {
             break;
         }
-        let results: Vec<Option<Trial>> = trials
-            .par_iter()
-            .map(|&t| try_pack(charts, outlines, origins, order, t, options, cells))
-            .collect();
+        let run = |&t: &f64| try_pack(charts, outlines, origins, order, t, options, cells);
+        let results: Vec<Option<Trial>> = if parallel {
+            trials.par_iter().map(run).collect()
+        } else {
+            trials.iter().map(run).collect()
+        };
         let mut estimate: Option<f64> = None;
         let mut smallest_failed: Option<f64> = None;
         for (&t, r) in trials.iter().zip(results) {

@@ -252,12 +252,15 @@ fn fertility_genus_4() {
 /// Issue 17: the atlas was more fragmented than xatlas (140 charts on the 5.9K-triangle
 /// spot cow where xatlas makes 39; 17 on the fandisk where it makes 15). The bounds are
 /// xatlas's chart counts and packing efficiencies on these meshes at padding 4
-/// (`bench/peers.py --atlas-sweep`).
+/// (`bench/peers.py --atlas-sweep`). The avocado (682 triangles) takes the
+/// single-threaded path for small meshes and the packer's small-input shortcut.
 #[test]
 fn no_more_charts_than_xatlas_at_its_packing() {
-    for (file, xatlas_charts, xatlas_packing) in
-        [("textured/spot/spot_triangulated.obj", 39, 0.598), ("meshes/fandisk.obj", 15, 0.589)]
-    {
+    for (file, xatlas_charts, xatlas_packing) in [
+        ("textured/avocado/avocado.obj", 9, 0.407),
+        ("textured/spot/spot_triangulated.obj", 39, 0.598),
+        ("meshes/fandisk.obj", 15, 0.589),
+    ] {
         let mesh = load_obj(file);
         let a = check_atlas(&mesh, &AtlasOptions::default());
         assert!(a.stats.charts <= xatlas_charts, "{file}: {:?}", a.stats);
@@ -340,12 +343,15 @@ fn bad_input_is_an_error() {
     }
 }
 
+/// Above [`crate::packing::SEQUENTIAL_BELOW_TRIANGLES`], so flattening and the
+/// packer's trials run on the thread pool.
 #[test]
 fn same_result_for_any_thread_count() {
     let mesh = concat(
-        &primitives::icosphere(3),
+        &primitives::icosphere(4),
         &translate(primitives::torus(1.0, 0.4, 32, 16), [3.0, 0.0, 0.0]),
     );
+    assert!(mesh.n_triangles() >= crate::packing::SEQUENTIAL_BELOW_TRIANGLES);
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
