@@ -58,7 +58,17 @@ fn main() {
             ..Default::default()
         }
     });
-    let approximate = (!exact).then(|| search.clone().unwrap_or_default());
+    // `--samples N` (0 = every query / the stride grid) and `--seed S`: the query sample.
+    let arg =
+        |name: &str| a.iter().position(|s| s == name).map(|i| a[i + 1].parse::<u64>().unwrap());
+    let mut search = search.unwrap_or_default();
+    if let Some(n) = arg("--samples") {
+        search.sampled_queries = n as usize;
+    }
+    if let Some(s) = arg("--seed") {
+        search.seed = s;
+    }
+    let approximate = (!exact).then(|| search.clone());
     let t0 = Instant::now();
     let angle = stage("exemplar_orientation", || {
         let (angle, _) = dominant_orientation(&ev).unwrap();
@@ -107,9 +117,14 @@ fn main() {
         cpu_s() * 1e3
     );
     println!(
-        "coherence {:.6} completeness {:.6} sw {:.6} guided {:.6} orient_err {:.3} sing {} pd {}",
+        "coherence {:.6} (se {:.6}, {} queries) completeness {:.6} (se {:.6}, {} queries) \
+         sw {:.6} guided {:.6} orient_err {:.3} sing {} pd {}",
         c.mean,
+        c.standard_error.unwrap_or(0.0),
+        c.queries,
         p.mean,
+        p.standard_error.unwrap_or(0.0),
+        p.queries,
         sw.distance,
         g.mean,
         oe.mean_error_deg,

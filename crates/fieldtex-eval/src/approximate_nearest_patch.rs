@@ -59,12 +59,27 @@ pub struct ApproximateSearchOptions {
     /// mean over a regular sub-grid estimates the mean over all). Applies to the
     /// direction whose queries are the larger image. Default 3 (4 aliases with the
     /// 16-pixel blocks of the test patchworks: −12 to −18 %, `docs/perf/orient.md`).
+    /// Used by the coherence map, and by coherence when `sampled_queries` is 0.
     pub query_stride: usize,
+    /// Coherence and completeness estimate their means from at most this many query
+    /// patches per direction, drawn as seeded runs ([`crate::query_sampling`]), and
+    /// report the standard error of the estimate; 0: every query (completeness) or the
+    /// `query_stride` grid (coherence). Default 8 192.
+    pub sampled_queries: usize,
+    /// Seed of the query sample. Default 1.
+    pub seed: u64,
 }
 
 impl Default for ApproximateSearchOptions {
     fn default() -> Self {
-        Self { pca_dims: 12, rerank: 12, max_checks: 256, query_stride: 3 }
+        Self {
+            pca_dims: 12,
+            rerank: 12,
+            max_checks: 256,
+            query_stride: 3,
+            sampled_queries: 8_192,
+            seed: 1,
+        }
     }
 }
 

@@ -22,5 +22,5 @@ pub fn coherence(
     exemplar: &ImageView,
     options: &PatchDistanceOptions,
 ) -> Result<PatchDistanceReport, EvalError> {
-    coherence_distances(output, exemplar, options).map(|r| r.0)
+    coherence_distances(output, exemplar, options, false).map(|r| r.0)
 }

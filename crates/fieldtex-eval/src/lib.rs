@@ -35,6 +35,7 @@ pub mod nearest_patch;
 pub mod nearest_patch_metrics;
 pub mod orientation;
 pub mod phase_defects;
+pub mod query_sampling;
 pub mod rosy_seam;
 pub mod seam_metrics;
 pub mod singularities;

@@ -1,9 +1,11 @@
 //! The nearest-patch metrics (coherence, completeness, the coherence map): options,
 //! report, and the choice between the exact displacement scan of
 //! [`crate::nearest_patch`] and the approximate search of
-//! [`crate::approximate_nearest_patch`] (PCA + kd-tree, query sub-grid; an upper bound
-//! of the exact distances, measured within +5 % on the test exemplars:
-//! `tests/approximate_metrics.rs`, `docs/first-hour.md`).
+//! [`crate::approximate_nearest_patch`] (PCA + kd-tree; an upper bound of the exact
+//! distances, measured within +5 % on the test exemplars). With the approximate search,
+//! coherence and completeness by default average a seeded sample of query patches
+//! ([`crate::query_sampling`]) and report the standard error of that sample mean
+//! (`tests/approximate_metrics.rs`, `docs/perf/orient.md`).
 
 use crate::EvalError;
 use crate::approximate_nearest_patch::{
@@ -11,6 +13,7 @@ use crate::approximate_nearest_patch::{
 };
 use crate::image_view::ImageView;
 use crate::nearest_patch::{PatchGrid, nearest_patch_ssd};
+use crate::query_sampling::{RUN_LENGTH, run_standard_error, sampled_runs};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -144,6 +147,36 @@ fn strided(g: &PatchGrid, stride: usize) -> Vec<usize> {
         .collect()
 }
 
+/// The coherence queries of the approximate search: seeded runs when
+/// `sampled_queries > 0` (`Some(whole grid?)`, stride 1), else the `query_stride` grid.
+fn coherence_queries(
+    out: &PatchGrid,
+    a: &ApproximateSearchOptions,
+) -> (Vec<usize>, Option<bool>, usize) {
+    if a.sampled_queries == 0 {
+        return (strided(out, a.query_stride), None, a.query_stride);
+    }
+    let runs = a.sampled_queries.div_ceil(RUN_LENGTH);
+    let qs = sampled_runs(out.cols, out.rows, runs, a.seed, "coherence-queries");
+    let whole = qs.len() == out.count();
+    (qs, Some(whole), 1)
+}
+
+/// The completeness queries (exemplar patches): seeded runs when `sampled_queries > 0`,
+/// else all.
+fn completeness_queries(
+    ex: &PatchGrid,
+    a: &ApproximateSearchOptions,
+) -> (Vec<usize>, Option<bool>) {
+    if a.sampled_queries == 0 {
+        return ((0..ex.count()).collect(), None);
+    }
+    let runs = a.sampled_queries.div_ceil(RUN_LENGTH);
+    let qs = sampled_runs(ex.cols, ex.rows, runs, a.seed, "completeness-queries");
+    let whole = qs.len() == ex.count();
+    (qs, Some(whole))
+}
+
 /// Summary of per-query nearest-patch distances, normalised per pixel and channel.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PatchDistanceReport {
@@ -174,6 +207,13 @@ pub struct PatchDistanceReport {
     /// for the exact search.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error_bound_percent: Option<f64>,
+    /// For a mean estimated on a seeded sample of query patches
+    /// ([`crate::query_sampling`]): the standard error of `mean` against the mean over
+    /// every query patch (the estimate is within ±1.96 of it with about 95 %
+    /// probability); absent when every query (or the stride grid) was searched. `p95`
+    /// and `max` are then those of the sample.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standard_error: Option<f64>,
 }
 
 pub(crate) fn summarize(
@@ -202,6 +242,7 @@ pub(crate) fn summarize(
         search: "exact".into(),
         query_stride: 1,
         error_bound_percent: None,
+        standard_error: None,
     }
 }
 
@@ -213,7 +254,26 @@ fn approximate_report(
     stride: usize,
     options: &ApproximateSearchOptions,
 ) -> PatchDistanceReport {
+    approximate_sampled_report(dists, dim, candidates, n, stride, options, None)
+}
+
+/// [`approximate_report`] of a query sample: `Some(whole_grid)` when the queries came
+/// from [`sampled_runs`] (adds the standard error, 0 when the sample was the whole grid).
+fn approximate_sampled_report(
+    dists: &[f32],
+    dim: usize,
+    candidates: usize,
+    n: usize,
+    stride: usize,
+    options: &ApproximateSearchOptions,
+    sampled: Option<bool>,
+) -> PatchDistanceReport {
     let mut r = summarize(dists, dim, candidates, n);
+    if let Some(whole_grid) = sampled {
+        let norm = 1.0 / dim as f64;
+        let v: Vec<f64> = dists.iter().map(|&d| d.max(0.0) as f64 * norm).collect();
+        r.standard_error = Some(run_standard_error(&v, whole_grid));
+    }
     r.search = "approximate".into();
     r.query_stride = stride;
     r.error_bound_percent = Some(ERROR_BOUND_PERCENT);
@@ -252,14 +312,14 @@ pub fn coherence_and_completeness(
     let (out, ex) = grids(output, exemplar, options, "coherence/completeness")?;
     let n = options.patch_size;
     if let Some(a) = &options.approximate {
-        let qs = strided(&out, a.query_stride);
+        let (qs, c_sampled, c_stride) = coherence_queries(&out, a);
         // One PCA basis (fitted on the exemplar's patches) for both directions.
         let (to_ex, basis) = approximate_ssd(&out, &qs, &ex, a, None)?;
-        let all_ex: Vec<usize> = (0..ex.count()).collect();
-        let (to_out, _) = approximate_ssd(&ex, &all_ex, &out, a, Some(&basis))?;
+        let (ps, p_sampled) = completeness_queries(&ex, a);
+        let (to_out, _) = approximate_ssd(&ex, &ps, &out, a, Some(&basis))?;
         return Ok((
-            approximate_report(&to_ex, out.dim(), ex.count(), n, a.query_stride, a),
-            approximate_report(&to_out, ex.dim(), out.count(), n, 1, a),
+            approximate_sampled_report(&to_ex, out.dim(), ex.count(), n, c_stride, a, c_sampled),
+            approximate_sampled_report(&to_out, ex.dim(), out.count(), n, 1, a, p_sampled),
         ));
     }
     let (to_ex, to_out) = nearest_patch_ssd(&out, &ex, true, true);
@@ -271,9 +331,24 @@ pub(crate) fn coherence_distances(
     output: &ImageView,
     exemplar: &ImageView,
     options: &PatchDistanceOptions,
+    map: bool,
 ) -> Result<(PatchDistanceReport, Vec<f32>, usize, usize), EvalError> {
     let (out, ex) = grids(output, exemplar, options, "coherence")?;
     if let Some(a) = &options.approximate {
+        let (qs, sampled, stride) = coherence_queries(&out, a);
+        if !map {
+            let (to_ex, _) = approximate_ssd(&out, &qs, &ex, a, None)?;
+            let report = approximate_sampled_report(
+                &to_ex,
+                out.dim(),
+                ex.count(),
+                options.patch_size,
+                stride,
+                a,
+                sampled,
+            );
+            return Ok((report, to_ex, 0, 0));
+        }
         let qs = strided(&out, a.query_stride);
         let (to_ex, _) = approximate_ssd(&out, &qs, &ex, a, None)?;
         let report = approximate_report(
@@ -304,9 +379,17 @@ pub(crate) fn completeness_distances(
 ) -> Result<PatchDistanceReport, EvalError> {
     let (out, ex) = grids(output, exemplar, options, "completeness")?;
     if let Some(a) = &options.approximate {
-        let all_ex: Vec<usize> = (0..ex.count()).collect();
-        let (to_out, _) = approximate_ssd(&ex, &all_ex, &out, a, None)?;
-        return Ok(approximate_report(&to_out, ex.dim(), out.count(), options.patch_size, 1, a));
+        let (ps, sampled) = completeness_queries(&ex, a);
+        let (to_out, _) = approximate_ssd(&ex, &ps, &out, a, None)?;
+        return Ok(approximate_sampled_report(
+            &to_out,
+            ex.dim(),
+            out.count(),
+            options.patch_size,
+            1,
+            a,
+            sampled,
+        ));
     }
     let (_, to_out) = nearest_patch_ssd(&out, &ex, false, true);
     Ok(summarize(&to_out, ex.dim(), out.count(), options.patch_size))
@@ -320,7 +403,7 @@ pub fn coherence_map(
     exemplar: &ImageView,
     options: &PatchDistanceOptions,
 ) -> Result<(Vec<f32>, usize, usize), EvalError> {
-    let (_, d, w, h) = coherence_distances(output, exemplar, options)?;
+    let (_, d, w, h) = coherence_distances(output, exemplar, options, true)?;
     let norm = 1.0 / (options.patch_size * options.patch_size * output.channels) as f32;
     Ok((d.iter().map(|v| v.max(0.0) * norm).collect(), w, h))
 }

@@ -82,7 +82,7 @@ pub(crate) fn image_metrics(
     // Default: the approximate nearest-patch search (PCA + kd-tree, an upper bound of
     // the exact distances; docs/perf/orient.md gives the measured gap); `exact`: the
     // exhaustive scan.
-    let approximate = (!exact).then(ev::ApproximateSearchOptions::default);
+    let approximate = (!exact).then(|| ev::ApproximateSearchOptions { seed, ..Default::default() });
     let popts = ev::PatchDistanceOptions::default()
         .with_wrap_exemplar(true)
         .with_approximate(approximate.clone());
@@ -133,12 +133,16 @@ pub(crate) fn image_metrics(
             format!(
                 "approximate: coherence, completeness and guided_coherence use the approximate \
                  nearest-patch search (one PCA basis for both images, k-d trees searched \
-                 with a bounded budget, coherent candidates, coherence queries on a step-3 \
-                 sub-grid); each is an upper bound of the exact value, \
-                 at most {}% above it on the test exemplars; color_sliced_wasserstein uses a \
+                 with a bounded budget, coherent candidates); coherence and completeness \
+                 average a seeded sample of at most {} query patches each (runs of {}), \
+                 with the standard error of the sample mean in standard_error; the search \
+                 is at most {}% above the exact distances on the test exemplars; \
+                 color_sliced_wasserstein uses a \
                  seeded sample of about {} pixels per image, within {} + {}% of the all-pixel \
                  value on the test exemplars (docs/perf/orient.md); --exact-metrics for the \
                  exhaustive versions",
+                ev::ApproximateSearchOptions::default().sampled_queries,
+                ev::query_sampling::RUN_LENGTH,
                 ev::approximate_nearest_patch::ERROR_BOUND_PERCENT,
                 ev::color_sliced_wasserstein::SAMPLED_PIXELS,
                 ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_ABS,
