@@ -290,6 +290,7 @@ fn the_feature_channel_keeps_the_mortar_connected() {
     let with = mortar_connectivity(&shown_mortar(&masked, &masked), side, side);
     let exemplar: Vec<f32> = mask.pixels.iter().map(|p| p[0]).collect();
     assert_eq!(mortar_connectivity(&exemplar, 64, 64), 1.0);
+    eprintln!("mortar in the largest component: with the channel {with:.3}, without {without:.3}");
     assert!(
         with > without + 0.1 && with > 0.8,
         "mortar in the largest component: {with:.3} with the feature channel, {without:.3} without"
