@@ -26,6 +26,16 @@ pub struct SolidArgs {
     /// Exemplar of the local zx plane.
     #[arg(long)]
     exemplar_zx: Option<PathBuf>,
+    /// Feature mask for regular exemplars such as bricks (paper E §4): a grey image
+    /// the size of the exemplar, white on the feature curves (mortar lines), black
+    /// elsewhere. It is matched as a fourth channel beside RGB (neighbourhoods, triple
+    /// search, correction) so the features stay connected; it is never shown. Used for
+    /// every plane (transposed for yz with a single --exemplar).
+    #[arg(long)]
+    feature_mask: Option<PathBuf>,
+    /// Weight of the feature mask against the colour channels.
+    #[arg(long, default_value_t = 1.0)]
+    feature_weight: f32,
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
@@ -65,6 +75,10 @@ pub struct SolidArgs {
     /// ones take the nearest voxel).
     #[arg(long, default_value_t = 3)]
     trilinear_levels: usize,
+    /// Coarsest levels whose correction integrates the neighbourhood sample positions
+    /// along the field (paper E §4.3); the finer ones span it with the voxel's frame.
+    #[arg(long, default_value_t = 2)]
+    integrate_levels: usize,
     /// Synthesis levels.
     #[arg(long, default_value_t = 5)]
     levels: usize,
@@ -113,6 +127,7 @@ pub fn run_solid(
         exemplar_xy: a.exemplar_xy,
         exemplar_yz: a.exemplar_yz,
         exemplar_zx: a.exemplar_zx,
+        feature_mask: a.feature_mask,
         resolution: a.resolution,
         cuts: a.cuts,
         volume: a.volume,
@@ -128,8 +143,10 @@ pub fn run_solid(
     opts.synthesis.block = a.block;
     opts.synthesis.seed = seed;
     opts.synthesis.trilinear_levels = a.trilinear_levels;
+    opts.synthesis.integrate_levels = a.integrate_levels;
     opts.analysis.levels = a.levels;
     opts.analysis.neighbourhood = a.neighbourhood;
+    opts.analysis.feature_weight = a.feature_weight;
     fieldtex::solid(&a.out, &opts, progress)
 }
 

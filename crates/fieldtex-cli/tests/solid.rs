@@ -257,3 +257,57 @@ fn interior_region_fills_the_deep_voxels() {
     assert!(opaque > 100, "{opaque} opaque pixels");
     assert!(changed > 0 && changed < opaque, "{changed} of {opaque} slice voxels changed");
 }
+
+/// `--feature-mask`: a mask the size of the exemplar is used (the report names the
+/// channel); a mask of another size is a clear error (exit 2) naming the mask.
+#[test]
+fn feature_mask_is_used_and_a_wrong_size_is_an_error() {
+    use fieldtex::crates::io::{read_image, write_png};
+    let d = tmp("feature-mask");
+    let bricks = shared().join("exemplars/bricks_Bricks012.png");
+    let img = read_image(&bricks).unwrap();
+    // A mask from the exemplar's darkest quarter (its mortar), and one of another size.
+    let mut lum: Vec<f32> = img.pixels.iter().map(|p| p[0] + p[1] + p[2]).collect();
+    lum.sort_by(f32::total_cmp);
+    let cut = lum[lum.len() / 4];
+    let mut mask = img.clone();
+    for p in &mut mask.pixels {
+        let m = if p[0] + p[1] + p[2] <= cut { 1.0 } else { 0.0 };
+        *p = [m, m, m, 1.0];
+    }
+    let good = d.join("mask.png");
+    write_png(&good, &mask).unwrap();
+    let bad = d.join("small.png");
+    write_png(&bad, &fieldtex::Image::new(20, 20, [1.0; 4])).unwrap();
+    let solid_run = |mask: &Path, out: &Path| {
+        run(&[
+            "solid",
+            "--mesh",
+            shared().join("meshes/torus.obj").to_str().unwrap(),
+            "--exemplar",
+            bricks.to_str().unwrap(),
+            "--feature-mask",
+            mask.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--resolution",
+            "32",
+            "--atlas-size",
+            "128",
+            "--levels",
+            "3",
+            "--block",
+            "6",
+            "--quiet",
+        ])
+    };
+    let o = solid_run(&bad, &d.join("bad"));
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("small.png") && e.contains("feature mask"), "{e}");
+    let out = d.join("good");
+    let o = solid_run(&good, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = std::fs::read_to_string(out.join("report.json")).unwrap();
+    assert!(report.contains("--feature-mask: the mask"), "the notes name the feature channel");
+}

@@ -21,6 +21,11 @@ pub enum SynthError {
     ExemplarBufferSize { width: usize, height: usize, found: usize },
     #[error("exemplar pixel {index} (x = {x}, y = {y}) has a non-finite channel value {value}")]
     NonFiniteExemplar { index: usize, x: usize, y: usize, value: f32 },
+    #[error(
+        "feature mask of plane {plane} is {}×{} pixels but its exemplar is {}×{}: the mask must match the exemplar pixel for pixel",
+        mask.0, mask.1, exemplar.0, exemplar.1
+    )]
+    FeatureMaskSize { plane: &'static str, mask: (usize, usize), exemplar: (usize, usize) },
     #[error("invalid option {name} = {value}: {reason}")]
     InvalidOption { name: &'static str, value: f64, reason: &'static str },
     #[error(
@@ -50,6 +55,7 @@ impl SynthError {
             | SynthError::ExemplarTooLarge { .. }
             | SynthError::ExemplarBufferSize { .. }
             | SynthError::NonFiniteExemplar { .. }
+            | SynthError::FeatureMaskSize { .. }
             | SynthError::InvalidOption { .. }
             | SynthError::FieldSize { .. }
             | SynthError::NonFiniteField { .. }

@@ -7,7 +7,9 @@
 //! [`super::solid_exemplar`], exemplar `j`'s *column* through `p_j` (its second
 //! coordinate, local axis `j + 1`) must agree with exemplar `j + 1`'s *row* through
 //! `p_{j+1}` (its first coordinate, the same local axis). The crossbar error of a triple
-//! is the sum over `j` of the squared RGB differences of those stick pairs.
+//! is the sum over `j` of the squared differences of those stick pairs' matched values
+//! (RGB, plus the feature channel when the exemplars carry masks:
+//! [`super::solid_exemplar::PlaneLevel::matched`]).
 //!
 //! For each pixel `p` of plane `i` the table keeps the `N_T` triples with `pᵢ = p` of
 //! least crossbar error, best first. Search (coarse to fine, in place of Dong 2008's
@@ -52,15 +54,15 @@ impl CandidateTriples {
     }
 }
 
-/// Row and column sticks of every pixel (`N × 3` floats each).
+/// Row and column sticks of every pixel (`N × ch` floats each).
 struct Sticks {
     rows: Vec<f32>,
     cols: Vec<f32>,
     len: usize,
 }
 
-fn sticks(colors: &[[f32; 3]], w: usize, hgt: usize, h: usize, n: usize) -> Sticks {
-    let len = 3 * n;
+fn sticks(colors: &[[f32; 4]], ch: usize, w: usize, hgt: usize, h: usize, n: usize) -> Sticks {
+    let len = ch * n;
     let half = (n / 2) as i64;
     let mut rows = vec![0.0f32; w * hgt * len];
     let mut cols = vec![0.0f32; w * hgt * len];
@@ -69,8 +71,8 @@ fn sticks(colors: &[[f32; 3]], w: usize, hgt: usize, h: usize, n: usize) -> Stic
         for (k, t) in (-half..=half).enumerate() {
             let xx = (x + t * h as i64).rem_euclid(w as i64) as usize;
             let yy = (y + t * h as i64).rem_euclid(hgt as i64) as usize;
-            r[3 * k..3 * k + 3].copy_from_slice(&colors[y as usize * w + xx]);
-            c[3 * k..3 * k + 3].copy_from_slice(&colors[yy * w + x as usize]);
+            r[ch * k..ch * (k + 1)].copy_from_slice(&colors[y as usize * w + xx][..ch]);
+            c[ch * k..ch * (k + 1)].copy_from_slice(&colors[yy * w + x as usize][..ch]);
         }
     });
     Sticks { rows, cols, len }
@@ -143,19 +145,25 @@ fn nearest(
     best
 }
 
-/// The candidate-triple table of plane `plane` at the level of spacing `h` (module
-/// docs). `levels[j]` is plane `j`'s exemplar and its stack colours at this level.
+/// The candidate-triple table of plane `plane` at level `c` of spacing `h` (module
+/// docs). `planes[j]` is plane `j`'s analysed exemplar.
 pub fn candidate_triples(
-    levels: [(&PlaneExemplar, &[[f32; 3]]); 3],
+    planes: [&PlaneExemplar; 3],
+    c: usize,
     plane: usize,
     h: usize,
     options: &SolidAnalysisOptions,
 ) -> CandidateTriples {
     let n = options.neighbourhood;
-    let st: Vec<Sticks> =
-        levels.iter().map(|(e, colors)| sticks(colors, e.width, e.height, h, n)).collect();
+    let st: Vec<Sticks> = planes
+        .iter()
+        .map(|e| {
+            let l = &e.levels[c];
+            sticks(&l.matched, l.channels, e.width, e.height, h, n)
+        })
+        .collect();
     let (i, j, k) = (plane, (plane + 1) % 3, (plane + 2) % 3);
-    let (ei, ej, ek) = (levels[i].0, levels[j].0, levels[k].0);
+    let (ei, ej, ek) = (planes[i], planes[j], planes[k]);
     let pool_j = pool(ej.width, ej.height, options.pool);
     let pool_k = pool(ek.width, ek.height, options.pool);
     let (dj, dk) = ((ej.width, ej.height), (ek.width, ek.height));

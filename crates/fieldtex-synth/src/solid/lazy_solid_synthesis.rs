@@ -78,8 +78,9 @@ pub struct SolidSynthesisOptions {
     /// The correction samples its neighbourhoods by trilinear interpolation on this many
     /// coarsest levels and by the nearest voxel below them (paper E §4.3). Default 3.
     pub trilinear_levels: usize,
-    /// On this many coarsest levels (at most `trilinear_levels`) the neighbourhood
-    /// sample positions are integrated along the field (module docs). Default 2.
+    /// On this many coarsest levels the neighbourhood sample positions are integrated
+    /// along the field (module docs); sampled trilinearly on the `trilinear_levels`
+    /// coarsest, at the nearest voxel below. Default 2.
     pub integrate_levels: usize,
     pub seed: u64,
 }
@@ -340,6 +341,27 @@ impl<'a> SolidSynthesizer<'a> {
             let col = self.exemplar.color(p, c, t[p][0], t[p][1]);
             for ch in 0..3 {
                 acc[ch] += w[p] * col[ch];
+            }
+        }
+        let total = w[0] + w[1] + w[2];
+        acc.map(|v| v / total)
+    }
+
+    /// Plane-weighted mean of the three level-`c` matched values at `t` (RGB, and the
+    /// feature channel when the exemplars carry masks): what the correction's voxel
+    /// neighbourhoods compare. Its RGB part equals [`Self::triple_color`].
+    #[inline]
+    pub fn triple_matched(&self, c: usize, t: &Triple) -> [f32; 4] {
+        let w = self.exemplar.options.plane_weights;
+        let ch = self.exemplar.channels();
+        let mut acc = [0.0f32; 4];
+        for p in 0..3 {
+            if w[p] == 0.0 {
+                continue;
+            }
+            let m = self.exemplar.matched(p, c, t[p][0], t[p][1]);
+            for k in 0..ch {
+                acc[k] += w[p] * m[k];
             }
         }
         let total = w[0] + w[1] + w[2];

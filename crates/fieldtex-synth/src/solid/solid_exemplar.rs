@@ -13,6 +13,15 @@
 //!   here [`SolidAnalysisOptions::pca_dims`], default 8);
 //! - the candidate triples ([`super::candidate_triples`]).
 //!
+//! **Feature channel** (paper E §4, for regular exemplars such as bricks, Fig. 16): each
+//! plane may carry a feature mask (grey image, high on the feature curves — mortar
+//! lines), stacked like the colours and appended, times
+//! [`SolidAnalysisOptions::feature_weight`], as a fourth *matched* channel: the PCA
+//! neighbourhoods, the crossbar sticks of the triple search and the correction's voxel
+//! neighbourhoods all compare RGB + feature ([`PlaneLevel::matched`]); the voxel colour
+//! stays the RGB mean (the mask is matched, never shown). Without masks the matched
+//! vectors are the three colour channels and every computation is the RGB one.
+//!
 //! Identical exemplars share one analysis: the triple search is symmetric under the
 //! cyclic exchange of the planes, so one table serves all three.
 
@@ -45,6 +54,9 @@ pub struct SolidAnalysisOptions {
     /// suggests dropping or down-weighting the third plane when the exemplars cannot
     /// all hold in one solid (stripes, wood grain).
     pub plane_weights: [f32; 3],
+    /// Weight of the feature-mask channel (mask values in `[0, 1]`) against the colour
+    /// channels when masks are given ([`SolidExemplar::with_features`]). Default 1.
+    pub feature_weight: f32,
 }
 
 impl Default for SolidAnalysisOptions {
@@ -57,6 +69,7 @@ impl Default for SolidAnalysisOptions {
             pool: 1024,
             max_size: 512,
             plane_weights: [1.0; 3],
+            feature_weight: 1.0,
         }
     }
 }
@@ -66,11 +79,17 @@ impl Default for SolidAnalysisOptions {
 pub struct PlaneLevel {
     /// Stack colours, `W × H` RGB (sRGB-encoded, as stored).
     pub colors: Vec<[f32; 3]>,
-    /// PCA basis of `N × N × 3` neighbourhoods.
+    /// The matched values per pixel: RGB and, with a feature mask, the stacked mask
+    /// times [`SolidAnalysisOptions::feature_weight`] (else 0); the first
+    /// [`Self::channels`] entries are compared.
+    pub matched: Vec<[f32; 4]>,
+    /// Matched channels: 3 (RGB) or 4 (RGB + feature).
+    pub channels: usize,
+    /// PCA basis of `N × N × channels` neighbourhoods.
     pub pca: Pca,
     /// Projected neighbourhood per pixel, `W × H × pca_dims`.
     pub appearance: Vec<f32>,
-    /// The PCA components as `f32`, `pca_dims × (N² · 3)` row-major, and
+    /// The PCA components as `f32`, `pca_dims × (N² · channels)` row-major, and
     /// `bias[j] = components[j] · mean`: the projection is `basis x − bias`.
     pub basis: Vec<f32>,
     pub bias: Vec<f32>,
@@ -110,7 +129,59 @@ impl SolidExemplar {
         options: &SolidAnalysisOptions,
         progress: &dyn Progress,
     ) -> Result<Self, SynthError> {
+        Self::with_features(exemplars, [None, None, None], options, progress)
+    }
+
+    /// Analyses `exemplars` (xy, yz, zx) with a feature mask per plane (module docs):
+    /// all three or none; each the size of its exemplar, its grey value (mean of RGB)
+    /// in `[0, 1]`.
+    pub fn with_features(
+        exemplars: [&Image; 3],
+        masks: [Option<&Image>; 3],
+        options: &SolidAnalysisOptions,
+        progress: &dyn Progress,
+    ) -> Result<Self, SynthError> {
         let t0 = std::time::Instant::now();
+        let given = masks.iter().filter(|m| m.is_some()).count();
+        if given != 0 && given != 3 {
+            return Err(SynthError::InvalidOption {
+                name: "SolidExemplar::with_features masks",
+                value: given as f64,
+                reason: "give a feature mask for all three planes or for none",
+            });
+        }
+        let fw = options.feature_weight;
+        if !(fw.is_finite() && fw >= 0.0) {
+            return Err(SynthError::InvalidOption {
+                name: "SolidAnalysisOptions::feature_weight",
+                value: fw as f64,
+                reason: "must be finite and ≥ 0",
+            });
+        }
+        for p in 0..3 {
+            if let Some(m) = masks[p] {
+                let e = exemplars[p];
+                if m.width != e.width || m.height != e.height || m.pixels.len() != e.pixels.len() {
+                    return Err(SynthError::FeatureMaskSize {
+                        plane: ["xy", "yz", "zx"][p],
+                        mask: (m.width, m.height),
+                        exemplar: (e.width, e.height),
+                    });
+                }
+                if let Some((index, v)) =
+                    m.pixels.iter().enumerate().find_map(|(i, px)| {
+                        px.iter().take(3).find(|v| !v.is_finite()).map(|v| (i, *v))
+                    })
+                {
+                    return Err(SynthError::NonFiniteExemplar {
+                        index,
+                        x: index % m.width.max(1),
+                        y: index / m.width.max(1),
+                        value: v,
+                    });
+                }
+            }
+        }
         if options.neighbourhood < 3
             || options.neighbourhood.is_multiple_of(2)
             || options.neighbourhood > 15
@@ -148,15 +219,22 @@ impl SolidExemplar {
             });
         }
         let same = |a: &Image, b: &Image| std::ptr::eq(a, b) || a == b;
+        let same_mask = |a: Option<&Image>, b: Option<&Image>| match (a, b) {
+            (None, None) => true,
+            (Some(a), Some(b)) => same(a, b),
+            _ => false,
+        };
         progress.stage("solid exemplar analysis", 3 * options.levels as u64);
         let mut planes: Vec<Arc<PlaneExemplar>> = Vec::with_capacity(3);
         for p in 0..3 {
-            if let Some(q) = (0..p).find(|&q| same(exemplars[q], exemplars[p])) {
+            if let Some(q) =
+                (0..p).find(|&q| same(exemplars[q], exemplars[p]) && same_mask(masks[q], masks[p]))
+            {
                 let shared = planes[q].clone();
                 planes.push(shared);
                 continue;
             }
-            planes.push(Arc::new(analyse_plane(exemplars[p], options)?));
+            planes.push(Arc::new(analyse_plane(exemplars[p], masks[p], options)?));
         }
         let planes: [Arc<PlaneExemplar>; 3] =
             [planes[0].clone(), planes[1].clone(), planes[2].clone()];
@@ -167,9 +245,8 @@ impl SolidExemplar {
         let mut triples = Vec::with_capacity(options.levels);
         for c in 0..options.levels {
             let h = 1usize << c;
-            let levels: [(&PlaneExemplar, &[[f32; 3]]); 3] =
-                std::array::from_fn(|p| (&*planes[p], &planes[p].levels[c].colors[..]));
-            let t0 = Arc::new(candidate_triples(levels, 0, h, options));
+            let levels: [&PlaneExemplar; 3] = std::array::from_fn(|p| &*planes[p]);
+            let t0 = Arc::new(candidate_triples(levels, c, 0, h, options));
             progress.advance(1);
             let row = if all_same {
                 // Cyclic symmetry: plane p's table is plane 0's with the coordinates
@@ -188,8 +265,8 @@ impl SolidExemplar {
                 let (t1, t2) = (turned(1), turned(2));
                 [t0, t1, t2]
             } else {
-                let t1 = Arc::new(candidate_triples(levels, 1, h, options));
-                let t2 = Arc::new(candidate_triples(levels, 2, h, options));
+                let t1 = Arc::new(candidate_triples(levels, c, 1, h, options));
+                let t2 = Arc::new(candidate_triples(levels, c, 2, h, options));
                 [t0, t1, t2]
             };
             progress.advance(2);
@@ -212,10 +289,26 @@ impl SolidExemplar {
         let yi = y.rem_euclid(e.height as i32) as usize;
         e.levels[c].colors[yi * e.width + xi]
     }
+
+    /// Level-`c` matched values (RGB + weighted feature, [`PlaneLevel::matched`]) of
+    /// plane `p` at pixel `(x, y)` (wrapped).
+    #[inline]
+    pub fn matched(&self, p: usize, c: usize, x: i32, y: i32) -> [f32; 4] {
+        let e = &self.planes[p];
+        let xi = x.rem_euclid(e.width as i32) as usize;
+        let yi = y.rem_euclid(e.height as i32) as usize;
+        e.levels[c].matched[yi * e.width + xi]
+    }
+
+    /// Matched channels: 4 with feature masks, else 3.
+    pub fn channels(&self) -> usize {
+        self.planes[0].levels[0].channels
+    }
 }
 
 fn analyse_plane(
     image: &Image,
+    mask: Option<&Image>,
     options: &SolidAnalysisOptions,
 ) -> Result<PlaneExemplar, SynthError> {
     let (w, h) = (image.width, image.height);
@@ -239,28 +332,52 @@ fn analyse_plane(
         }
     }
     let mut colors: Vec<[f32; 3]> = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    // The mask's grey value, stacked with the same filter as the colours (in channel 0).
+    let mut feature: Option<Vec<[f32; 3]>> = mask.map(|m| {
+        m.pixels.iter().map(|p| [((p[0] + p[1] + p[2]) / 3.0).clamp(0.0, 1.0), 0.0, 0.0]).collect()
+    });
+    let channels = if feature.is_some() { 4 } else { 3 };
     let mut levels = Vec::with_capacity(options.levels);
     for c in 0..options.levels {
         if c > 0 {
             colors = next_stack_level(&colors, w, h, c);
+            feature = feature.map(|f| next_stack_level(&f, w, h, c));
         }
-        let (pca, appearance) = neighbourhood_pca(&colors, w, h, 1 << c, options, c)?;
+        let matched: Vec<[f32; 4]> = match &feature {
+            Some(f) => colors
+                .iter()
+                .zip(f)
+                .map(|(col, m)| [col[0], col[1], col[2], options.feature_weight * m[0]])
+                .collect(),
+            None => colors.iter().map(|col| [col[0], col[1], col[2], 0.0]).collect(),
+        };
+        let (pca, appearance) = neighbourhood_pca(&matched, channels, w, h, 1 << c, options, c)?;
         let basis: Vec<f32> = pca.components.iter().flatten().map(|&v| v as f32).collect();
         let bias: Vec<f32> = pca
             .components
             .iter()
             .map(|comp| comp.iter().zip(&pca.mean).map(|(a, b)| a * b).sum::<f64>() as f32)
             .collect();
-        levels.push(PlaneLevel { colors: colors.clone(), pca, appearance, basis, bias });
+        levels.push(PlaneLevel {
+            colors: colors.clone(),
+            matched,
+            channels,
+            pca,
+            appearance,
+            basis,
+            bias,
+        });
     }
     Ok(PlaneExemplar { width: w, height: h, levels })
 }
 
-/// The `N × N × 3` neighbourhood of `(x, y)` sampled `h` apart into `out`; the first
-/// pixel coordinate varies fastest (`out[3 (N t + s) + ch]` for offsets `(s, t)`).
+/// The `N × N × ch` neighbourhood of `(x, y)` sampled `h` apart into `out` (the first
+/// `ch` matched channels); the first pixel coordinate varies fastest
+/// (`out[ch (N t + s) + k]` for offsets `(s, t)`).
 #[allow(clippy::too_many_arguments)]
 pub fn exemplar_neighbourhood(
-    colors: &[[f32; 3]],
+    colors: &[[f32; 4]],
+    ch: usize,
     w: usize,
     hgt: usize,
     h: usize,
@@ -275,14 +392,15 @@ pub fn exemplar_neighbourhood(
         let yy = (y as i64 + t * h as i64).rem_euclid(hgt as i64) as usize;
         for s in -half..=half {
             let xx = (x as i64 + s * h as i64).rem_euclid(w as i64) as usize;
-            out[k..k + 3].copy_from_slice(&colors[yy * w + xx]);
-            k += 3;
+            out[k..k + ch].copy_from_slice(&colors[yy * w + xx][..ch]);
+            k += ch;
         }
     }
 }
 
 fn neighbourhood_pca(
-    colors: &[[f32; 3]],
+    colors: &[[f32; 4]],
+    ch: usize,
     w: usize,
     hgt: usize,
     h: usize,
@@ -290,20 +408,20 @@ fn neighbourhood_pca(
     level: usize,
 ) -> Result<(Pca, Vec<f32>), SynthError> {
     let n = options.neighbourhood;
-    let dim = n * n * 3;
+    let dim = n * n * ch;
     let count = w * hgt;
     let stride = count.div_ceil(8192).max(1);
     let picks: Vec<usize> = (0..count).step_by(stride).collect();
     let mut samples = vec![0.0f32; picks.len() * dim];
     samples.par_chunks_mut(dim).zip(&picks).for_each(|(row, &p)| {
-        exemplar_neighbourhood(colors, w, hgt, h, n, p % w, p / w, row);
+        exemplar_neighbourhood(colors, ch, w, hgt, h, n, p % w, p / w, row);
     });
     let k = options.pca_dims.min(dim);
     let pca = Pca::fit(&samples, dim, k).map_err(|source| SynthError::Pca { level, source })?;
     let mut appearance = vec![0.0f32; count * k];
     appearance.par_chunks_mut(k).enumerate().for_each(|(p, out)| {
         let mut buf = vec![0.0f32; dim];
-        exemplar_neighbourhood(colors, w, hgt, h, n, p % w, p / w, &mut buf);
+        exemplar_neighbourhood(colors, ch, w, hgt, h, n, p % w, p / w, &mut buf);
         pca.project(&buf, out);
     });
     Ok((pca, appearance))

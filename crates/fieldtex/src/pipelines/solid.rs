@@ -53,6 +53,11 @@ pub struct SolidOptions {
     pub exemplar_xy: Option<PathBuf>,
     pub exemplar_yz: Option<PathBuf>,
     pub exemplar_zx: Option<PathBuf>,
+    /// Feature mask (paper E §4, regular exemplars such as bricks): a grey image the
+    /// size of the exemplar, high on the feature curves (mortar), matched as a fourth
+    /// channel and never shown; transposed for the yz plane like a single `--exemplar`.
+    /// `None` = RGB matching only.
+    pub feature_mask: Option<PathBuf>,
     /// Voxels along the bounding box's longest side. Default 256.
     pub resolution: usize,
     /// Cut planes `[x, y, z, nx, ny, nz]`.
@@ -86,6 +91,7 @@ impl Default for SolidOptions {
             exemplar_xy: None,
             exemplar_yz: None,
             exemplar_zx: None,
+            feature_mask: None,
             resolution: 256,
             cuts: Vec::new(),
             volume: false,
@@ -229,9 +235,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     // 2. Exemplar analysis and the synthesizer.
     let ex = report
         .stage(progress, "exemplar_analysis", || {
-            SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
-        })
-        .map_err(|e| Error::classify(&e, None, "exemplar"))?;
+            analyse_exemplars(options, &exemplars, single, &analysis, progress)
+        })?;
     let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
     report.metric("grid", grid);
     let frames = FieldFrames(field.as_ref());
@@ -392,6 +397,32 @@ pub(crate) fn read_exemplars(options: &SolidOptions) -> Result<([Image; 3], bool
         out[1] = transpose(&out[0]);
     }
     Ok(([out[0].clone(), out[1].clone(), out[2].clone()], single))
+}
+
+/// The exemplar analysis of `exemplars` (from [`read_exemplars`]), with the feature
+/// masks of `options.feature_mask` when given: the one mask for every plane, transposed
+/// for the yz plane when `single` (as the exemplar is).
+pub(crate) fn analyse_exemplars(
+    options: &SolidOptions,
+    exemplars: &[Image; 3],
+    single: bool,
+    analysis: &SolidAnalysisOptions,
+    progress: &dyn Progress,
+) -> Result<SolidExemplar> {
+    let planes = [&exemplars[0], &exemplars[1], &exemplars[2]];
+    let Some(path) = &options.feature_mask else {
+        return SolidExemplar::new(planes, analysis, progress)
+            .map_err(|e| Error::classify(&e, None, "exemplar"));
+    };
+    let mask = fieldtex_io::read_image(path)?;
+    let turned = if single { transpose(&mask) } else { mask.clone() };
+    SolidExemplar::with_features(
+        planes,
+        [Some(&mask), Some(&turned), Some(&mask)],
+        analysis,
+        progress,
+    )
+    .map_err(|e| Error::classify(&e, Some(path), "feature mask"))
 }
 
 /// The image mirrored about its main diagonal (`(x, y)` → `(y, x)`).
@@ -570,15 +601,20 @@ fn notes(options: &SolidOptions) -> Vec<String> {
     let mut n = vec![
         "candidate triples: the partners of each pixel are searched coarse to fine (brute force over a regular sub-grid pool of the other exemplars, SolidAnalysisOptions::pool, then every pixel of the pool cells around the best hits), not Dong 2008's exhaustive search; Dong's neighbour-consistency test is not applied".to_string(),
         format!(
-            "correction neighbourhoods are sampled by trilinear interpolation on the {} coarsest levels and at the nearest voxel below them, as the paper; the paper's numerical integration along the field on coarse levels is not implemented (the centre voxel's frame spans the neighbourhood)",
-            options.synthesis.trilinear_levels
+            "correction neighbourhoods are sampled by trilinear interpolation on the {} coarsest levels and at the nearest voxel below them, as the paper; on the {} coarsest levels the sample positions are integrated along the field (unit Euler steps), below them the centre voxel's frame spans the neighbourhood",
+            options.synthesis.trilinear_levels, options.synthesis.integrate_levels
         ),
         format!(
             "neighbourhood N = {} on every level and {} PCA dimensions per plane (the paper: N = 7 coarse / 9 fine, about 20 dimensions)",
             options.analysis.neighbourhood, options.analysis.pca_dims
         ),
         "the coarsest level uses the same block (dual-grid) scheme as the others, with more passes, so that every level is lazy; the paper corrects the whole coarsest level without barriers".to_string(),
-        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple; no feature channel (bricks) is implemented".to_string(),
+        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple".to_string(),
+        if options.feature_mask.is_some() {
+            "--feature-mask: the mask (grey value, stacked like the colours, times --feature-weight) is matched as a fourth channel in the PCA neighbourhoods, the crossbar sticks of the triple search and the correction's voxel neighbourhoods, and never shown (paper E §4); the same mask serves every plane, transposed for yz with one --exemplar; a detected mask is not implemented (give it)".to_string()
+        } else {
+            "no feature mask: matching is RGB only (--feature-mask adds the paper's fourth channel for regular exemplars such as bricks)".to_string()
+        },
         "the surface texture interpolates the eight voxels around each texel's surface point (trilinear)".to_string(),
     ];
     if options.interior.is_some() {

@@ -21,8 +21,8 @@
 //! synthesised (nothing here needs it).
 
 use super::solid::{
-    CutVoxels, FieldFrames, SolidGrid, SolidOptions, SolidRegions, Work, cut_voxels,
-    read_exemplars, read_inputs, sketch_frame_field, slice_image,
+    CutVoxels, FieldFrames, SolidGrid, SolidOptions, SolidRegions, Work, analyse_exemplars,
+    cut_voxels, read_exemplars, read_inputs, sketch_frame_field, slice_image,
 };
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, Warning};
@@ -126,9 +126,7 @@ impl SolidSession {
         };
         let ids = field.as_ref().map_or(Vec::new(), |f| f.curve_ids());
         crate::outputs::check_cancelled(progress)?;
-        let exemplar =
-            SolidExemplar::new([&exemplars[0], &exemplars[1], &exemplars[2]], &analysis, progress)
-                .map_err(|e| Error::classify(&e, None, "exemplar"))?;
+        let exemplar = analyse_exemplars(options, &exemplars, single, &analysis, progress)?;
         let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
         let bvh = Bvh::build(&mesh).map_err(|e| Error::internal("bvh", e))?;
         let session = Self {

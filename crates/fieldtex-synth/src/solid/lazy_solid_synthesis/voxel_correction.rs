@@ -24,8 +24,8 @@ impl SolidSynthesizer<'_> {
         let mut counts = Counts { corrections: 0, evaluations: 0 };
         let idx = |x: i32, y: i32, z: i32| ((z * s + y) * s + x) as usize;
         if passes > 0 {
-            let mut colors: Vec<[f32; 3]> =
-                region.iter().map(|t| self.triple_color(c, t)).collect();
+            let mut colors: Vec<[f32; 4]> =
+                region.iter().map(|t| self.triple_matched(c, t)).collect();
             let mut frames = Vec::with_capacity((m * m * m) as usize);
             for z in 0..m {
                 for y in 0..m {
@@ -72,7 +72,7 @@ impl SolidSynthesizer<'_> {
                     }
                     for &(i, t) in &updates {
                         region[i] = t;
-                        colors[i] = self.triple_color(c, &t);
+                        colors[i] = self.triple_matched(c, &t);
                     }
                 }
             }
@@ -135,7 +135,7 @@ impl SolidSynthesizer<'_> {
         &self,
         c: usize,
         region: &[Triple],
-        colors: &[[f32; 3]],
+        colors: &[[f32; 4]],
         s: i32,
         at: [i32; 3],
         g: [i32; 3],
@@ -145,13 +145,15 @@ impl SolidSynthesizer<'_> {
         let n = self.exemplar.options.neighbourhood as i32;
         let half = n / 2;
         let h = 1i32 << c;
+        // Matched channels: RGB, and the feature channel with masks.
+        let ch = self.exemplar.channels();
         let idx = |p: [i32; 3]| ((p[2] * s + p[1]) * s + p[0]) as usize;
         let current = region[idx(at)];
         scratch.candidates.clear();
         scratch.candidates.push(current);
         let weights = self.exemplar.options.plane_weights;
         let trilinear = c + self.options.trilinear_levels >= self.cache.len();
-        let integrate = trilinear && c + self.options.integrate_levels >= self.cache.len();
+        let integrate = c + self.options.integrate_levels >= self.cache.len();
         // Integrated samples stay where trilinear interpolation has both corners.
         let reach = self.halo() as f32;
         for p in 0..3 {
@@ -196,7 +198,7 @@ impl SolidSynthesizer<'_> {
                         let cell =
                             base + ((fl[2] as i32 * s + fl[1] as i32) * s + fl[0] as i32) as isize;
                         let lo = fr.map(|f| 1.0 - f);
-                        let mut acc = [0.0f32; 3];
+                        let mut acc = [0.0f32; 4];
                         for corner in 0..8 {
                             let (cx, cy, cz) = (corner & 1, (corner >> 1) & 1, corner >> 2);
                             let wx = if cx == 1 { fr[0] } else { lo[0] };
@@ -205,25 +207,33 @@ impl SolidSynthesizer<'_> {
                             let wt = wx * wy * wz;
                             let at = cell + ((cz * s + cy) * s + cx) as isize;
                             let col = &colors[at as usize];
-                            for ch in 0..3 {
-                                acc[ch] += wt * col[ch];
+                            for k in 0..ch {
+                                acc[k] += wt * col[k];
                             }
                         }
-                        scratch.buf[3 * j..3 * j + 3].copy_from_slice(&acc);
+                        scratch.buf[ch * j..ch * (j + 1)].copy_from_slice(&acc[..ch]);
                         j += 1;
                     }
                 }
+            } else if weights[p] > 0.0 && integrate {
+                // Nearest voxel to each integrated sample position (clamped to the halo).
+                self.integrated_offsets(c, g, (a1, a2), &mut scratch.row, &mut scratch.path);
+                for j in 0..(n * n) as usize {
+                    let d = scratch.path[j].map(|x| round_i32(x.clamp(-reach, reach)));
+                    let o = base + ((d[2] * s + d[1]) * s + d[0]) as isize;
+                    scratch.buf[ch * j..ch * (j + 1)].copy_from_slice(&colors[o as usize][..ch]);
+                }
             } else if weights[p] > 0.0 {
                 for (j, &o) in scratch.offsets[..(n * n) as usize].iter().enumerate() {
-                    scratch.buf[3 * j..3 * j + 3].copy_from_slice(&colors[o as usize]);
+                    scratch.buf[ch * j..ch * (j + 1)].copy_from_slice(&colors[o as usize][..ch]);
                 }
             }
             let dims = if weights[p] > 0.0 { lvl.dims() } else { 0 };
-            let dim = scratch.buf.len();
+            let dim = (n * n) as usize * ch;
             for j in 0..dims {
                 let row = &lvl.basis[j * dim..(j + 1) * dim];
                 let mut acc = 0.0f32;
-                for (a, b) in row.iter().zip(&scratch.buf) {
+                for (a, b) in row.iter().zip(&scratch.buf[..dim]) {
                     acc += a * b;
                 }
                 scratch.proj[p][j] = acc - lvl.bias[j];
@@ -290,7 +300,7 @@ impl Scratch {
     fn new(e: &SolidExemplar) -> Self {
         let n = e.options.neighbourhood;
         Self {
-            buf: vec![0.0; n * n * 3],
+            buf: vec![0.0; n * n * e.channels()],
             offsets: vec![0; n * n],
             proj: [[0.0; 32]; 3],
             candidates: Vec::with_capacity(64),
