@@ -43,6 +43,7 @@ pub mod color_lookup;
 pub mod domain;
 mod error;
 pub mod exemplar_analysis;
+mod exemplar_level;
 pub mod exemplar_policy;
 pub mod exemplar_scales;
 pub mod flip_combing;

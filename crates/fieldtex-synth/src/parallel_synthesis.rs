@@ -71,9 +71,10 @@ use rayon::prelude::*;
 
 use crate::color_lookup::color_lookup;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
+use crate::exemplar_level::{ExemplarLevel, NV, NvEntry, dist_nv};
 use crate::flip_combing::comb_flips;
 use crate::lattice_domain::{
-    CORNERS, Dim, LatticeDomain, PlanarDomain, Stencil, frobenius, mat_vec, mean, negated,
+    Dim, LatticeDomain, PlanarDomain, Stencil, frobenius, mat_vec, mean, negated,
 };
 use crate::level_tables::{LevelTables, NONE, tabulate};
 pub use crate::synthesis_options::SynthesisOptions;
@@ -100,122 +101,6 @@ pub struct SynthesisResult {
 pub(crate) const fn max_candidates(s: usize) -> usize {
     s * (1 + MAX_K) + MAX_K
 }
-/// Lanes of a four-corner neighbourhood vector: 4 corners × [`APPEARANCE_DIMS`].
-const NV: usize = 4 * APPEARANCE_DIMS;
-
-/// Squared distance between a quantised neighbourhood vector `a` and a target `t` given
-/// in units of `a / 6`, over the lanes whose mask is `−1` (exact integer arithmetic:
-/// `|6a − t| ≤ 1524`, 32 squares fit `i32` easily). Written so that it vectorises
-/// (`pmaddwd`).
-#[inline]
-fn dist_nv(a: &[i8; NV], t: &[i16; NV], mask: &[i16; NV]) -> i32 {
-    let mut acc = 0i32;
-    for i in 0..NV {
-        let d = ((a[i] as i16) * 6 - t[i]) & mask[i];
-        acc += d as i32 * d as i32;
-    }
-    acc
-}
-
-/// The exemplar side of one level.
-struct ExemplarLevel {
-    w: usize,
-    h: usize,
-    wf: f32,
-    hf: f32,
-    /// Four-corner neighbourhood vectors of every pixel for `[Ẽ₀, Ẽ₁]`: `nv[f][pix]`
-    /// holds, for corner `ci` of [`CORNERS`] in lanes `8 ci .. 8 ci + 8`, the quantised
-    /// appearance `Ẽ_f[pix + (−1)^f h Δ_ci]` (toroidal). One 32-byte load per candidate.
-    nv: [Vec<[i8; NV]>; 2],
-    /// k-coherence targets as pixel coordinates (`W × H × k_store`).
-    coherence: Vec<[f32; 2]>,
-    k_store: usize,
-    /// Valid pixel range `[margin, W − margin) × [margin, H − margin)`.
-    x_lo: usize,
-    x_hi: usize,
-    y_lo: usize,
-    y_hi: usize,
-}
-
-#[inline]
-fn wrap1(v: f32, size: f32) -> f32 {
-    let r = if v < 0.0 {
-        v + size
-    } else if v >= size {
-        v - size
-    } else {
-        return v;
-    };
-    if (0.0..size).contains(&r) {
-        return r;
-    }
-    let r = v.rem_euclid(size);
-    if r >= size || r.is_nan() { 0.0 } else { r }
-}
-
-impl ExemplarLevel {
-    fn new(analysis: &ExemplarAnalysis, level: usize, rosy: bool) -> Self {
-        let an = analysis.level(level);
-        let (w, h) = (analysis.width(), analysis.height());
-        let sp = an.spacing as i64;
-        let wrap_i = |v: i64, n: usize| v.rem_euclid(n as i64) as usize;
-        // Neighbourhood vectors (the flipped copy only when the 2-RoSy fix needs it).
-        let nv_of = |f: usize| -> Vec<[i8; NV]> {
-            let app = &an.appearance_q.data[f];
-            let sign = if f == 1 { -1 } else { 1 };
-            let mut out = vec![[0i8; NV]; w * h];
-            out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-                for (x, o) in row.iter_mut().enumerate() {
-                    for (ci, c) in CORNERS.iter().enumerate() {
-                        let cx = wrap_i(x as i64 + sign * c[0] as i64 * sp, w);
-                        let cy = wrap_i(y as i64 + sign * c[1] as i64 * sp, h);
-                        o[ci * APPEARANCE_DIMS..(ci + 1) * APPEARANCE_DIMS]
-                            .copy_from_slice(&app[cy * w + cx]);
-                    }
-                }
-            });
-            out
-        };
-        Self {
-            w,
-            h,
-            wf: w as f32,
-            hf: h as f32,
-            nv: [nv_of(0), if rosy { nv_of(1) } else { Vec::new() }],
-            coherence: an
-                .coherence
-                .iter()
-                .map(|&v| [(v as usize % w) as f32, (v as usize / w) as f32])
-                .collect(),
-            k_store: analysis.k(),
-            x_lo: an.margin.min(w / 2),
-            x_hi: w - an.margin.min(w / 2),
-            y_lo: an.margin.min(h / 2),
-            y_hi: h - an.margin.min(h / 2),
-        }
-    }
-
-    #[inline]
-    fn wrap(&self, u: [f32; 2]) -> [f32; 2] {
-        [wrap1(u[0], self.wf), wrap1(u[1], self.hf)]
-    }
-
-    /// Column and row of a wrapped coordinate.
-    #[inline]
-    fn cell(&self, u: [f32; 2]) -> (usize, usize) {
-        // `u` is wrapped (non-negative, finite): the i32 conversion is the floor and a
-        // single instruction, unlike the one to usize.
-        ((u[0] as i32 as usize).min(self.w - 1), (u[1] as i32 as usize).min(self.h - 1))
-    }
-
-    /// Pixel of a wrapped coordinate.
-    #[inline]
-    fn pixel(&self, u: [f32; 2]) -> usize {
-        let (x, y) = self.cell(u);
-        y * self.w + x
-    }
-}
-
 /// Per-level synthesis context on a `D`-dimensional lattice with `S` neighbours and room
 /// for `C` ([`max_candidates`]`(S)`) candidates.
 struct Pass<'a, const D: usize, const S: usize, const C: usize> {
@@ -272,6 +157,9 @@ where
                 continue;
             }
             let q = q as usize;
+            if self.k > 0 {
+                ex.prefetch_coherence(s[q]);
+            }
             let (mut fq, alpha) = if self.rosy {
                 let jq = self.t.jac[q];
                 let cons = frobenius(&jq, &jp) < 0.0;
@@ -307,7 +195,7 @@ where
                     continue;
                 }
                 let (u, a, _) = pred[t];
-                let v = &ex.nv[a as usize][ex.pixel(u)][lanes.clone()];
+                let v = &ex.nv[a as usize][ex.pixel(u)].0[lanes.clone()];
                 for (o, &x) in tc.iter_mut().zip(v) {
                     *o += x as i16;
                 }
@@ -325,7 +213,7 @@ where
         let current_d = {
             let (x, y) = ex.cell(current.0);
             if x >= ex.x_lo && x < ex.x_hi && y >= ex.y_lo && y < ex.y_hi {
-                let d = dist_nv(&ex.nv[current.1 as usize][y * ex.w + x], &target, &mask);
+                let d = dist_nv(&ex.nv[current.1 as usize][y * ex.w + x].0, &target, &mask);
                 if d == 0 {
                     return current;
                 }
@@ -337,7 +225,7 @@ where
         // Gather the eligible candidates (coordinates outside the level's margin band
         // are not), then score them in one branch-free sweep whose table loads overlap.
         let mut cand_u = [[0.0f32; 2]; C];
-        let mut cand_nv: [&[i8; NV]; C] = [&ex.nv[0][0]; C];
+        let mut cand_nv: [&NvEntry; C] = [&ex.nv[0][0]; C];
         let mut cand_b = [false; C];
         let mut n = 0usize;
         let mut push = |u: [f32; 2], b: bool| {
@@ -380,7 +268,7 @@ where
         }
         let mut dist = [0i32; C];
         for (d, a) in dist[..n].iter_mut().zip(&cand_nv[..n]) {
-            *d = dist_nv(a, &target, &mask);
+            *d = dist_nv(&a.0, &target, &mask);
         }
         // The smallest distance wins; ties keep the earlier candidate (the current
         // value first), so repeated candidates change nothing.

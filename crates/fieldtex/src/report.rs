@@ -77,7 +77,48 @@ impl Report {
         self.timings_ms.extend(timings.entries().into_iter().map(|t| (t.name, t.ms)));
     }
 
+    /// Appends the timings, metrics, warnings and notes of `part` (a report a stage kept
+    /// while running beside another, e.g. `orient`'s field design and exemplar analysis)
+    /// in its order: merging the parts in the order the stages ran serially before gives
+    /// the same report.
+    pub(crate) fn absorb(&mut self, part: Report) {
+        self.timings_ms.extend(part.timings_ms);
+        if let (Value::Object(m), Value::Object(p)) = (&mut self.metrics, part.metrics) {
+            m.extend(p);
+        }
+        self.warnings.extend(part.warnings);
+        self.notes.extend(part.notes);
+    }
+
     pub fn to_json_pretty(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|_| "{}".to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Report;
+
+    /// Parts absorbed in the serial order give the report the serial run would have
+    /// written: timings, metrics, warnings and notes appended in order.
+    #[test]
+    fn absorb_appends_parts_in_order() {
+        let mut serial = Report::new("orient", 1, serde_json::Value::Null);
+        serial.timings_ms.push(("read".into(), 1.0));
+        let mut merged = serial.clone();
+        for (stage, key, note) in [("field_solve", "field_residual", "a"), ("analysis", "x", "b")] {
+            serial.timings_ms.push((stage.into(), 2.0));
+            serial.metric(key, 0.5);
+            serial.notes.push(note.into());
+            let mut part = Report::new("orient", 1, serde_json::Value::Null);
+            part.timings_ms.push((stage.into(), 2.0));
+            part.metric(key, 0.5);
+            part.notes.push(note.into());
+            merged.absorb(part);
+        }
+        assert_eq!(merged.to_json_pretty(), serial.to_json_pretty());
+        let stages: Vec<&str> = merged.timings_ms.iter().map(|(s, _)| s.as_str()).collect();
+        assert_eq!(stages, ["read", "field_solve", "analysis"]);
+        assert_eq!(merged.metrics["field_residual"], 0.5);
     }
 }

@@ -215,21 +215,39 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         "exemplar_size": [exemplar.width * fitted.factor, exemplar.height * fitted.factor],
         "exemplar_reduction": fitted.factor,
     });
-    let (field, designed) = build_field(options, &mut report)?;
+    // The field design (serial: sparse factorisation) and the exemplar analysis do not
+    // depend on each other: they run side by side, each timed in a report part that is
+    // merged in the serial order. Errors keep their serial precedence: the field's, the
+    // output folder's, the analysis's.
+    let part = || Report::new("orient", options.seed, serde_json::Value::Null);
+    let ((field_part, field_report), (analysis, analysis_report)) = rayon::join(
+        || {
+            let mut r = part();
+            (build_field(options, &mut r), r)
+        },
+        || {
+            let mut r = part();
+            let cache = super::synthesis::AnalysisCache::process();
+            (super::synthesis::analyse_exemplar(&exemplar, cache, &mut r, progress), r)
+        },
+    );
+    let (field, designed) = field_part?;
+    report.absorb(field_report);
     let out = begin_outputs(
         out_dir,
         &["texture.png", "field.npy", "coords.npy", "preview.png", "report.json"],
     )?;
     let stage = out.staging();
     let n = options.size;
-    let result = super::synthesis::synthesize_image_result(
-        &exemplar,
+    report.absorb(analysis_report);
+    let analysis = analysis.map_err(|e| e.with_path(&options.exemplar))?;
+    let result = super::synthesis::synthesize_analysed(
+        &analysis,
         &field,
         n,
         n,
         per_pixel,
         options,
-        super::synthesis::AnalysisCache::process(),
         &mut report,
         progress,
     )

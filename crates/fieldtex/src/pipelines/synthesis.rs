@@ -75,6 +75,22 @@ fn analysis_key(exemplar: &Image, options: &AnalysisOptions) -> u64 {
     h
 }
 
+/// The analysis of `exemplar` at the default analysis options, through `cache`, timed
+/// as `analysis` in `report` (with the metric `analysis_cached`).
+pub(crate) fn analyse_exemplar(
+    exemplar: &Image,
+    cache: &AnalysisCache,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<Arc<ExemplarAnalysis>> {
+    let aopts = AnalysisOptions::default();
+    let (analysis, cached) = report
+        .stage(progress, "analysis", || cache.analysis(exemplar, &aopts, progress))
+        .map_err(|e| Error::classify(&e, None, "exemplar"))?;
+    report.metric("analysis_cached", cached);
+    Ok(analysis)
+}
+
 /// Synthesises a `width × height` texture whose exemplar x axis follows `field`, at
 /// `per_pixel` exemplar pixels per output pixel: the whole synthesis result (colours,
 /// the exemplar coordinate of every pixel in exemplar pixels, the flip indicators).
@@ -90,18 +106,29 @@ pub(crate) fn synthesize_image_result(
     report: &mut Report,
     progress: &dyn Progress,
 ) -> Result<fieldtex_synth::SynthesisResult> {
-    let aopts = AnalysisOptions::default();
-    let (analysis, cached) = report
-        .stage(progress, "analysis", || cache.analysis(exemplar, &aopts, progress))
-        .map_err(|e| Error::classify(&e, None, "exemplar"))?;
-    report.metric("analysis_cached", cached);
+    let analysis = analyse_exemplar(exemplar, cache, report, progress)?;
+    synthesize_analysed(&analysis, field, width, height, per_pixel, options, report, progress)
+}
+
+/// [`synthesize_image_result`] from an analysis already made ([`analyse_exemplar`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn synthesize_analysed(
+    analysis: &ExemplarAnalysis,
+    field: &[[f32; 2]],
+    width: usize,
+    height: usize,
+    per_pixel: f64,
+    options: &OrientOptions,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<fieldtex_synth::SynthesisResult> {
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     let domain = ImageDomain::from_direction_field(width, height, &flat, per_pixel as f32)
         .map_err(|e| Error::internal("synthesis domain", e))?;
     let sopts =
         SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };
     let result = report
-        .stage(progress, "synthesis", || synthesize(&analysis, &domain, &sopts, progress))
+        .stage(progress, "synthesis", || synthesize(analysis, &domain, &sopts, progress))
         .map_err(|e| Error::internal("synthesis", e))?;
     Ok(result)
 }
