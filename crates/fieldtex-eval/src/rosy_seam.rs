@@ -331,7 +331,9 @@ pub fn rosy_seam_coherence_with_flips(
 /// pixel from the nearest pixel of a forced-seam pair (horizontal or vertical
 /// neighbours whose effective frames `(−1)^I u` point in opposite directions), by a
 /// breadth-first sweep over the 8-neighbours. `unit` gives the unit field vector
-/// (`None`: skipped pixel).
+/// (`None`: skipped pixel). Not `fieldtex_features::distance_transform` (exact
+/// Euclidean, Felzenszwalb & Huttenlocher 2012): eval does not depend on that crate, and
+/// the control needs only capped integer buckets.
 fn forced_seam_distance(
     w: usize,
     h: usize,
