@@ -541,7 +541,7 @@ mod tests {
         let f = split_field();
         let fv = FieldView::new(&f, N, N).unwrap();
         let mut c = coords(1.0, [10.0, 20.0]);
-        for i in (0..N * N).filter(|i| i % N >= 27 && i % 5 == 0) {
+        for i in (0..N * N).filter(|i| i % N >= 27 && i.is_multiple_of(5)) {
             c[2 * i] = (c[2 * i] + 57.0).rem_euclid(EX as f32);
         }
         let flips: Vec<bool> = (0..N * N).map(|i| (i % N >= N / 2) != (i % N < 10)).collect();
