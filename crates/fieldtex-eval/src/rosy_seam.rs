@@ -53,6 +53,21 @@
 //! synthesis; where they are far apart (loops, whorl), combing moves the forced seam
 //! off the representation jump and the plain ratio is high.
 //!
+//! **Distance-matched control** ([`SeamSubset::local_share`], repaired jumps only): the
+//! image-wide share is a fair yardstick only when the jump pairs sit in ordinary parts
+//! of the texture. Near a forced seam no synthesis is coherent (its neighbourhoods
+//! straddle a point reflection), and on the tented arch the repaired pairs lie on the
+//! same short segment as the forced seam. So the repaired pairs are also compared with
+//! the *control* pairs (no representation jump, effective frames agree) at the same
+//! distance from the forced seam: with `d(p)` the Chebyshev distance (output pixels,
+//! capped at [`LOCAL_DISTANCE_CAP`]; farther counts as one bucket) from the nearest
+//! pixel of an effective-seam pair, and a pair's distance `min(d(p), d(q))`, the
+//! control share is `Σ_b n_rep(b) · share_ctrl(b) / Σ_b n_rep(b)` over the distance
+//! buckets `b` that have control pairs. `local_ratio` = repaired share / that: ≈ 1
+//! when the repaired jumps are as coherent as their surroundings, i.e. when what is
+//! lost there is the forced seam's disturbance, not the jump's. This is a diagnosis
+//! beside the criterion (≥ 0.8× the image-wide share), not a replacement.
+//!
 //! This is the "coherent pairs" count of `fieldtex-synth`'s `orient_probe` example
 //! made into a metric; unlike the probe, it needs no flip indicators (the sign-free
 //! test above), so `fieldtex eval` can compute it from a texture's coordinate map
@@ -115,7 +130,17 @@ pub struct SeamSubset {
     /// `coherent_share / ` the image-wide share; `None` when there are no pairs or no
     /// coherent pair in the image.
     pub ratio: Option<f64>,
+    /// Repaired jumps only: the coherent share of the control pairs at the same
+    /// distances from the forced seam (module docs, "distance-matched control");
+    /// `None` for the effective seam, or without pairs or controls.
+    pub local_share: Option<f64>,
+    /// `coherent_share / local_share`; `None` when either is missing or zero.
+    pub local_ratio: Option<f64>,
 }
+
+/// Distances from the forced seam beyond this many output pixels share one bucket of
+/// the distance-matched control ([`SeamSubset::local_share`]).
+pub const LOCAL_DISTANCE_CAP: usize = 16;
 
 /// The seam measure (module docs) of an exemplar-coordinate map `coords`
 /// (`height × width × 2`, `(x, y)` in exemplar pixels, row-major like the field) made
@@ -203,6 +228,11 @@ pub fn rosy_seam_coherence_with_flips(
         [coords[i] as f64, coords[i + 1] as f64]
     };
     let wrap = |d: f64, period: f64| d - (d / period).round() * period;
+    // Distance of every pixel from the forced seam (only with flips).
+    let seam_distance = flips.map(|f| forced_seam_distance(w, h, &unit, f));
+    // (pairs, coherent) per distance bucket of the repaired jumps and of the controls.
+    let mut rep_by_d = [[0usize; 2]; LOCAL_DISTANCE_CAP + 2];
+    let mut ctrl_by_d = [[0usize; 2]; LOCAL_DISTANCE_CAP + 2];
     let (mut pairs, mut coherent, mut jumps, mut jump_coherent) = (0usize, 0usize, 0usize, 0usize);
     // (pairs, coherent) of the repaired jumps and of the effective seams.
     let (mut repaired, mut seam) = ([0usize; 2], [0usize; 2]);
@@ -239,6 +269,14 @@ pub fn rosy_seam_coherence_with_flips(
                     // Effective frames (−1)^I J disagree: a forced seam; agree across a
                     // representation jump: a repaired jump.
                     let toggled = f[y * w + x] != f[qy * w + qx];
+                    if jump == toggled
+                        && let Some(dist) = &seam_distance
+                    {
+                        let b = dist[y * w + x].min(dist[qy * w + qx]) as usize;
+                        let by_d = if jump { &mut rep_by_d } else { &mut ctrl_by_d };
+                        by_d[b][0] += 1;
+                        by_d[b][1] += ok as usize;
+                    }
                     let slot = if jump != toggled {
                         Some(&mut seam)
                     } else if jump {
@@ -257,17 +295,28 @@ pub fn rosy_seam_coherence_with_flips(
     let coherent_share = if pairs > 0 { coherent as f64 / pairs as f64 } else { 0.0 };
     let jump_coherent_share = (jumps > 0).then(|| jump_coherent as f64 / jumps as f64);
     let seam_ratio = jump_coherent_share.filter(|_| coherent > 0).map(|s| s / coherent_share);
-    let subset = |[n, ok]: [usize; 2]| {
+    let subset = |[n, ok]: [usize; 2], local_share: Option<f64>| {
         let share = (n > 0).then(|| ok as f64 / n as f64);
         SeamSubset {
             pairs: n,
             coherent_share: share,
             ratio: share.filter(|_| coherent > 0).map(|s| s / coherent_share),
+            local_share,
+            local_ratio: share.zip(local_share.filter(|&l| l > 0.0)).map(|(s, l)| s / l),
         }
     };
+    // Distance-matched control share of the repaired jumps.
+    let (mut weight, mut sum) = (0usize, 0.0f64);
+    for (r, c) in rep_by_d.iter().zip(&ctrl_by_d) {
+        if r[0] > 0 && c[0] > 0 {
+            weight += r[0];
+            sum += r[0] as f64 * c[1] as f64 / c[0] as f64;
+        }
+    }
+    let local_share = (weight > 0).then(|| sum / weight as f64);
     Ok(RosySeamReport {
-        repaired: flips.map(|_| subset(repaired)),
-        effective_seam: flips.map(|_| subset(seam)),
+        repaired: flips.map(|_| subset(repaired, local_share)),
+        effective_seam: flips.map(|_| subset(seam, None)),
         pairs,
         coherent_share,
         jump_pairs: jumps,
@@ -276,6 +325,61 @@ pub fn rosy_seam_coherence_with_flips(
         step,
         tolerance_px: tol,
     })
+}
+
+/// Chebyshev distance (output pixels, capped at [`LOCAL_DISTANCE_CAP`] + 1) of every
+/// pixel from the nearest pixel of a forced-seam pair (horizontal or vertical
+/// neighbours whose effective frames `(−1)^I u` point in opposite directions), by a
+/// breadth-first sweep over the 8-neighbours. `unit` gives the unit field vector
+/// (`None`: skipped pixel). Not `fieldtex_features::distance_transform` (exact
+/// Euclidean, Felzenszwalb & Huttenlocher 2012): eval does not depend on that crate, and
+/// the control needs only capped integer buckets.
+fn forced_seam_distance(
+    w: usize,
+    h: usize,
+    unit: &dyn Fn(usize, usize) -> Option<[f64; 2]>,
+    flips: &[bool],
+) -> Vec<u8> {
+    let far = (LOCAL_DISTANCE_CAP + 1) as u8;
+    let mut dist = vec![far; w * h];
+    let mut front = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let Some(up) = unit(x, y) else { continue };
+            for (qx, qy) in [(x + 1, y), (x, y + 1)] {
+                if qx >= w || qy >= h {
+                    continue;
+                }
+                let Some(uq) = unit(qx, qy) else { continue };
+                let jump = up[0] * uq[0] + up[1] * uq[1] < 0.0;
+                if jump != (flips[y * w + x] != flips[qy * w + qx]) {
+                    for i in [y * w + x, qy * w + qx] {
+                        if dist[i] != 0 {
+                            dist[i] = 0;
+                            front.push(i);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for d in 1..far {
+        let mut next = Vec::new();
+        for &i in &front {
+            let (x, y) = (i % w, i / w);
+            for qy in y.saturating_sub(1)..(y + 2).min(h) {
+                for qx in x.saturating_sub(1)..(x + 2).min(w) {
+                    let q = qy * w + qx;
+                    if dist[q] > d {
+                        dist[q] = d;
+                        next.push(q);
+                    }
+                }
+            }
+        }
+        front = next;
+    }
+    dist
 }
 
 #[cfg(test)]
@@ -426,5 +530,33 @@ mod tests {
         );
         // Without flips the split is absent.
         assert!(measure(&c, &f).repaired.is_none());
+    }
+
+    #[test]
+    fn local_control_matches_the_repaired_jumps_surroundings() {
+        // Repaired jump at column 31 | 32, a forced seam planted at column 9 | 10, and
+        // every 5th sample scrambled from column 27 on (all farther than the distance
+        // cap from the seam): the repaired pairs are as coherent as the controls around
+        // them (local ratio ≈ 1) but clearly less than the image-wide share.
+        let f = split_field();
+        let fv = FieldView::new(&f, N, N).unwrap();
+        let mut c = coords(1.0, [10.0, 20.0]);
+        for i in (0..N * N).filter(|i| i % N >= 27 && i.is_multiple_of(5)) {
+            c[2 * i] = (c[2 * i] + 57.0).rem_euclid(EX as f32);
+        }
+        let flips: Vec<bool> = (0..N * N).map(|i| (i % N >= N / 2) != (i % N < 10)).collect();
+        let o = RosySeamOptions::default();
+        let r = rosy_seam_coherence_with_flips(&c, &fv, Some(&flips), [EX, EX], 1.0, &o).unwrap();
+        let rep = r.repaired.unwrap();
+        assert_eq!(rep.pairs, N);
+        assert_eq!(r.effective_seam.as_ref().unwrap().pairs, N);
+        let (ratio, local) = (rep.ratio.unwrap(), rep.local_ratio.unwrap());
+        assert!(ratio < 0.9, "{ratio}");
+        assert!((0.85..1.15).contains(&local), "local ratio {local}, share {:?}", rep.local_share);
+        assert!(r.effective_seam.unwrap().local_share.is_none());
+        // The coherent version: everything 1.
+        let c = coords(1.0, [10.0, 20.0]);
+        let r = rosy_seam_coherence_with_flips(&c, &fv, Some(&flips), [EX, EX], 1.0, &o).unwrap();
+        assert_eq!(r.repaired.unwrap().local_ratio, Some(1.0));
     }
 }
