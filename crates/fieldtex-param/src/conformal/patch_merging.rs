@@ -31,6 +31,10 @@ use fieldtex_mesh::Topology;
 use std::collections::HashMap;
 
 type Grid = HashMap<(i64, i64), Vec<u32>>;
+/// `(lower patch, higher patch, quantised shift)`.
+type CandKey = (u32, u32, i64, i64);
+/// `(shared seam length, face in the lower patch, face in the higher patch, vertex)`.
+type CandVal = (f64, u32, u32, u32);
 
 /// What [`merge_patches`] did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -131,7 +135,7 @@ pub fn merge_patches(
     // 2. Candidate merges: patch pairs and the shift that joins them, with the seam length
     //    they would remove.
     let q = |s: [f64; 2]| ((s[0] / tol).round() as i64, (s[1] / tol).round() as i64);
-    let mut cands: HashMap<(u32, u32, i64, i64), (f64, u32, u32, u32)> = HashMap::new();
+    let mut cands: HashMap<CandKey, CandVal> = HashMap::new();
     for e in 0..topology.n_edges() {
         let fs = topology.edge_faces(e);
         if fs.len() != 2 {
@@ -160,7 +164,7 @@ pub fn merge_patches(
         ));
         entry.0 += len;
     }
-    let mut order: Vec<((u32, u32, i64, i64), (f64, u32, u32, u32))> = cands.into_iter().collect();
+    let mut order: Vec<(CandKey, CandVal)> = cands.into_iter().collect();
     order.sort_by(|x, y| y.1.0.total_cmp(&x.1.0).then(x.0.cmp(&y.0)));
     // 3. Greedy merging with union–find over patch ids; corners move with their group.
     let mut parent: Vec<u32> = (0..n0 as u32).collect();

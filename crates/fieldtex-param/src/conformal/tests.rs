@@ -282,7 +282,7 @@ fn patch_merging_keeps_every_chart_injective_and_shortens_the_seams() {
             let d = (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
             // A patch may still close around a handle (a seam inside one patch): then
             // the corners differ by a period, far more than rounding.
-            assert!(d < 1e-9 || d > 1e-3, "edge {e}: corners {d} apart");
+            assert!(!(1e-9..=1e-3).contains(&d), "edge {e}: corners {d} apart");
         }
     }
 }
