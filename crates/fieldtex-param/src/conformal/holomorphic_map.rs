@@ -35,7 +35,7 @@ use fieldtex_mesh::{CotanOptions, Topology, TriMesh, cotan_face_weights};
 /// Length budget of a critical trajectory, in units of `√(surface area)`.
 pub const TRAJECTORY_LENGTH: f64 = 0.15;
 /// Largest patch piece side, in units of `√(UV area)`.
-pub const PIECE_SIDE: f64 = 1.0;
+pub const PIECE_SIDE: f64 = 3.0;
 /// Candidate levels tried for each period seam of a torus image.
 pub const SEAM_LEVELS: usize = 64;
 /// Objective evaluations of the most-uniform-form search.
@@ -51,17 +51,18 @@ pub fn holomorphic_map(
     genus: usize,
     n_keep: usize,
 ) -> Result<ComponentMap, ParamError> {
-    holomorphic_map_with(mesh, genus, n_keep, TRAJECTORY_LENGTH, PIECE_SIDE)
+    holomorphic_map_with(mesh, genus, n_keep, TRAJECTORY_LENGTH, PIECE_SIDE, true)
 }
 
-/// [`holomorphic_map`] with the trajectory length budget (× `√area`) and the patch piece
-/// side (× `√(UV area)`) given.
+/// [`holomorphic_map`] with the trajectory length budget (× `√area`), the patch piece
+/// side (× `√(UV area)`) and patch merging ([`super::patch_merging`]) given.
 pub fn holomorphic_map_with(
     mesh: &TriMesh,
     genus: usize,
     n_keep: usize,
     trajectory_length: f64,
     piece_side: f64,
+    merge: bool,
 ) -> Result<ComponentMap, ParamError> {
     let nv = mesh.n_vertices();
     let nf = mesh.n_triangles();
@@ -150,7 +151,7 @@ pub fn holomorphic_map_with(
             &d,
             &cut,
             &kept,
-            PatchOptions { rings: GHOST_RINGS, piece_side },
+            PatchOptions { rings: GHOST_RINGS, piece_side, merge },
         );
         return Ok(ComponentMap {
             method: ConformalMethod::CriticalTrajectoryPatches,
@@ -166,6 +167,7 @@ pub fn holomorphic_map_with(
             cut_curves: trajectories.into_iter().map(|t| t.points).collect(),
             small_patches: layout.small_patches,
             folded_faces: layout.folded,
+            patch_merges: layout.merges,
             stretch_cv: Some([uniform.cv_basis, uniform.cv]),
             ..ComponentMap::empty(ConformalMethod::CriticalTrajectoryPatches)
         });

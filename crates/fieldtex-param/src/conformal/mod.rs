@@ -28,6 +28,7 @@ pub mod hole_caps;
 pub mod holomorphic_basis;
 pub mod holomorphic_map;
 pub mod mass_spring;
+pub mod patch_merging;
 pub mod periodic_uv;
 pub mod seam_placement;
 pub mod slit_cylinder;
@@ -100,8 +101,10 @@ pub struct ComponentMap {
     pub cut_curves: Vec<Vec<[f64; 3]>>,
     /// Patches made by the overlap guard that hold under 1 % of the faces.
     pub small_patches: usize,
-    /// Faces the discrete form folds, given their own one-face charts.
+    /// Faces the discrete form folds left on their own one-face charts.
     pub folded_faces: usize,
+    /// Patch merges into maximal charts ([`patch_merging`]).
+    pub patch_merges: usize,
     /// Area-stretch CV of the best basis form and of the optimised form (genus ≥ 2).
     pub stretch_cv: Option<[f64; 2]>,
 }
@@ -126,6 +129,7 @@ impl ComponentMap {
             small_patches: 0,
             stretch_cv: None,
             folded_faces: 0,
+            patch_merges: 0,
         }
     }
 

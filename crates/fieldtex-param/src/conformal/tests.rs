@@ -226,6 +226,67 @@ fn genus_two_is_cut_into_patches_along_critical_trajectories() {
     }
 }
 
+/// 3-D length of the edges whose two faces disagree on a shared corner.
+fn seam_length(mesh: &fieldtex_mesh::TriMesh, corner: &[[[f64; 2]; 3]]) -> f64 {
+    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
+    let uv = |f: usize, v: u32| corner[f][(0..3).find(|&k| mesh.triangles[f][k] == v).unwrap()];
+    let mut len = 0.0;
+    for e in 0..topo.n_edges() {
+        let fs = topo.edge_faces(e);
+        let [a, b] = topo.edges[e];
+        let (f, g) = (fs[0] as usize, fs[1] as usize);
+        let d = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
+        if d(uv(f, a), uv(g, a)) + d(uv(f, b), uv(g, b)) > 1e-9 {
+            len += fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(
+                mesh.positions[b as usize],
+                mesh.positions[a as usize],
+            ));
+        }
+    }
+    len
+}
+
+#[test]
+fn patch_merging_keeps_every_chart_injective_and_shortens_the_seams() {
+    use holomorphic_map::{PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with};
+    let mesh = genus_two_slab(4);
+    let nf = mesh.n_triangles();
+    let run = |merge| holomorphic_map_with(&mesh, 2, nf, TRAJECTORY_LENGTH, PIECE_SIDE, merge);
+    let (plain, merged) = (run(false).unwrap(), run(true).unwrap());
+    assert_eq!(plain.patch_merges, 0);
+    assert!(merged.patch_merges > 0, "nothing merged");
+    let n = |m: &ComponentMap| m.n_patches();
+    assert!(n(&merged) < n(&plain), "{} patches merged vs {} plain", n(&merged), n(&plain));
+    let (lp, lm) = (seam_length(&mesh, &plain.corner), seam_length(&mesh, &merged.corner));
+    assert!(lm < lp, "seam length {lm} merged vs {lp} plain");
+    // Injective: no flipped face and no two faces of the packed layout overlap.
+    let cu = &merged.corner;
+    for f in 0..nf {
+        assert!(periodic_uv::signed_area(&cu[f]) > 0.0, "face {f} flipped");
+        for g in f + 1..nf {
+            assert!(!translation_patches::triangles_overlap(&cu[f], &cu[g]), "{f} {g}");
+        }
+    }
+    // Inside a patch, faces sharing an edge share its corners: merging moved whole
+    // charts by one translation and introduced no crack.
+    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
+    for e in 0..topo.n_edges() {
+        let fs = topo.edge_faces(e);
+        let (f, g) = (fs[0] as usize, fs[1] as usize);
+        if merged.patch[f] != merged.patch[g] {
+            continue;
+        }
+        for v in topo.edges[e] {
+            let p = cu[f][(0..3).find(|&k| mesh.triangles[f][k] == v).unwrap()];
+            let q = cu[g][(0..3).find(|&k| mesh.triangles[g][k] == v).unwrap()];
+            let d = (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
+            // A patch may still close around a handle (a seam inside one patch): then
+            // the corners differ by a period, far more than rounding.
+            assert!(!(1e-9..=1e-3).contains(&d), "edge {e}: corners {d} apart");
+        }
+    }
+}
+
 #[test]
 fn a_disk_with_two_holes_is_mapped_through_its_double_cover() {
     // g = 0, b = 3: the double cover has genus 2.

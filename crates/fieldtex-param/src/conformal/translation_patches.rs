@@ -16,7 +16,9 @@
 //! guarantees an injective map per patch; the number of extra (small) patches it makes
 //! is reported. A face whose own development is folded (non-positive area: the
 //! discrete form is not exactly holomorphic next to zero points) gets a one-face chart
-//! of its isometric layout at the form's mean scale, also counted.
+//! of its isometric layout at the form's mean scale, also counted. The patches are then
+//! merged into maximal injective charts and their seams shortened face by face
+//! ([`super::patch_merging`]).
 //!
 //! Patches longer than a piece side are cut into pieces (by face centroid) and all
 //! pieces are packed without rotation (rotation would break the translation
@@ -26,10 +28,14 @@
 //! listed as [`Ghost`]s: drawn shifted beside the near side they fill the image margin
 //! with the continuation of the surface, for boundary consistency (§4.2).
 
+use super::patch_merging::{merge_patches, shorten_seams};
 use super::periodic_uv::{along2, signed_area};
 use fieldtex_core::vec3;
 use fieldtex_mesh::Topology;
 use std::collections::{HashMap, HashSet, VecDeque};
+
+/// Sweeps of [`shorten_seams`] after merging.
+pub const SEAM_ROUNDS: usize = 8;
 
 /// A face drawn shifted beside another patch: corners `corner[face] − shift` continue
 /// the chart across a seam; a point `p` of the ghost shows the surface point at
@@ -47,6 +53,8 @@ pub struct PatchOptions {
     pub rings: usize,
     /// Largest piece side, in units of `√(total UV area)`.
     pub piece_side: f64,
+    /// Merge patches into maximal injective charts ([`super::patch_merging`]).
+    pub merge: bool,
 }
 
 /// The packed patch layout.
@@ -59,8 +67,11 @@ pub struct PatchLayout {
     pub n_patches: usize,
     /// Patches that hold fewer than 1 % of the faces (made by the overlap guard).
     pub small_patches: usize,
-    /// Faces the discrete form folds (non-positive area), laid out on their own.
+    /// Faces the discrete form folds (non-positive area) left on one-face charts (not
+    /// attached to a neighbouring patch by [`super::patch_merging`]).
     pub folded: usize,
+    /// Patch merges performed by [`super::patch_merging`].
+    pub merges: usize,
     /// Edges whose two faces are in different charts.
     pub seam_edges: Vec<u32>,
     pub ghosts: Vec<Ghost>,
@@ -79,7 +90,7 @@ pub fn translation_patches(
     keep: &[bool],
     options: PatchOptions,
 ) -> PatchLayout {
-    let PatchOptions { rings, piece_side } = options;
+    let PatchOptions { rings, piece_side, merge } = options;
     let nf = triangles.len();
     let ne = topology.n_edges();
     let mean_len = (d.iter().map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt()).sum::<f64>()
@@ -94,6 +105,7 @@ pub fn translation_patches(
     }
     let form_scale = mean_len / (l3 / n3.max(1) as f64).max(1e-300);
     let mut folded = 0usize;
+    let mut is_folded = vec![false; nf];
     let mut corner = vec![[[f64::NAN; 2]; 3]; nf];
     let mut patch = vec![u32::MAX; nf];
     let mut n_patches = 0u32;
@@ -113,6 +125,7 @@ pub fn translation_patches(
             // The discrete form folds this face (next to a zero point): it gets its own
             // chart, the triangle laid out isometrically at the form's mean scale.
             folded += 1;
+            is_folded[seed] = true;
             let p = triangles[seed].map(|v| positions[v as usize]);
             let (e1, e2) = (vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0]));
             let l1 = vec3::norm(e1);
@@ -155,6 +168,39 @@ pub fn translation_patches(
             }
         }
     }
+    let tol = 1e-9 * mean_len.max(1e-300) * 1e3;
+    let (n_patches, merges) = if merge {
+        let m = merge_patches(
+            positions,
+            triangles,
+            topology,
+            &mut corner,
+            &mut patch,
+            keep,
+            &is_folded,
+            cell,
+            tol,
+        );
+        folded -= m.attached_folded;
+        // Faces still on one-face charts are not moved; attached ones are not
+        // translation-developed either.
+        shorten_seams(
+            positions,
+            triangles,
+            topology,
+            &mut corner,
+            &mut patch,
+            keep,
+            &is_folded,
+            cell,
+            tol,
+            SEAM_ROUNDS,
+        );
+        let n = patch.iter().filter(|&&p| p != u32::MAX).map(|&p| p + 1).max().unwrap_or(0);
+        (n, m.merges)
+    } else {
+        (n_patches, 0)
+    };
     // Long strips (trajectories that spiral make them) are cut into pieces no longer
     // than `piece` along x and y, so that the pieces pack densely; the cuts become
     // seams like any other.
@@ -227,7 +273,6 @@ pub fn translation_patches(
     }
     // Seams: edges whose faces disagree on a shared corner.
     let uv_of = |f: usize, v: u32| corner[f][(0..3).find(|&j| triangles[f][j] == v).unwrap_or(0)];
-    let tol = 1e-9 * mean_len.max(1e-300) * 1e3;
     let mut is_seam = vec![false; ne];
     let mut seam_edges = Vec::new();
     for (e, seam) in is_seam.iter_mut().enumerate() {
@@ -291,10 +336,10 @@ pub fn translation_patches(
     }
     let n_kept = keep.iter().filter(|k| **k).count();
     let small_patches = count.iter().filter(|&&c| (c as f64) < 0.01 * n_kept as f64).count();
-    PatchLayout { corner, patch, n_patches, small_patches, folded, seam_edges, ghosts }
+    PatchLayout { corner, patch, n_patches, small_patches, folded, merges, seam_edges, ghosts }
 }
 
-fn insert(
+pub(super) fn insert(
     grid: &mut HashMap<(i64, i64), Vec<u32>>,
     key: &impl Fn([f64; 2]) -> (i64, i64),
     f: u32,
@@ -308,7 +353,7 @@ fn insert(
     }
 }
 
-fn cell_range(
+pub(super) fn cell_range(
     key: &impl Fn([f64; 2]) -> (i64, i64),
     c: &[[f64; 2]; 3],
 ) -> ((i64, i64), (i64, i64)) {
@@ -317,7 +362,7 @@ fn cell_range(
     (key(lo), key(hi))
 }
 
-fn overlaps(
+pub(super) fn overlaps(
     grid: &HashMap<(i64, i64), Vec<u32>>,
     key: &impl Fn([f64; 2]) -> (i64, i64),
     corner: &[[[f64; 2]; 3]],

@@ -256,9 +256,15 @@ pub fn conformal(
         };
         crate::outputs::check_cancelled(progress)?;
         let (mut image, st) = quilt(&levels, &target, &q, progress);
-        // Margins across patch cuts take their partners' colours (§4.2).
+        // Margins across patch cuts take their partners' colours (§4.2); count those the
+        // quilting left different from their partner (both sides written in one patch).
+        let changed = img
+            .margin_copies
+            .iter()
+            .filter(|&&(g, r, _)| image.pixels[g as usize] != image.pixels[r as usize])
+            .count();
         img.copy_margins(&mut image.pixels);
-        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len()}));
+        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len(), "margin_texels_changed_by_copy": changed}));
         let faces = c.faces.iter().copied().zip(img.corner_texel.iter().copied()).collect();
         blocks.push(Block {
             image,
