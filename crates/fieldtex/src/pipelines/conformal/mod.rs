@@ -308,9 +308,13 @@ pub fn conformal(
         .time("eval-seams", || fieldtex_eval::seam_metrics::seam_metrics(&out_mesh, &texture));
     report.metric("seams", seams);
     let feature = report.time("eval-feature-size", || {
-        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24)
+        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, true)
     });
     report.metric("feature_size", feature);
+    let feature24 = report.time("eval-feature-size-fixed", || {
+        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, false)
+    });
+    report.metric("feature_size_fixed_window", feature24);
     // Whole-mesh distortion in texel units (the texture is not square).
     let whole = out_mesh.uvs.as_ref().and_then(|uv| {
         let mut texel_uv = uv.clone();
