@@ -4,7 +4,7 @@
 //! Kwatra, Schödl, Essa, Turk & Bobick 2003 (max-flow over the overlap,
 //! [`crate::graph_cut::MaxFlow`]), and the multi-scale choice of Wang et al. 2005 §4.2:
 //! each patch takes its exemplar level from the mean inverse conformal factor `τ` under
-//! it — weighted towards the texels that show the most surface ([`patch_tau`]).
+//! it — weighted towards the texels that show the most surface (`patch_tau`).
 //!
 //! Canvas texels are *unknown*, *synthesised* or *fixed*. Before a patch is placed, every
 //! unknown texel of its region that has an already known partner (a texel showing the
@@ -135,8 +135,8 @@ pub fn quilt(
             if unknown == 0 {
                 continue;
             }
-            let level = (target.level_for)(patch_tau(&target.tau[..], w, x0..x1, y0..y1))
-                .min(levels.len() - 1);
+            let level =
+                (target.level_for)(patch_tau(target.tau, w, x0..x1, y0..y1)).min(levels.len() - 1);
             let ex = &levels[level];
             stats.patches += 1;
             stats.level_histogram[level] += 1;
@@ -271,7 +271,7 @@ fn patch_tau(
     if den > 0.0 && num.is_finite() { num / den } else { f64::NAN }
 }
 
-/// See [`patch_tau`].
+/// Power `p` of the `τ^-p` weights of a patch's level choice (`patch_tau`).
 pub const TAU_WEIGHT_POWER: f64 = 4.0;
 
 fn positions(len: usize, b: usize, step: usize) -> Vec<usize> {
