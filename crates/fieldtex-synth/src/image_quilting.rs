@@ -4,7 +4,7 @@
 //! Kwatra, Schödl, Essa, Turk & Bobick 2003 (max-flow over the overlap,
 //! [`crate::graph_cut::MaxFlow`]), and the multi-scale choice of Wang et al. 2005 §4.2:
 //! each patch takes its exemplar level from the mean inverse conformal factor `τ` under
-//! it.
+//! it — weighted towards the texels that show the most surface (`patch_tau`).
 //!
 //! Canvas texels are *unknown*, *synthesised* or *fixed*. Before a patch is placed, every
 //! unknown texel of its region that has an already known partner (a texel showing the
@@ -121,7 +121,6 @@ pub fn quilt(
                 }
             }
             let mut unknown = 0;
-            let (mut ts, mut tn) = (0.0, 0usize);
             let mut known: Vec<(usize, usize, [f32; 3])> = Vec::new();
             for y in y0..y1 {
                 for x in x0..x1 {
@@ -131,18 +130,13 @@ pub fn quilt(
                     } else {
                         known.push((x - x0, y - y0, pix[i]));
                     }
-                    let t = target.tau[i];
-                    if t.is_finite() {
-                        ts += t as f64;
-                        tn += 1;
-                    }
                 }
             }
             if unknown == 0 {
                 continue;
             }
-            let level = (target.level_for)(if tn > 0 { ts / tn as f64 } else { f64::NAN })
-                .min(levels.len() - 1);
+            let level =
+                (target.level_for)(patch_tau(target.tau, w, x0..x1, y0..y1)).min(levels.len() - 1);
             let ex = &levels[level];
             stats.patches += 1;
             stats.level_histogram[level] += 1;
@@ -246,6 +240,40 @@ pub fn quilt(
     (out, stats)
 }
 
+/// The `τ` a patch takes its level from: the mean of `τ` over the patch weighted by
+/// `τ^-p` (`p` = [`TAU_WEIGHT_POWER`]; `NaN` when no texel has a `τ`).
+///
+/// Wang et al. 2005 §4.2 take "the mean τ under the patch". A texel covers surface area
+/// `∝ τ⁻²`, so a plain texel mean lets the few texels of a region the map compressed
+/// (small `τ`, much surface) take the level of their large-`τ` neighbours, and their
+/// features come out far too large on the surface. With one level `s` for the patch,
+/// the feature period on the surface is `∝ s/τ` per texel; the `s` that minimises its
+/// surface-area-weighted variance around the target `1/τ_ref`-scaled period is
+/// `s ∝ Σ τ⁻³ / Σ τ⁻⁴`, the mean of `τ` weighted by `τ⁻⁴` (`p = 4`); `p = 2` is the
+/// surface-area-weighted mean, `p = 0` the plain texel mean.
+fn patch_tau(
+    tau: &[f32],
+    width: usize,
+    xs: std::ops::Range<usize>,
+    ys: std::ops::Range<usize>,
+) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for y in ys {
+        for x in xs.clone() {
+            let t = tau[y * width + x] as f64;
+            if t.is_finite() && t > 0.0 {
+                let wgt = t.powf(-TAU_WEIGHT_POWER);
+                num += wgt * t;
+                den += wgt;
+            }
+        }
+    }
+    if den > 0.0 && num.is_finite() { num / den } else { f64::NAN }
+}
+
+/// Power `p` of the `τ^-p` weights of a patch's level choice (`patch_tau`).
+pub const TAU_WEIGHT_POWER: f64 = 4.0;
+
 fn positions(len: usize, b: usize, step: usize) -> Vec<usize> {
     if len <= b {
         return vec![0];
@@ -302,6 +330,20 @@ mod tests {
                 assert_eq!(im.get(x, y), im.get(x - 80, y), "texel ({x}, {y})");
             }
         }
+    }
+
+    /// A 10 × 10 patch whose one texel shows 100× more surface than each of the others
+    /// (`τ` 1 against 10): the plain texel mean (9.91) would give the whole patch the
+    /// large-`τ` level; the `τ⁻⁴`-weighted mean stays near the compressed texel's `τ`.
+    /// Texels without `τ` are ignored, and a patch without any has none.
+    #[test]
+    fn compressed_texels_choose_the_patch_level() {
+        let mut tau = vec![10.0f32; 12 * 10];
+        tau[3 * 12 + 4] = 1.0;
+        tau[5 * 12 + 5] = f32::NAN;
+        let t = patch_tau(&tau, 12, 0..10, 0..10);
+        assert!(t > 1.0 && t < 1.2, "{t}");
+        assert!(patch_tau(&[f32::NAN; 4], 2, 0..2, 0..2).is_nan());
     }
 
     #[test]

@@ -317,9 +317,13 @@ pub fn conformal(
     });
     report.metric("seams", seams);
     let feature = report.stage(progress, "eval-feature-size", || {
-        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24)
+        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, true)
     });
     report.metric("feature_size", feature);
+    let feature24 = report.stage(progress, "eval-feature-size-fixed", || {
+        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, false)
+    });
+    report.metric("feature_size_fixed_window", feature24);
     // Whole-mesh distortion in texel units (the texture is not square).
     let whole = out_mesh.uvs.as_ref().and_then(|uv| {
         let mut texel_uv = uv.clone();
