@@ -233,10 +233,9 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     }
     crate::outputs::check_cancelled(progress)?;
     // 2. Exemplar analysis and the synthesizer.
-    let ex = report
-        .stage(progress, "exemplar_analysis", || {
-            analyse_exemplars(options, &exemplars, single, &analysis, progress)
-        })?;
+    let ex = report.stage(progress, "exemplar_analysis", || {
+        analyse_exemplars(options, &exemplars, single, &analysis, progress)
+    })?;
     let grid = SolidGrid::over_box(bbox.min, bbox.max, options.resolution);
     report.metric("grid", grid);
     let frames = FieldFrames(field.as_ref());
