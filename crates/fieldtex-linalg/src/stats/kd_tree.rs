@@ -6,12 +6,16 @@
 //! Construction splits at the median of the coordinate with the widest spread, down to
 //! leaves of at most [`KD_LEAF`] points; ties in the median order are broken by point
 //! index, so the tree is a pure function of the points (no thread count dependence).
-//! A query visits nodes in increasing order of a lower bound on their squared distance
-//! (the sum over the split planes crossed, Arya & Mount's incremental distance) and
-//! stops when the bound exceeds the best distance found (exact) or after `max_checks`
-//! points were examined (approximate: the answer is a true point and its true distance,
-//! so never closer than the exact nearest one). Ties between equal distances keep the
-//! smaller point index.
+//! A query visits nodes in increasing order of a priority: the sum of the squared
+//! distances to the split planes crossed on the way to the node. That sum is a lower
+//! bound only while each plane is on a different axis (Arya & Mount's incremental
+//! distance replaces an axis's term instead of adding it); when one axis is split twice
+//! it can overestimate, so it only orders the visits and prunes the approximate search
+//! (`max_checks` points examined: the answer is a true point and its true distance, so
+//! never closer than the exact nearest one). The exact search prunes with a bound that
+//! always holds, the largest single-plane term crossed, and keeps popping until every
+//! pending node is provably farther than the best point found. Ties between equal
+//! distances keep the smaller point index.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -52,7 +56,10 @@ pub struct KdScratch {
 
 #[derive(Debug, PartialEq)]
 struct Pending {
+    /// Visit priority (sum of the crossed planes' squared distances).
     bound: f32,
+    /// A true lower bound on the squared distance to any point under `node`.
+    lower: f32,
     node: u32,
 }
 impl Eq for Pending {}
@@ -165,11 +172,16 @@ impl KdTree {
         }
         let heap = &mut scratch.heap;
         heap.clear();
-        heap.push(Pending { bound: 0.0, node: 0 });
+        heap.push(Pending { bound: 0.0, lower: 0.0, node: 0 });
+        let exact = max_checks == usize::MAX;
         let mut best = (usize::MAX, f32::INFINITY);
         let mut checked = 0usize;
-        while let Some(Pending { bound, node }) = heap.pop() {
-            if bound > best.1 || (checked >= max_checks && best.0 != usize::MAX) {
+        while let Some(Pending { bound, lower, node }) = heap.pop() {
+            if exact {
+                if lower > best.1 {
+                    continue;
+                }
+            } else if bound > best.1 || (checked >= max_checks && best.0 != usize::MAX) {
                 break;
             }
             // Descend to a leaf, queueing the far sides with their bounds.
@@ -190,8 +202,9 @@ impl KdTree {
                         let diff = query[axis as usize] - value;
                         let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
                         let far_bound = bound + diff * diff;
-                        if far_bound <= best.1 {
-                            heap.push(Pending { bound: far_bound, node: far });
+                        let far_lower = lower.max(diff * diff);
+                        if (if exact { far_lower } else { far_bound }) <= best.1 {
+                            heap.push(Pending { bound: far_bound, lower: far_lower, node: far });
                         }
                         id = near;
                     }
@@ -243,5 +256,35 @@ mod tests {
         // Best-bin-first with 64 checks finds the exact neighbour most of the time.
         assert!(hits > 100, "approximate hits {hits}/200");
         assert!(KdTree::build(&[], 3).nearest(&[0.0; 3], 10, &mut sc).is_none());
+    }
+
+    #[test]
+    fn exact_search_holds_when_one_axis_is_split_many_times() {
+        // Two dimensions with a long x range: nearly every split is on x, so the sum of
+        // crossed-plane terms overestimates far-of-far nodes; the exact search must
+        // still equal brute force, also for queries outside the points' box.
+        let d = 2;
+        let n = 400;
+        let pts: Vec<f32> = (0..n)
+            .flat_map(|i| {
+                let x = 100.0 * hash_unit(5, "kdx", i as u64) as f32;
+                let y = 40.0 * hash_unit(5, "kdy", i as u64) as f32;
+                [x, y]
+            })
+            .collect();
+        let tree = KdTree::build(&pts, d);
+        let mut sc = KdScratch::default();
+        for q in 0..2000u64 {
+            let query = [
+                300.0 * hash_unit(6, "qx", q) as f32 - 100.0,
+                120.0 * hash_unit(6, "qy", q) as f32 - 40.0,
+            ];
+            let (bi, bd) = brute(&pts, d, &query);
+            let (ei, ed) = tree.nearest(&query, usize::MAX, &mut sc).unwrap();
+            assert!((ed - bd).abs() <= 1e-5 * bd.max(1.0), "query {q}: {ed} vs {bd}");
+            if (ed - bd).abs() == 0.0 {
+                assert_eq!(ei, bi, "query {q}");
+            }
+        }
     }
 }
