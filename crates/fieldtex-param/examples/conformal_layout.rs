@@ -16,31 +16,8 @@ use fieldtex_param::conformal::holomorphic_map::{
 use fieldtex_param::conformal::periodic_uv::signed_area;
 use std::time::Instant;
 
-fn load_obj(path: &str) -> Result<TriMesh, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).filter_map(|s| s.parse().ok()).collect();
-                if c.len() == 3 {
-                    positions.push([c[0], c[1], c[2]]);
-                }
-            }
-            Some("f") => {
-                let idx: Vec<u32> = it
-                    .filter_map(|t| t.split('/').next()?.parse::<u32>().ok())
-                    .map(|i| i - 1)
-                    .collect();
-                for k in 1..idx.len().saturating_sub(1) {
-                    triangles.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok(TriMesh::new(positions, triangles))
+fn load_mesh(path: &str) -> Result<TriMesh, String> {
+    fieldtex_io::read_mesh(std::path::Path::new(path)).map(|l| l.mesh).map_err(|e| e.to_string())
 }
 
 fn main() -> Result<(), String> {
@@ -50,7 +27,7 @@ fn main() -> Result<(), String> {
     let traj = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(TRAJECTORY_LENGTH);
     let piece = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(PIECE_SIDE);
     let merge = args.get(4).is_none_or(|s| s != "0");
-    let mesh = load_obj(path)?;
+    let mesh = load_mesh(path)?;
     let nf = mesh.n_triangles();
     let t = Instant::now();
     let map =
