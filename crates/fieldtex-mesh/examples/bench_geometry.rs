@@ -17,40 +17,19 @@
 use fieldtex_core::rng::hash_unit;
 use fieldtex_core::vec3;
 use fieldtex_linalg::SparseMatrix;
-use fieldtex_mesh::primitives::{subdivide_midpoint, torus};
+use fieldtex_mesh::primitives::{self, subdivide_midpoint, torus};
 use fieldtex_mesh::{
     Bvh, CotanOptions, PoissonDiskOptions, Ray, TriMesh, VertexAreaKind, cotan_laplacian_and_mass,
     poisson_disk_sampling, total_area,
 };
 use std::time::Instant;
 
-fn parse_obj(text: &str) -> TriMesh {
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).filter_map(|s| s.parse().ok()).collect();
-                if c.len() == 3 {
-                    positions.push([c[0], c[1], c[2]]);
-                }
-            }
-            Some("f") => {
-                let n = positions.len() as i64;
-                let idx: Vec<u32> = it
-                    .filter_map(|s| s.split('/').next()?.parse::<i64>().ok())
-                    .map(|i| if i < 0 { (n + i) as u32 } else { (i - 1) as u32 })
-                    .collect();
-                for k in 1..idx.len().saturating_sub(1) {
-                    triangles.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    TriMesh::new(positions, triangles)
-}
+// The crate's test-support OBJ reader (`v`/`f` lines, polygons fanned); it names
+// `crate::TriMesh` and `crate::primitives`, which the imports above provide.
+#[path = "../src/test_meshes.rs"]
+#[allow(dead_code)]
+mod test_meshes;
+use test_meshes::parse_obj;
 
 fn median_ms(runs: usize, f: impl FnMut()) -> f64 {
     median_ms_cpu(runs, f).0

@@ -39,15 +39,7 @@ pub fn triangle_area(a: V3, b: V3, c: V3) -> f64 {
 
 /// `#F` triangle areas.
 pub fn face_areas(mesh: &TriMesh) -> Vec<f64> {
-    crate::checks::assert_indices(mesh, "face_areas");
-    mesh.triangles
-        .par_iter()
-        .with_min_len(4096)
-        .map(|t| {
-            let p = |i: usize| mesh.positions[t[i] as usize];
-            triangle_area(p(0), p(1), p(2))
-        })
-        .collect()
+    crate::checks::map_triangles(mesh, "face_areas", triangle_area)
 }
 
 /// Sum of all triangle areas (sequential sum in triangle order: deterministic).

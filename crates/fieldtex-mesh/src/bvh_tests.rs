@@ -42,6 +42,12 @@ fn random_unit(seed: u64, i: u64) -> V3 {
 }
 
 /// Rays from a sphere of radius 3 around the mesh towards random inner points.
+/// `intersect_many` and `occluded_many` of `rays` in a pool of `threads` threads.
+fn batches_on(bvh: &Bvh, rays: &[Ray], threads: usize) -> (Vec<Option<Hit>>, Vec<bool>) {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    pool.install(|| (bvh.intersect_many(rays), bvh.occluded_many(rays)))
+}
+
 fn rays(mesh: &TriMesh, n: u64) -> Vec<Ray> {
     let bb = mesh.bounding_box().unwrap();
     let (c, r) = (bb.center(), bb.diagonal());
@@ -210,10 +216,7 @@ fn batches_in_coherent_order_match_single_queries() {
             _ => r.dir = [f64::INFINITY, 0.0, 0.0],
         }
     }
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| (bvh.intersect_many(&rs), bvh.occluded_many(&rs)))
-    };
+    let run = |threads| batches_on(&bvh, &rs, threads);
     let (hits, occ) = run(2);
     assert_eq!((hits.clone(), occ.clone()), run(1));
     let mut n_hits = 0;
@@ -289,10 +292,7 @@ fn random_rays_with_ranges_and_duplicates_match_brute_force() {
             *r = r.with_range(a, a + 3.0 * hash_unit(6, "tlen", i) / len);
         }
     }
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| (bvh.intersect_many(&rs), bvh.occluded_many(&rs)))
-    };
+    let run = |threads| batches_on(&bvh, &rs, threads);
     let (hits, occ) = run(1);
     assert_eq!((hits.clone(), occ.clone()), run(2));
     let mut n_hits = 0;

@@ -3,6 +3,11 @@
 use crate::inspect::{Examples, InspectReport};
 use fieldtex_core::Warning;
 
+/// `(count, "COUNT WHAT (e.g. …)")` of an example list, for `problems`.
+fn counted<T: std::fmt::Debug>(e: &Examples<T>, what: &str) -> (usize, String) {
+    (e.count, format!("{} {what}{}", e.count, list(e)))
+}
+
 fn list<T: std::fmt::Debug>(e: &Examples<T>) -> String {
     if e.examples.is_empty() {
         return String::new();
@@ -37,24 +42,13 @@ impl InspectReport {
             }
         };
         add("empty-mesh", usize::from(self.n_triangles == 0), "the mesh has no triangles".into());
-        let e = &self.non_finite_vertices;
-        add(
-            "non-finite-positions",
-            e.count,
-            format!("{} vertices with NaN/Inf coordinates{}", e.count, list(e)),
-        );
-        let e = &self.invalid_index_triangles;
-        add(
-            "invalid-indices",
-            e.count,
-            format!("{} triangles refer to missing vertices{}", e.count, list(e)),
-        );
-        let e = &self.repeated_index_triangles;
-        add(
-            "repeated-index-triangles",
-            e.count,
-            format!("{} triangles repeat a vertex{}", e.count, list(e)),
-        );
+        let (n, what) = counted(&self.non_finite_vertices, "vertices with NaN/Inf coordinates");
+        add("non-finite-positions", n, what);
+        let (n, what) =
+            counted(&self.invalid_index_triangles, "triangles refer to missing vertices");
+        add("invalid-indices", n, what);
+        let (n, what) = counted(&self.repeated_index_triangles, "triangles repeat a vertex");
+        add("repeated-index-triangles", n, what);
         let e = &self.non_manifold_edges;
         let ex: Vec<String> = e
             .examples
@@ -85,16 +79,11 @@ impl InspectReport {
                 bounded(ex, e.count)
             ),
         );
-        let e = &self.orientation.inconsistent_edges;
-        add(
-            "inconsistent-orientation",
-            e.count,
-            format!(
-                "{} edges where neighbouring triangles disagree in orientation{}",
-                e.count,
-                list(e)
-            ),
+        let (n, what) = counted(
+            &self.orientation.inconsistent_edges,
+            "edges where neighbouring triangles disagree in orientation",
         );
+        add("inconsistent-orientation", n, what);
         let n = &self.orientation.non_orientable_components;
         add(
             "non-orientable",
@@ -126,12 +115,8 @@ impl InspectReport {
                 list(&s.slivers)
             ),
         );
-        let e = &self.duplicate_triangles;
-        add(
-            "duplicate-triangles",
-            e.count,
-            format!("{} triangles repeat an earlier one{}", e.count, list(e)),
-        );
+        let (n, what) = counted(&self.duplicate_triangles, "triangles repeat an earlier one");
+        add("duplicate-triangles", n, what);
         let d = &self.duplicate_vertices;
         let close = d.near.saturating_sub(d.exact);
         add(
@@ -144,12 +129,8 @@ impl InspectReport {
                 d.weldable, d.epsilon, d.exact
             ),
         );
-        let e = &self.unreferenced_vertices;
-        add(
-            "unreferenced-vertices",
-            e.count,
-            format!("{} vertices are used by no triangle{}", e.count, list(e)),
-        );
+        let (n, what) = counted(&self.unreferenced_vertices, "vertices are used by no triangle");
+        add("unreferenced-vertices", n, what);
         for a in &self.attribute_problems {
             add("attribute-length", 1, a.clone());
         }
@@ -162,18 +143,11 @@ impl InspectReport {
                 uv.non_finite_values,
                 format!("{} UV values are NaN/Inf", uv.non_finite_values),
             );
-            let e = &uv.negative_area;
-            add(
-                "uv-flipped",
-                e.count,
-                format!("{} triangles are clockwise (mirrored) in UV space{}", e.count, list(e)),
-            );
-            let e = &uv.zero_area;
-            add(
-                "uv-zero-area",
-                e.count,
-                format!("{} triangles have zero area in UV space{}", e.count, list(e)),
-            );
+            let (n, what) =
+                counted(&uv.negative_area, "triangles are clockwise (mirrored) in UV space");
+            add("uv-flipped", n, what);
+            let (n, what) = counted(&uv.zero_area, "triangles have zero area in UV space");
+            add("uv-zero-area", n, what);
         }
         w
     }

@@ -48,10 +48,8 @@ mod tests {
 
     #[test]
     fn mass_sums_to_area_over_categories_and_fixtures() {
-        let mut all = crate::test_meshes::categories();
-        for name in ["fertility.obj", "stanford-bunny.obj", "defects/narrow_triangles.obj"] {
-            all.extend(crate::test_meshes::load_obj(name).map(|m| (name, m)));
-        }
+        let fixtures = ["fertility.obj", "stanford-bunny.obj", "defects/narrow_triangles.obj"];
+        let all = crate::test_meshes::categories_and(&fixtures);
         for (name, m) in &all {
             let a = total_area(m);
             for kind in [VertexAreaKind::Barycentric, VertexAreaKind::MixedVoronoi] {

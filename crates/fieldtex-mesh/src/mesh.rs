@@ -139,23 +139,14 @@ impl TriMesh {
                 }
             }
         }
-        if let Some(c) = &self.vertex_colors
-            && c.len() != nv
-        {
-            return Err(MeshError::AttributeLength {
-                attribute: "vertex colours",
-                expected: nv,
-                found: c.len(),
-            });
-        }
-        if let Some(n) = &self.vertex_normals
-            && n.len() != nv
-        {
-            return Err(MeshError::AttributeLength {
-                attribute: "vertex normals",
-                expected: nv,
-                found: n.len(),
-            });
+        let per_vertex = [
+            ("vertex colours", self.vertex_colors.as_ref().map(Vec::len)),
+            ("vertex normals", self.vertex_normals.as_ref().map(Vec::len)),
+        ];
+        for (attribute, len) in per_vertex {
+            if let Some(found) = len.filter(|&n| n != nv) {
+                return Err(MeshError::AttributeLength { attribute, expected: nv, found });
+            }
         }
         if self.triangles.is_empty() {
             return Err(MeshError::Empty);

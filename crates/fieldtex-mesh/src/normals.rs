@@ -45,15 +45,7 @@ pub fn triangle_normal(a: V3, b: V3, c: V3) -> V3 {
 
 /// `#F × 3` unit face normals; zero vector for degenerate triangles (module docs).
 pub fn face_normals(mesh: &TriMesh) -> Vec<V3> {
-    crate::checks::assert_indices(mesh, "face_normals");
-    mesh.triangles
-        .par_iter()
-        .with_min_len(4096)
-        .map(|t| {
-            let p = |i: usize| mesh.positions[t[i] as usize];
-            triangle_normal(p(0), p(1), p(2))
-        })
-        .collect()
+    crate::checks::map_triangles(mesh, "face_normals", triangle_normal)
 }
 
 /// Interior angle at corner `a` of triangle `(a, b, c)` in `[0, π]`; 0 when an
@@ -233,10 +225,8 @@ mod tests {
 
     #[test]
     fn unit_and_finite_over_categories_and_fixtures() {
-        let mut all = crate::test_meshes::categories();
-        for name in ["fertility.obj", "stanford-bunny.obj", "defects/narrow_triangles.obj"] {
-            all.extend(crate::test_meshes::load_obj(name).map(|m| (name, m)));
-        }
+        let fixtures = ["fertility.obj", "stanford-bunny.obj", "defects/narrow_triangles.obj"];
+        let all = crate::test_meshes::categories_and(&fixtures);
         for (name, m) in &all {
             for w in [NormalWeighting::Angle, NormalWeighting::Area, NormalWeighting::Uniform] {
                 let (vn, _) = vertex_normals(m, w);

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::primitives::{grid, icosphere};
-use crate::test_meshes::{categories, load_obj};
+use crate::test_meshes::categories_and;
 
 /// The smallest pairwise distance below `r` (else infinity), through the static
 /// [`crate::SpatialGrid`] (not the incremental grid the sampler uses).
@@ -40,10 +40,8 @@ fn check(name: &str, mesh: &TriMesh, s: &PoissonDiskSamples) {
 
 #[test]
 fn minimum_distance_holds_over_categories_and_fixtures() {
-    let mut all = categories();
-    for name in ["stanford-bunny.obj", "fertility.obj", "defects/narrow_triangles.obj"] {
-        all.extend(load_obj(name).map(|m| (name, m)));
-    }
+    let all =
+        categories_and(&["stanford-bunny.obj", "fertility.obj", "defects/narrow_triangles.obj"]);
     for (name, m) in &all {
         // About 1750 samples whatever the size (the defective patch's needle is huge).
         let r = 0.02 * crate::areas::total_area(m).sqrt();

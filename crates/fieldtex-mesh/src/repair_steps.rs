@@ -13,23 +13,19 @@ use fieldtex_core::vec3::{is_finite, sub};
 /// Step 1: attribute tables of the wrong length and out-of-range triangles.
 pub(crate) fn sanitise(w: &mut Work) {
     let nv = w.positions.len();
-    if let Some(n) = w.colors.as_ref().map(|c| c.len()).filter(|&n| n != nv) {
+    let colors = w.colors.as_ref().map(Vec::len).filter(|&n| n != nv);
+    if colors.is_some() {
         w.colors = None;
-        w.change(
-            "attribute-dropped",
-            1,
-            format!("vertex colours ({n} for {nv} vertices) dropped"),
-            vec![],
-        );
     }
-    if let Some(n) = w.normals.as_ref().map(|c| c.len()).filter(|&n| n != nv) {
+    let normals = w.normals.as_ref().map(Vec::len).filter(|&n| n != nv);
+    if normals.is_some() {
         w.normals = None;
-        w.change(
-            "attribute-dropped",
-            1,
-            format!("vertex normals ({n} for {nv} vertices) dropped"),
-            vec![],
-        );
+    }
+    for (what, dropped) in [("vertex colours", colors), ("vertex normals", normals)] {
+        if let Some(n) = dropped {
+            let message = format!("{what} ({n} for {nv} vertices) dropped");
+            w.change("attribute-dropped", 1, message, vec![]);
+        }
     }
     let nf = w.triangles.len();
     if let Some(uv) = &w.uv {

@@ -97,6 +97,14 @@ pub fn two_components() -> TriMesh {
     m
 }
 
+/// [`categories`] followed by the shared fixtures `names` that are present (a missing
+/// file is skipped, as in [`load_obj`]).
+pub fn categories_and(names: &[&'static str]) -> Vec<(&'static str, TriMesh)> {
+    let mut all = categories();
+    all.extend(names.iter().filter_map(|&name| load_obj(name).map(|m| (name, m))));
+    all
+}
+
 /// The procedural categories every operator is run over, with a name.
 pub fn categories() -> Vec<(&'static str, TriMesh)> {
     vec![

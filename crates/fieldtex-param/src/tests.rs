@@ -13,34 +13,12 @@ fn data(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data").join(rel)
 }
 
-/// Test-only OBJ reader: `v` and `f` lines (polygons fanned, `a/b/c` and negative
-/// indices); unreferenced vertices are dropped.
+/// A fixture read through `fieldtex-io`'s OBJ reader, geometry only (positions and
+/// triangles); unreferenced vertices are dropped.
 fn load_obj(rel: &str) -> TriMesh {
     let path = data(rel);
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
-                positions.push([c[0], c[1], c[2]]);
-            }
-            Some("f") => {
-                let idx: Vec<u32> = it
-                    .map(|t| {
-                        let v: i64 = t.split('/').next().unwrap().parse().unwrap();
-                        (if v < 0 { positions.len() as i64 + v } else { v - 1 }) as u32
-                    })
-                    .collect();
-                for k in 1..idx.len() - 1 {
-                    triangles.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
+    let read = fieldtex_io::read_mesh(&path).unwrap_or_else(|e| panic!("{e}")).mesh;
+    let (positions, mut triangles) = (read.positions, read.triangles);
     let mut map = vec![u32::MAX; positions.len()];
     let mut kept = Vec::new();
     for t in triangles.iter_mut() {
