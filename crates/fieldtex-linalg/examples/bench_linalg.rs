@@ -14,32 +14,20 @@ use fieldtex_linalg::{Cholesky, SparseMatrix, SymbolicCholesky};
 
 const ALPHA: f64 = 1e8;
 
+// The tests' grid fixtures (grid Laplacian plus penalty diagonal).
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+/// The `side × side` grid Laplacian with `ALPHA` on every 50th diagonal entry, and which
+/// entries are constrained.
 fn grid_penalty_system(side: usize) -> (SparseMatrix, Vec<bool>) {
     let n = side * side;
-    let mut t = Vec::with_capacity(10 * n);
-    let id = |x: usize, y: usize| y * side + x;
-    for y in 0..side {
-        for x in 0..side {
-            let mut edge = |a: usize, b: usize| {
-                t.push((a, a, 1.0));
-                t.push((b, b, 1.0));
-                t.push((a, b, -1.0));
-                t.push((b, a, -1.0));
-            };
-            if x + 1 < side {
-                edge(id(x, y), id(x + 1, y));
-            }
-            if y + 1 < side {
-                edge(id(x, y), id(x, y + 1));
-            }
-        }
-    }
+    let picked = common::every(n, 50);
     let mut constrained = vec![false; n];
-    for i in (0..n).step_by(50) {
+    for &i in &picked {
         constrained[i] = true;
-        t.push((i, i, ALPHA));
     }
-    (SparseMatrix::from_triplets(n, n, &t).expect("valid grid"), constrained)
+    (common::penalty_system(side, side, &picked, ALPHA), constrained)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

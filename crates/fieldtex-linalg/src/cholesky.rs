@@ -129,13 +129,7 @@ impl SymbolicCholesky {
         perm: &[usize],
     ) -> Result<Self, LinalgError> {
         let n = check_square(a)?;
-        if perm.len() != n {
-            return Err(LinalgError::Dimension {
-                what: "ordering length",
-                expected: n,
-                found: perm.len(),
-            });
-        }
+        LinalgError::check_len("ordering length", n, perm.len())?;
         let mut inv = vec![usize::MAX; n];
         for (k, &i) in perm.iter().enumerate() {
             if i >= n || inv[i] != usize::MAX {
@@ -205,13 +199,7 @@ impl SymbolicCholesky {
 
     fn check_pattern(&self, a: &SparseMatrix) -> Result<(), LinalgError> {
         let n = check_square(a)?;
-        if n != self.size() {
-            return Err(LinalgError::Dimension {
-                what: "matrix size vs symbolic analysis",
-                expected: self.size(),
-                found: n,
-            });
-        }
+        LinalgError::check_len("matrix size vs symbolic analysis", self.size(), n)?;
         if a.col_ptr() != self.inner.col_ptr.as_slice() {
             return Err(LinalgError::PatternMismatch { what: "column counts differ" });
         }
@@ -463,13 +451,7 @@ impl Cholesky {
     /// Solves `A x = b` and returns `x` with its relative residual.
     pub fn solve_with_residual(&self, b: &[f64]) -> Result<(Vec<f64>, f64), LinalgError> {
         let n = self.size();
-        if b.len() != n {
-            return Err(LinalgError::Dimension {
-                what: "right-hand side",
-                expected: n,
-                found: b.len(),
-            });
-        }
+        LinalgError::check_len("right-hand side", n, b.len())?;
         let (x, rel) = self.solve_block(b, 1)?;
         Ok((x, rel[0]))
     }
@@ -515,13 +497,7 @@ pub(crate) fn failed(size: usize, reason: String) -> LinalgError {
 }
 
 fn check_square(a: &SparseMatrix) -> Result<usize, LinalgError> {
-    if a.nrows() != a.ncols() {
-        return Err(LinalgError::Dimension {
-            what: "Cholesky needs a square matrix (columns)",
-            expected: a.nrows(),
-            found: a.ncols(),
-        });
-    }
+    LinalgError::check_len("Cholesky needs a square matrix (columns)", a.nrows(), a.ncols())?;
     Ok(a.nrows())
 }
 

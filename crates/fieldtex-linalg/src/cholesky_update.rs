@@ -517,14 +517,7 @@ impl DynamicFactor {
             for &c in &self.path[step..] {
                 self.work[c] = 0.0;
             }
-            let reason = if ratio.is_nan() {
-                "the updated pivot is not a positive finite number (overflow?)".to_string()
-            } else {
-                format!(
-                    "the pivot would change by a factor of {ratio:e} in its square: the downdated matrix is not (numerically) positive definite"
-                )
-            };
-            return Err((j, reason));
+            return Err((j, pivot_failure_reason(ratio)));
         }
         Ok(())
     }
@@ -705,6 +698,18 @@ pub(crate) fn check_alpha(alpha: f64) -> Result<(), LinalgError> {
         });
     }
     Ok(())
+}
+
+/// Why a rank-1 sweep stopped at a pivot: `ratio` is the factor by which the pivot's
+/// square would change, NaN when the updated pivot is not a positive finite number.
+pub(crate) fn pivot_failure_reason(ratio: f64) -> String {
+    if ratio.is_nan() {
+        "the updated pivot is not a positive finite number (overflow?)".to_string()
+    } else {
+        format!(
+            "the pivot would change by a factor of {ratio:e} in its square: the downdated matrix is not (numerically) positive definite"
+        )
+    }
 }
 
 #[cfg(test)]

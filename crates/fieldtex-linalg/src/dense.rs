@@ -15,13 +15,7 @@ use crate::LinalgError;
 /// row-major `n × n` `vectors`. Errors on wrong length, non-finite or asymmetric input
 /// (relative tolerance `1e-10`).
 pub fn symmetric_eigen(a: &[f64], n: usize) -> Result<(Vec<f64>, Vec<f64>), LinalgError> {
-    if a.len() != n * n {
-        return Err(LinalgError::Dimension {
-            what: "dense symmetric matrix (n²)",
-            expected: n * n,
-            found: a.len(),
-        });
-    }
+    LinalgError::check_len("dense symmetric matrix (n²)", n * n, a.len())?;
     if let Some(index) = a.iter().position(|v| !v.is_finite()) {
         return Err(LinalgError::NonFinite { what: "dense symmetric matrix", index });
     }

@@ -14,13 +14,7 @@ use crate::{Cholesky, LinalgError, SparseMatrix};
 /// Least-squares solution of `A x ≈ b` (`A` is `m × n`, `m ≥ n` with full column rank,
 /// `b` has `m` entries); returns `x` with `n` entries.
 pub fn least_squares(a: &SparseMatrix, b: &[f64]) -> Result<Vec<f64>, LinalgError> {
-    if b.len() != a.nrows() {
-        return Err(LinalgError::Dimension {
-            what: "least-squares right-hand side",
-            expected: a.nrows(),
-            found: b.len(),
-        });
-    }
+    LinalgError::check_len("least-squares right-hand side", a.nrows(), b.len())?;
     if let Some(index) = a.first_non_finite() {
         return Err(LinalgError::NonFinite { what: "least-squares matrix value", index });
     }

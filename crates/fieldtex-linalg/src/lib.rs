@@ -85,6 +85,13 @@ pub enum LinalgError {
     InvalidArgument { what: &'static str, value: f64, reason: &'static str },
 }
 
+impl LinalgError {
+    /// `Ok` when `found == expected`, else [`LinalgError::Dimension`] naming `what`.
+    pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), Self> {
+        if found == expected { Ok(()) } else { Err(Self::Dimension { what, expected, found }) }
+    }
+}
+
 /// Every solver failure is internal: the workspace builds its matrices itself, so a
 /// failed factorisation or a bad argument is our bug or a numerical breakdown.
 impl fieldtex_core::HasErrorKind for LinalgError {

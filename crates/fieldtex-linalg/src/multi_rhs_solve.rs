@@ -53,22 +53,10 @@ impl Cholesky {
     /// values.
     pub fn solve_many_into(&self, b: &[&[f64]], x: &mut [&mut [f64]]) -> Result<f64, LinalgError> {
         let n = self.size();
-        if x.len() != b.len() {
-            return Err(LinalgError::Dimension {
-                what: "number of solution buffers",
-                expected: b.len(),
-                found: x.len(),
-            });
-        }
+        LinalgError::check_len("number of solution buffers", b.len(), x.len())?;
         for (bi, xi) in b.iter().zip(x.iter()) {
             for len in [bi.len(), xi.len()] {
-                if len != n {
-                    return Err(LinalgError::Dimension {
-                        what: "right-hand side or solution buffer",
-                        expected: n,
-                        found: len,
-                    });
-                }
+                LinalgError::check_len("right-hand side or solution buffer", n, len)?;
             }
         }
         let results: Vec<Result<f64, LinalgError>> = b

@@ -55,7 +55,7 @@
 use crate::LinalgError;
 use crate::blocked_update::Blocked;
 use crate::cholesky::Cholesky;
-use crate::cholesky_update::{DynamicFactor, NONE, check_alpha};
+use crate::cholesky_update::{DynamicFactor, NONE, check_alpha, pivot_failure_reason};
 
 const NO_SLOT: u32 = u32::MAX;
 
@@ -268,14 +268,7 @@ impl DynamicFactor {
                     off += l;
                 }
             }
-            let reason = if ratio.is_nan() {
-                "the updated pivot is not a positive finite number (overflow?)".to_string()
-            } else {
-                format!(
-                    "the pivot would change by a factor of {ratio:e} in its square: the downdated matrix is not (numerically) positive definite"
-                )
-            };
-            return Err((j, reason));
+            return Err((j, pivot_failure_reason(ratio)));
         }
         Ok(())
     }

@@ -204,13 +204,7 @@ impl Cholesky {
             if i >= n {
                 return Err(LinalgError::IndexOutOfRange { row: i, col: 0, nrows: n, ncols: k });
             }
-            if v.len() != k {
-                return Err(LinalgError::Dimension {
-                    what: "values per right-hand-side row",
-                    expected: k,
-                    found: v.len(),
-                });
-            }
+            LinalgError::check_len("values per right-hand-side row", k, v.len())?;
             if v.iter().any(|x| !x.is_finite()) {
                 return Err(LinalgError::NonFinite { what: "right-hand side", index: i });
             }
@@ -313,13 +307,7 @@ impl Cholesky {
         b: &[f64],
     ) -> Result<(Vec<f64>, f64), LinalgError> {
         let n = self.size();
-        if b.len() != n {
-            return Err(LinalgError::Dimension {
-                what: "right-hand side",
-                expected: n,
-                found: b.len(),
-            });
-        }
+        LinalgError::check_len("right-hand side", n, b.len())?;
         if let Some(index) = b.iter().position(|v| !v.is_finite()) {
             return Err(LinalgError::NonFinite { what: "right-hand side", index });
         }

@@ -101,13 +101,7 @@ impl SparseMatrix {
         row_idx: Vec<usize>,
         values: Vec<f64>,
     ) -> Result<Self, LinalgError> {
-        if col_ptr.len() != ncols + 1 {
-            return Err(LinalgError::Dimension {
-                what: "CSC column pointers",
-                expected: ncols + 1,
-                found: col_ptr.len(),
-            });
-        }
+        LinalgError::check_len("CSC column pointers", ncols + 1, col_ptr.len())?;
         let nnz = *col_ptr.last().unwrap();
         if col_ptr[0] != 0 || row_idx.len() != nnz || values.len() != nnz {
             return Err(LinalgError::Dimension {

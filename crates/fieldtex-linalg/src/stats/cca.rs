@@ -155,13 +155,7 @@ pub fn cca(
         });
     }
     let n = x.len() / p;
-    if y.len() / q != n {
-        return Err(LinalgError::Dimension {
-            what: "CCA paired rows",
-            expected: n,
-            found: y.len() / q,
-        });
-    }
+    LinalgError::check_len("CCA paired rows", n, y.len() / q)?;
     if n < 2 {
         return Err(LinalgError::Dimension {
             what: "CCA sample count (≥ 2)",
