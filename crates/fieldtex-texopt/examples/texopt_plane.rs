@@ -4,19 +4,16 @@
 //! `cargo run --release -p fieldtex-texopt --example texopt_plane -- [SIZE] [EXEMPLAR]
 //! [FIELD_ANGLE_DEG] [OUT.png]` (defaults: 256, stripes, 30°, /tmp/texopt_plane.png).
 
-use fieldtex_core::{Image, NoProgress};
+use fieldtex_core::NoProgress;
 use fieldtex_mesh::primitives::grid;
 use fieldtex_texopt::{SurfaceDomain, TexOptOptions, optimise};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-fn load(path: &Path) -> Image {
-    let img = image::open(path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
-        .to_rgba32f();
-    let (w, h) = img.dimensions();
-    Image { width: w as usize, height: h as usize, pixels: img.pixels().map(|p| p.0).collect() }
-}
+// The plane tests' helpers (exemplar reading, orientation measurement).
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::{dominant_orientation, line_angle_difference, luma};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -27,7 +24,7 @@ fn main() {
     let angle_deg: f64 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(30.0);
     let out =
         args.get(4).map(PathBuf::from).unwrap_or_else(|| PathBuf::from("/tmp/texopt_plane.png"));
-    let exemplar = load(&exemplar_path);
+    let exemplar = common::load_image(&exemplar_path);
 
     let t0 = Instant::now();
     let n = size - 1;
@@ -43,13 +40,13 @@ fn main() {
 
     // Carrier of vertex (i, j) → image pixel (i, size-1-j) (world y up, image y down).
     let mut img = image::RgbaImage::new(size as u32, size as u32);
-    let mut luma = vec![0.0f32; size * size];
+    let mut luma_img = vec![0.0f32; size * size];
     for (c, &v) in vertices.iter().enumerate() {
         let (i, j) = (v as usize % size, v as usize / size);
         let col = result.colors[c];
         let px = col.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8);
         img.put_pixel(i as u32, (size - 1 - j) as u32, image::Rgba(px));
-        luma[(size - 1 - j) * size + i] = 0.2126 * col[0] + 0.7152 * col[1] + 0.0722 * col[2];
+        luma_img[(size - 1 - j) * size + i] = luma(col);
     }
     img.save(&out).expect("write png");
     // The same carriers coloured by their source coordinate (nearest exemplar pixel).
@@ -69,7 +66,7 @@ fn main() {
     let (ex_angle, _) =
         dominant_orientation(&exemplar.luminance(), exemplar.width, exemplar.height)
             .unwrap_or((0.0, 0.0));
-    let (got, coh) = dominant_orientation(&luma, size, size).unwrap_or((f64::NAN, 0.0));
+    let (got, coh) = dominant_orientation(&luma_img, size, size).unwrap_or((f64::NAN, 0.0));
     // Image y is down: a world angle a appears as -a in the image; exemplar lines at
     // ex_angle follow the field.
     let expected = (-a + ex_angle).rem_euclid(std::f64::consts::PI);
@@ -94,18 +91,4 @@ fn main() {
         );
     }
     println!("wrote {}", out.display());
-}
-
-/// Dominant line orientation (radians in `[0, π)`) and coherence of a luminance image,
-/// by fieldtex-eval's structure tensor.
-fn dominant_orientation(luma: &[f32], w: usize, h: usize) -> Option<(f64, f64)> {
-    let view = fieldtex_eval::ImageView::new(luma, w, h, 1).ok()?;
-    let (deg, coherence) = fieldtex_eval::dominant_orientation(&view).ok()?;
-    Some((deg.to_radians(), coherence))
-}
-
-/// Smallest angle between two line orientations (radians, modulo π).
-fn line_angle_difference(a: f64, b: f64) -> f64 {
-    let d = (a - b).rem_euclid(std::f64::consts::PI);
-    d.min(std::f64::consts::PI - d)
 }

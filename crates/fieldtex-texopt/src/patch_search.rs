@@ -65,22 +65,13 @@ pub(crate) fn gather_patch(
     out: &mut [f32; DIM],
 ) -> bool {
     let f = &ctx.frames[p];
-    let pos = ctx.domain.positions();
-    let nrm = ctx.domain.normals();
     let mut acc = [0.0f32; DIM];
     let mut wsum = [0.0f32; GRID * GRID];
-    let lim = GRID as f64 - 0.5;
     ctx.carrier_grid.for_each_within(&ctx.active_positions, f.pos, ctx.radius, |a, _| {
         let c = ctx.active[a as usize] as usize;
-        if dot(nrm[c], f.n) < ctx.normal_cosine {
+        let Some((u, v)) = ctx.footprint_coords(p, c) else {
             return;
-        }
-        let d = sub(pos[c], f.pos);
-        let u = dot(d, f.tx) + HALF;
-        let v = dot(d, f.ty) + HALF;
-        if !(-0.5..lim).contains(&u) || !(-0.5..lim).contains(&v) {
-            return;
-        }
+        };
         let (u, v) = (u.clamp(0.0, HALF * 2.0), v.clamp(0.0, HALF * 2.0));
         let (i0, j0) = ((u.floor() as usize).min(GRID - 2), (v.floor() as usize).min(GRID - 2));
         let (a, b) = ((u - i0 as f64) as f32, (v - j0 as f64) as f32);

@@ -25,9 +25,8 @@
 //! exemplar pixel; seams between patches stay where the average put its transitions).
 
 use crate::CrispChoice;
-use crate::exemplar_patches::{GRID, HALF};
+use crate::exemplar_patches::HALF;
 use crate::texture_optimisation::LevelContext;
-use fieldtex_core::vec3::{dot, sub};
 use rayon::prelude::*;
 
 /// Robust IRLS weight `λ · max(e, 1/255)^(r−2)` of a sample whose squared 192-D patch
@@ -113,8 +112,6 @@ fn blend_carrier(
     let lvl = ctx.level;
     let s = lvl.step as f64;
     let pos = ctx.domain.positions();
-    let nrm = ctx.domain.normals();
-    let lim = GRID as f64 - 0.5;
     let mut acc = [0.0f64; 4];
     let mut wsum = 0.0f64;
     let mut win = (f64::NEG_INFINITY, [0.0f64; 2]);
@@ -123,16 +120,9 @@ fn blend_carrier(
     let mut win_color = [0.0f32; 4];
     ctx.sample_grid.for_each_within(&ctx.sample_positions, pos[c], ctx.radius, |p, _| {
         let p = p as usize;
-        let f = &ctx.frames[p];
-        if dot(nrm[c], f.n) < ctx.normal_cosine {
+        let Some((u, v)) = ctx.footprint_coords(p, c) else {
             return;
-        }
-        let d = sub(pos[c], f.pos);
-        let u = dot(d, f.tx) + HALF;
-        let v = dot(d, f.ty) + HALF;
-        if !(-0.5..lim).contains(&u) || !(-0.5..lim).contains(&v) {
-            return;
-        }
+        };
         let [ox, oy] = lvl.origin(matches[p].position);
         let [fx, fy] = matches[p].offset;
         let (ex, ey) = (ox as f64 + fx as f64 + u * s, oy as f64 + fy as f64 + v * s);

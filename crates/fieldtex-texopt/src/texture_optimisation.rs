@@ -23,7 +23,7 @@
 //! between the gathered patch and its new match (before blending) — the robust energy
 //! IRLS decreases.
 
-use crate::exemplar_patches::{ExemplarLevel, GRID};
+use crate::exemplar_patches::{ExemplarLevel, GRID, HALF};
 use crate::patch_search::{Match, Placement, search_sample};
 use crate::robust_blend::{BlendMode, blend, robust_weight};
 use crate::{FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, sample_set};
@@ -120,6 +120,27 @@ pub(crate) struct LevelContext<'a> {
     pub coherence_bias: f64,
     /// [`TexOptOptions::crisp_choice`].
     pub crisp_choice: crate::CrispChoice,
+}
+
+impl LevelContext<'_> {
+    /// Patch-grid coordinates `(u, v)` of carrier `c` in sample `p`'s frame (the tangent
+    /// plane projection of Kwatra et al. 2005 §4), or `None` when the carrier faces away
+    /// (normal cosine below `normal_cosine`) or falls outside the `GRID × GRID` patch.
+    #[inline]
+    pub(crate) fn footprint_coords(&self, p: usize, c: usize) -> Option<(f64, f64)> {
+        let f = &self.frames[p];
+        if vec3::dot(self.domain.normals()[c], f.n) < self.normal_cosine {
+            return None;
+        }
+        let d = vec3::sub(self.domain.positions()[c], f.pos);
+        let u = vec3::dot(d, f.tx) + HALF;
+        let v = vec3::dot(d, f.ty) + HALF;
+        let lim = GRID as f64 - 0.5;
+        if !(-0.5..lim).contains(&u) || !(-0.5..lim).contains(&v) {
+            return None;
+        }
+        Some((u, v))
+    }
 }
 
 fn validate_inputs(

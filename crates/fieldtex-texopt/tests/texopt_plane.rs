@@ -6,15 +6,9 @@ use fieldtex_mesh::primitives::grid;
 use fieldtex_texopt::{
     Carrier, FeatureAlignment, SurfaceDomain, TexOptError, TexOptOptions, optimise, sample_set,
 };
-use std::path::Path;
 
-fn load_exemplar(name: &str) -> Image {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/exemplars").join(name);
-    let img = image::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba32f();
-    let (w, h) = img.dimensions();
-    Image { width: w as usize, height: h as usize, pixels: img.pixels().map(|p| p.0).collect() }
-}
+mod common;
+use common::{dominant_orientation, line_angle_difference, load_exemplar, luminance};
 
 /// A `size × size` vertex grid (unit spacing) with a constant field at `angle` (radians).
 fn plane(size: usize, angle: f64) -> (SurfaceDomain, Vec<u32>) {
@@ -26,15 +20,10 @@ fn plane(size: usize, angle: f64) -> (SurfaceDomain, Vec<u32>) {
     (domain, vertices)
 }
 
-/// Luminance of the carriers laid out as an image (vertex (i, j) → pixel (i, size−1−j)).
-fn luminance(colors: &[[f32; 4]], vertices: &[u32], size: usize) -> Vec<f32> {
-    let mut out = vec![0.0; size * size];
-    for (c, &v) in vertices.iter().enumerate() {
-        let (i, j) = (v as usize % size, v as usize / size);
-        let col = colors[c];
-        out[(size - 1 - j) * size + i] = 0.2126 * col[0] + 0.7152 * col[1] + 0.0722 * col[2];
-    }
-    out
+/// Per exemplar pixel, the distance in pixels to the row `y` (a horizontal feature line).
+fn row_distance(exemplar: &Image, y: f32) -> Vec<f32> {
+    let w = exemplar.width;
+    (0..w * exemplar.height).map(|i| ((i / w) as f32 - y).abs()).collect()
 }
 
 fn quick_options() -> TexOptOptions {
@@ -42,20 +31,6 @@ fn quick_options() -> TexOptOptions {
         .with_patch_sizes(vec![16, 8])
         .with_pixel_size(1.0)
         .with_max_iterations(3)
-}
-
-/// Dominant line orientation (radians in `[0, π)`) and coherence of a luminance image,
-/// by fieldtex-eval's structure tensor.
-fn dominant_orientation(luma: &[f32], w: usize, h: usize) -> Option<(f64, f64)> {
-    let view = fieldtex_eval::ImageView::new(luma, w, h, 1).ok()?;
-    let (deg, coherence) = fieldtex_eval::dominant_orientation(&view).ok()?;
-    Some((deg.to_radians(), coherence))
-}
-
-/// Smallest angle between two line orientations (radians, modulo π).
-fn line_angle_difference(a: f64, b: f64) -> f64 {
-    let d = (a - b).rem_euclid(std::f64::consts::PI);
-    d.min(std::f64::consts::PI - d)
 }
 
 /// Orientation error (degrees) and coherence of a run on a `size²` plane with field
@@ -151,7 +126,7 @@ fn feature_alignment_puts_exemplar_features_on_the_curve() {
     let stripes = load_exemplar("stripes_Fabric071.png");
     let (w, h) = (stripes.width, stripes.height);
     // Exemplar feature line: the row y = 58 (horizontal, along the stripes).
-    let exemplar_distance: Vec<f32> = (0..w * h).map(|i| ((i / w) as f32 - 58.0).abs()).collect();
+    let exemplar_distance = row_distance(&stripes, 58.0);
     let size = 64;
     let (domain, vertices) = plane(size, 0.0);
     // Salient curve: the line y = 31.
@@ -322,8 +297,7 @@ fn curved_closed_surface_runs_with_a_swirling_field() {
 #[test]
 fn unreachable_carriers_still_get_colour() {
     let stripes = load_exemplar("stripes_Fabric071.png");
-    let (w, h) = (stripes.width, stripes.height);
-    let exemplar_distance: Vec<f32> = (0..w * h).map(|i| ((i / w) as f32 - 58.0).abs()).collect();
+    let exemplar_distance = row_distance(&stripes, 58.0);
     let size = 64;
     let (domain, vertices) = plane(size, 0.0);
     // Only rows within 6 of y = 31 know their distance; everything else is unreachable.
