@@ -40,6 +40,7 @@
 //! result is identical for any thread count and the work is parallel.
 
 use crate::TransferError;
+use crate::parametric_synthesis::SynthesisInput;
 use crate::surface_samples::{SamplePyramid, SampleSet};
 use crate::surface_stencils::{Stencils, stencil_grid, stencils};
 use fieldtex_linalg::Pca;
@@ -136,21 +137,6 @@ pub struct NonparametricLevel {
 pub struct NonparametricStats {
     /// Coarsest first.
     pub levels: Vec<NonparametricLevel>,
-}
-
-/// Inputs of [`nonparametric_synthesis`]: level-0 values over the two pyramids.
-pub struct NonparametricInput<'a> {
-    pub source: &'a SamplePyramid,
-    /// `#source × 3`.
-    pub source_guidance: &'a [f64],
-    /// `#source × 3` RGB.
-    pub source_colors: &'a [f64],
-    pub source_valid: &'a [bool],
-    pub target: &'a SamplePyramid,
-    /// `#target × 3`.
-    pub target_guidance: &'a [f64],
-    /// Up axis index (0, 1, 2) that orients the stencils.
-    pub up: usize,
 }
 
 const PCA_FIT: usize = 20_000;
@@ -342,8 +328,11 @@ fn nearest_in(set: &SampleSet, pts: &SampleSet) -> Vec<u32> {
 }
 
 /// Runs the engine (module docs); returns `#target × 3` RGB in `[0, 1]`.
+///
+/// `up` is the up axis index (0, 1, 2) that orients the stencils.
 pub fn nonparametric_synthesis(
-    input: &NonparametricInput<'_>,
+    input: &SynthesisInput<'_>,
+    up: usize,
     options: &NonparametricOptions,
 ) -> Result<(Vec<f64>, NonparametricStats), TransferError> {
     options.validate()?;
@@ -375,11 +364,11 @@ pub fn nonparametric_synthesis(
     let tgrid: Vec<_> = tp.levels[..levels].iter().map(stencil_grid).collect();
     let own = |p: &SamplePyramid, g: &[fieldtex_texopt::UniformGrid], l: usize, size: usize| {
         let set = &p.levels[l];
-        stencils(&set.positions, &set.normals, set, &g[l], size, input.up)
+        stencils(&set.positions, &set.normals, set, &g[l], size, up)
     };
     let parent = |p: &SamplePyramid, g: &[fieldtex_texopt::UniformGrid], l: usize| {
         let (fine, coarse) = (&p.levels[l], &p.levels[l + 1]);
-        stencils(&fine.positions, &fine.normals, coarse, &g[l + 1], 3, input.up)
+        stencils(&fine.positions, &fine.normals, coarse, &g[l + 1], 3, up)
     };
     let fine_w = cell_weights(n, 1.0);
     let parent_w = cell_weights(3, 0.5);

@@ -85,8 +85,9 @@ pub struct ParametricStats {
     pub noise_std: [f64; 3],
 }
 
-/// Inputs of [`parametric_synthesis`]: level-0 values over the two pyramids.
-pub struct ParametricInput<'a> {
+/// Inputs of both synthesis engines ([`parametric_synthesis`] and
+/// [`crate::nonparametric_synthesis`]): level-0 values over the two pyramids.
+pub struct SynthesisInput<'a> {
     pub source: &'a SamplePyramid,
     /// `#source × 3` guidance.
     pub source_guidance: &'a [f64],
@@ -301,7 +302,7 @@ struct TargetModel {
 
 /// Runs the engine (module docs); returns `#target × 3` RGB in `[0, 1]`.
 pub fn parametric_synthesis(
-    input: &ParametricInput<'_>,
+    input: &SynthesisInput<'_>,
     options: &ParametricOptions,
     seed: u64,
 ) -> Result<(Vec<f64>, ParametricStats), TransferError> {

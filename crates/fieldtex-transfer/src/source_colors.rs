@@ -51,16 +51,7 @@ pub fn surface_colors(
     if texture.width == 0 || texture.height == 0 {
         return Err(TransferError::SourceNotTextured { what: "texture is empty".into() });
     }
-    if let Some(m) = mask
-        && (m.width != texture.width || m.height != texture.height)
-    {
-        return Err(TransferError::MaskSize {
-            mask_w: m.width,
-            mask_h: m.height,
-            tex_w: texture.width,
-            tex_h: texture.height,
-        });
-    }
+    check_mask_size(mask, texture)?;
     let (w, h) = (texture.width as f64, texture.height as f64);
     let rows: Vec<([f64; 3], bool)> = (0..triangles.len().min(barycentric.len()))
         .into_par_iter()
@@ -102,4 +93,19 @@ pub fn surface_colors(
         valid.push(v);
     }
     Ok((colors, valid))
+}
+
+/// A mask must have the texture's size (one mask texel per texture texel).
+pub(crate) fn check_mask_size(mask: Option<&Image>, texture: &Image) -> Result<(), TransferError> {
+    match mask {
+        Some(m) if m.width != texture.width || m.height != texture.height => {
+            Err(TransferError::MaskSize {
+                mask_w: m.width,
+                mask_h: m.height,
+                tex_w: texture.width,
+                tex_h: texture.height,
+            })
+        }
+        _ => Ok(()),
+    }
 }

@@ -7,13 +7,13 @@ use crate::descriptors::{DescriptorOptions, compute_descriptors};
 use crate::feature_matching::{MatchMode, MatchStep, match_features};
 use crate::guidance::{Reduction, build_guidance};
 use crate::nonparametric_synthesis::{
-    NonparametricInput, NonparametricOptions, NonparametricStats, nonparametric_synthesis,
+    NonparametricOptions, NonparametricStats, nonparametric_synthesis,
 };
 use crate::parametric_synthesis::{
-    ParametricInput, ParametricOptions, ParametricStats, parametric_synthesis,
+    ParametricOptions, ParametricStats, SynthesisInput, parametric_synthesis,
 };
 use crate::scattered_interpolation::Interpolator;
-use crate::source_colors::source_sample_colors;
+use crate::source_colors::{check_mask_size, source_sample_colors};
 use crate::surface_samples::{SamplePyramid, SampleSet};
 use fieldtex_core::vec3::{self, V3};
 use fieldtex_core::{Image, Progress, Warning};
@@ -180,16 +180,7 @@ pub fn transfer(
     if source.uvs.is_none() {
         return Err(TransferError::SourceNotTextured { what: "has no texture coordinates".into() });
     }
-    if let Some(m) = mask
-        && (m.width != texture.width || m.height != texture.height)
-    {
-        return Err(TransferError::MaskSize {
-            mask_w: m.width,
-            mask_h: m.height,
-            tex_w: texture.width,
-            tex_h: texture.height,
-        });
-    }
+    check_mask_size(mask, texture)?;
     if source.n_triangles() == 0 {
         return Err(TransferError::EmptyMesh { which: "source" });
     }
@@ -220,35 +211,25 @@ pub fn transfer(
         match_features(&mut gt, &g.source, &sp, &tp, options.matching, seed)
     })?;
     progress.stage("synthesis", 1);
-    let (target_colors, parametric, nonparametric) =
-        timed(&mut t, "synthesis", || match options.engine {
-            Engine::Parametric => parametric_synthesis(
-                &ParametricInput {
-                    source: &sp,
-                    source_guidance: &g.source,
-                    source_colors: &source_colors,
-                    source_valid: &source_valid,
-                    target: &tp,
-                    target_guidance: &gt,
-                },
-                &options.parametric,
-                seed,
-            )
-            .map(|(c, s)| (c, Some(s), None)),
-            Engine::Nonparametric => nonparametric_synthesis(
-                &NonparametricInput {
-                    source: &sp,
-                    source_guidance: &g.source,
-                    source_colors: &source_colors,
-                    source_valid: &source_valid,
-                    target: &tp,
-                    target_guidance: &gt,
-                    up: options.descriptors.up.index(),
-                },
-                &options.nonparametric,
-            )
-            .map(|(c, s)| (c, None, Some(s))),
-        })?;
+    let input = SynthesisInput {
+        source: &sp,
+        source_guidance: &g.source,
+        source_colors: &source_colors,
+        source_valid: &source_valid,
+        target: &tp,
+        target_guidance: &gt,
+    };
+    let (target_colors, parametric, nonparametric) = timed(&mut t, "synthesis", || match options
+        .engine
+    {
+        Engine::Parametric => {
+            parametric_synthesis(&input, &options.parametric, seed).map(|(c, s)| (c, Some(s), None))
+        }
+        Engine::Nonparametric => {
+            nonparametric_synthesis(&input, options.descriptors.up.index(), &options.nonparametric)
+                .map(|(c, s)| (c, None, Some(s)))
+        }
+    })?;
     progress.advance(1);
     progress.finish_stage();
     let SamplePyramid { levels, .. } = sp;
