@@ -9,6 +9,14 @@
 use fieldtex_eval::*;
 use std::path::Path;
 
+/// The four exemplars the bound tests run on (lines, cells, blobs, curved bands).
+const EXEMPLARS: [&str; 4] = [
+    "stripes_Fabric071.png",
+    "bricks_Bricks012.png",
+    "pebbles_Rocks002.png",
+    "bands-fingerprint-like_Onyx013.png",
+];
+
 fn load(name: &str) -> (Vec<f32>, usize, usize) {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/exemplars").join(name);
     let im = image::open(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).to_rgb32f();
@@ -52,12 +60,7 @@ fn approximate_coherence_and_completeness_stay_within_the_stated_bound() {
     let size = 128;
     let bound = fieldtex_eval::approximate_nearest_patch::ERROR_BOUND_PERCENT / 100.0;
     let mut worst_search: f64 = 0.0;
-    for name in [
-        "stripes_Fabric071.png",
-        "bricks_Bricks012.png",
-        "pebbles_Rocks002.png",
-        "bands-fingerprint-like_Onyx013.png",
-    ] {
+    for name in EXEMPLARS {
         let (ex, w, h) = load(name);
         let out = patchwork(&ex, w, h, size, 3);
         let o = ImageView::new(&out, size, size, 3).unwrap();
@@ -157,22 +160,16 @@ fn approximate_metrics_do_not_depend_on_the_thread_count() {
     let opts = PatchDistanceOptions::default()
         .with_wrap_exemplar(true)
         .with_approximate(Some(ApproximateSearchOptions::default()));
+    let on_threads =
+        |threads: usize| rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| coherence_and_completeness(&o, &e, &opts).unwrap())
+        on_threads(threads).install(|| coherence_and_completeness(&o, &e, &opts).unwrap())
     };
     assert_eq!(run(1), run(2));
     // The sampled sliced Wasserstein distance too (a sample of 2 000 of 9 216 pixels).
     let sw = SlicedWassersteinOptions { seed: 4, max_pixels: Some(2_000), ..Default::default() };
     let run_sw = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| color_sliced_wasserstein(&o, &e, &sw).unwrap())
+        on_threads(threads).install(|| color_sliced_wasserstein(&o, &e, &sw).unwrap())
     };
     assert_eq!(run_sw(1), run_sw(2));
 }
@@ -186,12 +183,7 @@ fn sampled_sliced_wasserstein_stays_within_the_stated_bound() {
         SAMPLED_ERROR_BOUND_ABS, SAMPLED_ERROR_BOUND_PERCENT, SAMPLED_PIXELS,
     };
     let size = 384;
-    for name in [
-        "stripes_Fabric071.png",
-        "bricks_Bricks012.png",
-        "pebbles_Rocks002.png",
-        "bands-fingerprint-like_Onyx013.png",
-    ] {
+    for name in EXEMPLARS {
         let (ex, w, h) = load(name);
         for shift in [0.0f32, 0.05] {
             let out: Vec<f32> =

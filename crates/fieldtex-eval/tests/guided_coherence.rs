@@ -61,23 +61,39 @@ fn exemplar_view(ex: &[f32], ew: usize, eh: usize) -> ImageView<'_> {
     ImageView::new(ex, ew, eh, 3).unwrap()
 }
 
-#[test]
-fn exact_rotated_copies_score_near_zero_and_noise_scores_high() {
-    let (ex, ew, eh) = exemplar("stripes_Fabric071.png");
-    let size = 96;
-    let mut scores = Vec::new();
-    for deg in [0.0, 30.0, 45.0, 90.0] {
-        let out = rotated_copy(&ex, ew, eh, size, deg, false);
-        scores.push((deg, guided(&out, size, &ex, ew, eh, &constant_field(size, deg))));
-    }
-    let out45 = rotated_copy(&ex, ew, eh, size, 45.0, false);
+/// Guided coherence of rotated copies (patchworks when `patchwork`) at each angle in
+/// `degs`, each under its own constant field, and the plain coherence of the 45° copy.
+fn rotated_scores(
+    ex: &[f32],
+    ew: usize,
+    eh: usize,
+    size: usize,
+    degs: &[f64],
+    patchwork: bool,
+) -> (Vec<(f64, f64)>, f64) {
+    let scores = degs
+        .iter()
+        .map(|&deg| {
+            let out = rotated_copy(ex, ew, eh, size, deg, patchwork);
+            (deg, guided(&out, size, ex, ew, eh, &constant_field(size, deg)))
+        })
+        .collect();
+    let out45 = rotated_copy(ex, ew, eh, size, 45.0, patchwork);
     let plain45 = coherence(
         &ImageView::new(&out45, size, size, 3).unwrap(),
-        &exemplar_view(&ex, ew, eh),
+        &exemplar_view(ex, ew, eh),
         &PatchDistanceOptions::default().with_wrap_exemplar(true),
     )
     .unwrap()
     .mean;
+    (scores, plain45)
+}
+
+#[test]
+fn exact_rotated_copies_score_near_zero_and_noise_scores_high() {
+    let (ex, ew, eh) = exemplar("stripes_Fabric071.png");
+    let size = 96;
+    let (scores, plain45) = rotated_scores(&ex, ew, eh, size, &[0.0, 30.0, 45.0, 90.0], false);
     let noise: Vec<f32> = (0..size * size * 3)
         .map(|i| fieldtex_core::rng::hash_unit(7, "guided-noise", i as u64) as f32)
         .collect();
@@ -105,19 +121,7 @@ fn rotated_patchworks_score_within_twice_the_unrotated_one() {
         eh,
         &constant_field(size, 0.0),
     );
-    let mut scores = Vec::new();
-    for deg in [30.0, 45.0, 90.0] {
-        let out = rotated_copy(&ex, ew, eh, size, deg, true);
-        scores.push((deg, guided(&out, size, &ex, ew, eh, &constant_field(size, deg))));
-    }
-    let out45 = rotated_copy(&ex, ew, eh, size, 45.0, true);
-    let plain45 = coherence(
-        &ImageView::new(&out45, size, size, 3).unwrap(),
-        &exemplar_view(&ex, ew, eh),
-        &PatchDistanceOptions::default().with_wrap_exemplar(true),
-    )
-    .unwrap()
-    .mean;
+    let (scores, plain45) = rotated_scores(&ex, ew, eh, size, &[30.0, 45.0, 90.0], true);
     eprintln!("patchworks: 0° {zero}, {scores:?}, plain 45° {plain45}");
     assert!(zero > 1e-5, "the seams must cost something: {zero}");
     for &(deg, v) in &scores {

@@ -43,6 +43,19 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Chains of edges whose dihedral angle exceeds `min_angle_deg`, broken at vertices of
 /// sharp-degree ≠ 2 and at turns sharper than `max_turn_deg`, kept if ≥ `min_edges` long.
+/// Runs `f` `runs` times (at least once); the wall times in ms and the last result.
+fn timed_runs<T>(runs: usize, mut f: impl FnMut() -> T) -> (Vec<f64>, T) {
+    let mut totals = Vec::new();
+    let mut last = None;
+    for _ in 0..runs.max(1) {
+        let t0 = Instant::now();
+        let r = f();
+        totals.push(1e3 * t0.elapsed().as_secs_f64());
+        last = Some(r);
+    }
+    (totals, last.expect("at least one run"))
+}
+
 fn sharp_edge_chains(
     mesh: &TriMesh,
     min_angle_deg: f64,
@@ -201,15 +214,9 @@ fn main() {
 
     // Greedy: `runs` timed runs; metrics from the last.
     let options = CurveOrientationOptions::default();
-    let mut totals = Vec::new();
-    let mut last = None;
-    for _ in 0..runs.max(1) {
-        let t0 = Instant::now();
-        let r = orient_curves(&mesh, &curves, &options, &NoProgress).expect("greedy orientation");
-        totals.push(1e3 * t0.elapsed().as_secs_f64());
-        last = Some(r);
-    }
-    let r = last.expect("at least one run");
+    let (totals, r) = timed_runs(runs, || {
+        orient_curves(&mesh, &curves, &options, &NoProgress).expect("greedy orientation")
+    });
     let t_metrics = Instant::now();
     let m =
         surface_field_metrics(&mesh, &r.field.vectors, &r.solver.constraints()).expect("metrics");
@@ -268,15 +275,9 @@ fn main() {
     // Batched greedy (not in the paper): same measures, and agreement with the exact one.
     if batch > 0.0 {
         let o = CurveOrientationOptions { batch_consistency: Some(batch), ..Default::default() };
-        let mut totals = Vec::new();
-        let mut last = None;
-        for _ in 0..runs.max(1) {
-            let t0 = Instant::now();
-            let b = orient_curves(&mesh, &curves, &o, &NoProgress).expect("batched greedy");
-            totals.push(1e3 * t0.elapsed().as_secs_f64());
-            last = Some(b);
-        }
-        let b = last.expect("at least one run");
+        let (totals, b) = timed_runs(runs, || {
+            orient_curves(&mesh, &curves, &o, &NoProgress).expect("batched greedy")
+        });
         let mb = surface_field_metrics(&mesh, &b.field.vectors, &b.solver.constraints())
             .expect("metrics");
         let same = b.signs.iter().zip(&r.signs).filter(|(x, y)| x == y).count();

@@ -11,6 +11,16 @@ fn curve(points: Vec<[f64; 3]>, normal: [f64; 3], axis: usize) -> FrameCurve {
     FrameCurve { points, normals, axis, weight: 1.0, refine: false }
 }
 
+/// 41 points on 90 % of a horizontal circle (radius 0.4 around (0.5, 0.6), z = 0.7).
+fn arc_points() -> Vec<[f64; 3]> {
+    (0..=40)
+        .map(|i| {
+            let a = i as f64 / 40.0 * std::f64::consts::TAU * 0.9;
+            [0.5 + 0.4 * a.cos(), 0.6 + 0.4 * a.sin(), 0.7]
+        })
+        .collect()
+}
+
 #[test]
 fn constraints_are_met_within_five_degrees() {
     let mut field = FrameField3d::new(grid(), FrameFieldOptions::default()).unwrap();
@@ -37,12 +47,7 @@ fn signs_are_continuous_along_a_curve_and_against_the_field() {
     let mut field = FrameField3d::new(grid(), FrameFieldOptions::default()).unwrap();
     // A full turn of the tangent makes the quaternion go to −q by continuity;
     // the chosen signs must stay continuous between consecutive samples.
-    let pts: Vec<[f64; 3]> = (0..=40)
-        .map(|i| {
-            let a = i as f64 / 40.0 * std::f64::consts::TAU * 0.9;
-            [0.5 + 0.4 * a.cos(), 0.6 + 0.4 * a.sin(), 0.7]
-        })
-        .collect();
+    let pts = arc_points();
     let id = field.add_curve(&curve(pts, [0.0, 0.0, 1.0], 0)).unwrap();
     let targets = field.curves[id].as_ref().unwrap();
     // Consecutive targets (nodes in curve order) differ by small rotations and
@@ -61,12 +66,7 @@ fn signs_are_continuous_along_a_curve_and_against_the_field() {
     // Removing it restores the previous field exactly (downdate of the kept factor).
     let before: Vec<Quat> = {
         let mut f2 = FrameField3d::new(grid(), FrameFieldOptions::default()).unwrap();
-        let pts: Vec<[f64; 3]> = (0..=40)
-            .map(|i| {
-                let a = i as f64 / 40.0 * std::f64::consts::TAU * 0.9;
-                [0.5 + 0.4 * a.cos(), 0.6 + 0.4 * a.sin(), 0.7]
-            })
-            .collect();
+        let pts = arc_points();
         f2.add_curve(&curve(pts, [0.0, 0.0, 1.0], 0)).unwrap();
         f2.frames().to_vec()
     };

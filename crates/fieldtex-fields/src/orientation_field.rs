@@ -166,73 +166,65 @@ pub fn sample_plane_into(
     height: usize,
     out: &mut Vec<[f32; 2]>,
 ) -> Result<(), FieldsError> {
-    crate::field_design::in_pool(|| sample_in_pool(design, field, width, height, out))
-}
-
-fn sample_in_pool(
-    design: &FieldDesign,
-    field: &SolvedField,
-    width: usize,
-    height: usize,
-    out: &mut Vec<[f32; 2]>,
-) -> Result<(), FieldsError> {
-    let grid = *design.plane().ok_or(FieldsError::InvalidOption {
-        name: "sample_plane domain",
-        value: 0.0,
-        expected: "a plane design (mesh designs are sampled per vertex or triangle)",
-    })?;
-    if width == 0 || height == 0 {
-        return Err(FieldsError::FieldSize { width, height, expected: 1, found: 0 });
-    }
-    let zv = vertex_complex(design, field);
-    let symmetry = field.symmetry;
-    let (nx, ny) = (grid.nx, grid.ny);
-    // Pixel → grid coordinates: g = (pixel + ½) · (cells / pixels); cell index and the
-    // local coordinate in [0, 1], per column and per row.
-    let axis = |pixels: usize, cells: usize| -> Vec<(usize, f64)> {
-        let k = cells as f64 / pixels as f64;
-        (0..pixels)
-            .map(|p| {
-                let g = (p as f64 + 0.5) * k;
-                let i = (g as usize).min(cells - 1);
-                (i, (g - i as f64).clamp(0.0, 1.0))
-            })
-            .collect()
-    };
-    let (cols, rows) = (axis(width, nx), axis(height, ny));
-    // every pixel is written below: no clearing of a kept buffer of the right size
-    out.resize(width * height, [0.0; 2]);
-    // Rows in fixed groups (disjoint outputs), enough work per task to hide rayon's cost.
-    let group = (1 << 14) / width.max(1) + 1;
-    out.par_chunks_mut(width * group).zip(rows.par_chunks(group)).for_each(|(block, rows)| {
-        // Two passes per row: interpolate (gathers), then the root on plain arrays, a
-        // branch-free loop the compiler vectorises.
-        let (mut xs, mut ys) = (vec![0.0f32; width], vec![0.0f32; width]);
-        for (row, &(j, v)) in block.chunks_mut(width).zip(rows) {
-            let lower = &zv[j * (nx + 1)..(j + 1) * (nx + 1)];
-            let upper = &zv[(j + 1) * (nx + 1)..(j + 2) * (nx + 1)];
-            for ((x, y), &(i, u)) in xs.iter_mut().zip(ys.iter_mut()).zip(&cols) {
-                // Corners a=(i,j) b=(i+1,j) c=(i+1,j+1) d=(i,j+1); triangles as in
-                // PlaneGrid::locate.
-                let (za, zb, zc, zd) = (lower[i], lower[i + 1], upper[i + 1], upper[i]);
-                let (w, p, q, r) = if (i + j) % 2 == 0 {
-                    if u >= v {
-                        ([1.0 - u, u - v, v], za, zb, zc)
-                    } else {
-                        ([1.0 - v, u, v - u], za, zc, zd)
-                    }
-                } else if u + v <= 1.0 {
-                    ([1.0 - u - v, u, v], za, zb, zd)
-                } else {
-                    ([1.0 - v, u + v - 1.0, 1.0 - u], zb, zc, zd)
-                };
-                *x = (w[0] * p[0] + w[1] * q[0] + w[2] * r[0]) as f32;
-                *y = (w[0] * p[1] + w[1] * q[1] + w[2] * r[1]) as f32;
-            }
-            roots_f32(&xs, &ys, symmetry, row);
+    crate::field_design::in_pool(|| {
+        let grid = *design.plane().ok_or(FieldsError::InvalidOption {
+            name: "sample_plane domain",
+            value: 0.0,
+            expected: "a plane design (mesh designs are sampled per vertex or triangle)",
+        })?;
+        if width == 0 || height == 0 {
+            return Err(FieldsError::FieldSize { width, height, expected: 1, found: 0 });
         }
-    });
-    Ok(())
+        let zv = vertex_complex(design, field);
+        let symmetry = field.symmetry;
+        let (nx, ny) = (grid.nx, grid.ny);
+        // Pixel → grid coordinates: g = (pixel + ½) · (cells / pixels); cell index and the
+        // local coordinate in [0, 1], per column and per row.
+        let axis = |pixels: usize, cells: usize| -> Vec<(usize, f64)> {
+            let k = cells as f64 / pixels as f64;
+            (0..pixels)
+                .map(|p| {
+                    let g = (p as f64 + 0.5) * k;
+                    let i = (g as usize).min(cells - 1);
+                    (i, (g - i as f64).clamp(0.0, 1.0))
+                })
+                .collect()
+        };
+        let (cols, rows) = (axis(width, nx), axis(height, ny));
+        // every pixel is written below: no clearing of a kept buffer of the right size
+        out.resize(width * height, [0.0; 2]);
+        // Rows in fixed groups (disjoint outputs), enough work per task to hide rayon's cost.
+        let group = (1 << 14) / width.max(1) + 1;
+        out.par_chunks_mut(width * group).zip(rows.par_chunks(group)).for_each(|(block, rows)| {
+            // Two passes per row: interpolate (gathers), then the root on plain arrays, a
+            // branch-free loop the compiler vectorises.
+            let (mut xs, mut ys) = (vec![0.0f32; width], vec![0.0f32; width]);
+            for (row, &(j, v)) in block.chunks_mut(width).zip(rows) {
+                let lower = &zv[j * (nx + 1)..(j + 1) * (nx + 1)];
+                let upper = &zv[(j + 1) * (nx + 1)..(j + 2) * (nx + 1)];
+                for ((x, y), &(i, u)) in xs.iter_mut().zip(ys.iter_mut()).zip(&cols) {
+                    // Corners a=(i,j) b=(i+1,j) c=(i+1,j+1) d=(i,j+1); triangles as in
+                    // PlaneGrid::locate.
+                    let (za, zb, zc, zd) = (lower[i], lower[i + 1], upper[i + 1], upper[i]);
+                    let (w, p, q, r) = if (i + j) % 2 == 0 {
+                        if u >= v {
+                            ([1.0 - u, u - v, v], za, zb, zc)
+                        } else {
+                            ([1.0 - v, u, v - u], za, zc, zd)
+                        }
+                    } else if u + v <= 1.0 {
+                        ([1.0 - u - v, u, v], za, zb, zd)
+                    } else {
+                        ([1.0 - v, u + v - 1.0, 1.0 - u], zb, zc, zd)
+                    };
+                    *x = (w[0] * p[0] + w[1] * q[0] + w[2] * r[0]) as f32;
+                    *y = (w[0] * p[1] + w[1] * q[1] + w[2] * r[1]) as f32;
+                }
+                roots_f32(&xs, &ys, symmetry, row);
+            }
+        });
+        Ok(())
+    })
 }
 
 /// [`nrosy_root_f32`] of `(xs[k], ys[k])` into `out[k]` (bit-identical), written without

@@ -6,13 +6,8 @@
 use fieldtex_fields::presets::preset;
 use fieldtex_fields::*;
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-}
+mod common;
+use common::{max_abs, max_diff};
 
 fn stroke_a(dy: f64) -> Stroke {
     Stroke::from_pixels(&[[30.0, 80.0 + dy], [120.0, 65.0 + dy], [230.0, 90.0 + dy]])
@@ -36,6 +31,19 @@ const STEPS: [(Option<f64>, Option<f64>); 10] = [
     (None, None),
 ];
 
+/// Brings the stroke `id` of `d` to `want`: added, moved, removed or left absent.
+fn edit_stroke(d: &mut FieldDesign, id: &mut Option<StrokeId>, want: Option<Stroke>) {
+    match (*id, want) {
+        (None, Some(s)) => *id = Some(d.add_stroke(s).unwrap()),
+        (Some(i), Some(s)) => d.set_stroke(i, s).unwrap(),
+        (Some(i), None) => {
+            d.remove_stroke(i).unwrap();
+            *id = None;
+        }
+        (None, None) => {}
+    }
+}
+
 /// Runs the edit sequence on one design; returns the one-forms after every step and
 /// the counters (refactorisations, checkpoint restores).
 fn edit_sequence() -> (Vec<Vec<f64>>, usize, usize) {
@@ -46,24 +54,8 @@ fn edit_sequence() -> (Vec<Vec<f64>>, usize, usize) {
     let (mut a, mut b) = (None, None);
     let mut out = Vec::new();
     for (sa, sb) in STEPS {
-        match (a, sa) {
-            (None, Some(y)) => a = Some(d.add_stroke(stroke_a(y)).unwrap()),
-            (Some(id), Some(y)) => d.set_stroke(id, stroke_a(y)).unwrap(),
-            (Some(id), None) => {
-                d.remove_stroke(id).unwrap();
-                a = None;
-            }
-            (None, None) => {}
-        }
-        match (b, sb) {
-            (None, Some(x)) => b = Some(d.add_stroke(stroke_b(x)).unwrap()),
-            (Some(id), Some(x)) => d.set_stroke(id, stroke_b(x)).unwrap(),
-            (Some(id), None) => {
-                d.remove_stroke(id).unwrap();
-                b = None;
-            }
-            (None, None) => {}
-        }
+        edit_stroke(&mut d, &mut a, sa.map(stroke_a));
+        edit_stroke(&mut d, &mut b, sb.map(stroke_b));
         out.push(d.solve().unwrap().one_form);
     }
     (out, d.refactor_count() - refactors, d.checkpoint_restore_count())

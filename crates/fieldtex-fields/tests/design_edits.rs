@@ -1,7 +1,7 @@
 //! The editable design: strokes, moves, determinism, mesh domains, bad input.
 
 use fieldtex_fields::orientation_field::{
-    detect_design_singularities, face_directions, nrosy_root, sample_plane, vertex_complex,
+    detect_design_singularities, face_directions, sample_plane,
 };
 use fieldtex_fields::presets::preset;
 use fieldtex_fields::singularity_index::{
@@ -9,6 +9,8 @@ use fieldtex_fields::singularity_index::{
 };
 use fieldtex_fields::*;
 use fieldtex_mesh::{TriMesh, primitives};
+
+mod common;
 
 fn plane(size: f64, cells: usize, symmetry: Symmetry) -> FieldDesign {
     FieldDesign::new(
@@ -122,19 +124,14 @@ fn sampling_matches_point_location() {
     let f = d.solve().unwrap();
     let (w, h) = (77usize, 53usize);
     let px = sample_plane(&d, &f, w, h).unwrap();
-    let zv = vertex_complex(&d, &f);
     let g = *d.plane().unwrap();
-    for (k, p) in px.iter().enumerate() {
+    assert_eq!((g.width, g.height, f.symmetry), (96.0, 64.0, Symmetry::Orientation));
+    let reference = common::reference_pixels(&d, &f, w, h);
+    for (k, (p, e)) in px.iter().zip(&reference).enumerate() {
         let (c, r) = (k % w, k / w);
         let (x, y) = ((c as f64 + 0.5) * 96.0 / w as f64, (r as f64 + 0.5) * 64.0 / h as f64);
         let (face, b) = g.locate(x, y);
         let t = d.dec().triangles[face];
-        let mut z = [0.0; 2];
-        for i in 0..3 {
-            z[0] += b[i] * zv[t[i] as usize][0];
-            z[1] += b[i] * zv[t[i] as usize][1];
-        }
-        let e = nrosy_root(z, Symmetry::Orientation);
         assert!(
             (p[0] as f64 - e[0]).abs() < 1e-5 && (p[1] as f64 - e[1]).abs() < 1e-5,
             "pixel {c},{r}"

@@ -3,17 +3,12 @@
 //! singularity moves re-solve only; pixel sampling matches point location for odd sizes
 //! and is bit-identical for 1 and 2 threads after a sequence of edits.
 
-use fieldtex_fields::orientation_field::{nrosy_root, sample_plane, sample_plane_into};
+use fieldtex_fields::orientation_field::{sample_plane, sample_plane_into};
 use fieldtex_fields::presets::preset;
 use fieldtex_fields::*;
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-}
+mod common;
+use common::{max_abs, max_diff, reference_pixels};
 
 fn long_stroke(dy: f64) -> Stroke {
     Stroke::from_pixels(&[[30.0, 90.0 + dy], [120.0, 75.0 + dy], [230.0, 100.0 + dy]])
@@ -108,27 +103,6 @@ fn edits_beyond_the_update_limit_refactor_to_the_same_field() {
     assert_eq!(small.refactor_count(), r0 + 1, "more changed edges than the limit refactor");
     let scale = max_abs(&a.one_form);
     assert!(max_diff(&a.one_form, &b.one_form) <= 1e-9 * scale);
-}
-
-/// Scalar reference: locate every pixel centre, interpolate the vertex values.
-fn reference_pixels(d: &FieldDesign, f: &SolvedField, w: usize, h: usize) -> Vec<[f64; 2]> {
-    let zv = orientation_field::vertex_complex(d, f);
-    let g = *d.plane().unwrap();
-    (0..w * h)
-        .map(|k| {
-            let (c, r) = (k % w, k / w);
-            let x = (c as f64 + 0.5) * g.width / w as f64;
-            let y = (r as f64 + 0.5) * g.height / h as f64;
-            let (face, b) = g.locate(x, y);
-            let t = d.dec().triangles[face];
-            let mut z = [0.0; 2];
-            for i in 0..3 {
-                z[0] += b[i] * zv[t[i] as usize][0];
-                z[1] += b[i] * zv[t[i] as usize][1];
-            }
-            nrosy_root(z, f.symmetry)
-        })
-        .collect()
 }
 
 #[test]

@@ -7,13 +7,8 @@ use fieldtex_fields::presets::preset;
 use fieldtex_fields::*;
 use fieldtex_linalg::{Cholesky, SparseMatrix};
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-}
+mod common;
+use common::{max_abs, max_diff};
 
 /// `A` with the strokes of `d`: the base matrix plus the stroke weights on the diagonal
 /// (rebuilt with the public constraint builder).
