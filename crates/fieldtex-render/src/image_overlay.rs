@@ -7,7 +7,7 @@
 //! coverage.
 
 use crate::draw2d::{blend, fill_sdf, marker_sdf, segment_distance};
-use crate::scene::MarkerShape;
+use crate::scene::{MarkerShape, marker_style_setters};
 use fieldtex_core::Image;
 
 /// A 2-D polyline on an image (width in pixels of the output image).
@@ -36,22 +36,7 @@ impl Marker2 {
             outline: Some([0.0, 0.0, 0.0, 1.0]),
         }
     }
-    pub fn with_shape(mut self, shape: MarkerShape) -> Self {
-        self.shape = shape;
-        self
-    }
-    pub fn with_radius(mut self, radius: f64) -> Self {
-        self.radius = radius;
-        self
-    }
-    pub fn with_color(mut self, color: [f32; 4]) -> Self {
-        self.color = color;
-        self
-    }
-    pub fn with_outline(mut self, outline: Option<[f32; 4]>) -> Self {
-        self.outline = outline;
-        self
-    }
+    marker_style_setters!();
 }
 
 /// What [`render_image_overlay`] draws: polylines first, then markers.

@@ -146,6 +146,31 @@ impl FieldGlyphs {
     }
 }
 
+/// The builder setters of a marker's look (`shape`, `radius`, `color`, `outline`),
+/// shared by the 3-D [`Markers`] and the 2-D [`crate::Marker2`], whose fields carry
+/// the same names and meanings. A macro because the setters are methods of two types.
+macro_rules! marker_style_setters {
+    () => {
+        pub fn with_shape(mut self, shape: $crate::MarkerShape) -> Self {
+            self.shape = shape;
+            self
+        }
+        pub fn with_radius(mut self, radius: f64) -> Self {
+            self.radius = radius;
+            self
+        }
+        pub fn with_color(mut self, color: [f32; 4]) -> Self {
+            self.color = color;
+            self
+        }
+        pub fn with_outline(mut self, outline: Option<[f32; 4]>) -> Self {
+            self.outline = outline;
+            self
+        }
+    };
+}
+pub(crate) use marker_style_setters;
+
 /// Screen-space markers at 3-D points (singularities, picked points).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Markers {
@@ -174,22 +199,7 @@ impl Markers {
             depth_test: true,
         }
     }
-    pub fn with_shape(mut self, shape: MarkerShape) -> Self {
-        self.shape = shape;
-        self
-    }
-    pub fn with_radius(mut self, radius: f64) -> Self {
-        self.radius = radius;
-        self
-    }
-    pub fn with_color(mut self, color: [f32; 4]) -> Self {
-        self.color = color;
-        self
-    }
-    pub fn with_outline(mut self, outline: Option<[f32; 4]>) -> Self {
-        self.outline = outline;
-        self
-    }
+    marker_style_setters!();
     pub fn with_depth_test(mut self, depth_test: bool) -> Self {
         self.depth_test = depth_test;
         self
