@@ -412,25 +412,8 @@ fn orient_patch_outputs_determinism_and_valid_glb() {
     std::fs::write(&cap, bumpy_cap_obj(14)).unwrap();
     let (a, b) = (work.join("t1"), work.join("t2"));
     for (dir, t) in [(&a, "1"), (&b, "2")] {
-        let o = run(
-            &[
-                "orient",
-                "--preset",
-                "right-loop",
-                "--exemplar",
-                ex.to_str().unwrap(),
-                "--mesh",
-                cap.to_str().unwrap(),
-                "--size",
-                "128",
-                "--out",
-                dir.to_str().unwrap(),
-                "--threads",
-                t,
-                "--quiet",
-            ],
-            Duration::from_secs(300),
-        );
+        let extra = ["--preset", "right-loop", "--size", "128", "--threads", t, "--quiet"];
+        let o = common::run_on_mesh("orient", &cap, &ex, dir, &extra, Duration::from_secs(300));
         assert_eq!(code(&o), 0, "{}", stderr(&o));
     }
     for f in ["texture.png", "field.npy", "preview.png", "model.glb"] {
@@ -473,22 +456,9 @@ fn orient_patch_refuses_non_disk_meshes() {
     std::fs::write(&holed_path, holed).unwrap();
     let torus = shared().join("meshes/torus.obj");
     for (mesh, loops) in [(torus, "0 boundary loop"), (holed_path, "2 boundary loop")] {
-        let o = run(
-            &[
-                "orient",
-                "--preset",
-                "arch",
-                "--exemplar",
-                ex.to_str().unwrap(),
-                "--mesh",
-                mesh.to_str().unwrap(),
-                "--size",
-                "64",
-                "--out",
-                work.join("out").to_str().unwrap(),
-            ],
-            Duration::from_secs(120),
-        );
+        let extra = ["--preset", "arch", "--size", "64"];
+        let limit = Duration::from_secs(120);
+        let o = common::run_on_mesh("orient", &mesh, &ex, &work.join("out"), &extra, limit);
         assert_eq!(code(&o), 2, "{}: {}", mesh.display(), stderr(&o));
         let e = stderr(&o);
         assert!(e.contains("disk") && e.contains(loops), "{e}");
@@ -506,11 +476,8 @@ fn align_outputs_determinism_and_valid_glb() {
     let (a, b) = (tmp("align-t1"), tmp("align-t2"));
     // fandisk at 256² into `dir` with `extra` flags; must succeed.
     let align = |dir: &Path, extra: &[&str]| {
-        let mut args = vec!["align", "--mesh", mesh.to_str().unwrap(), "--exemplar"];
-        args.extend([ex.to_str().unwrap(), "--size", "256", "--out", dir.to_str().unwrap()]);
-        args.push("--quiet");
-        args.extend_from_slice(extra);
-        let o = run(&args, Duration::from_secs(300));
+        let args = [&["--size", "256", "--quiet"][..], extra].concat();
+        let o = common::run_on_mesh("align", &mesh, &ex, dir, &args, Duration::from_secs(300));
         assert_eq!(code(&o), 0, "{}", stderr(&o));
     };
     for (dir, threads) in [(&a, "1"), (&b, "2")] {
@@ -553,16 +520,8 @@ fn align_fallback_ablation_and_bad_input() {
     fieldtex::crates::io::write_obj(&obj, &m, None).unwrap();
     let ex = shared().join("exemplars/stripes_Fabric071.png");
     let out = d.join("out");
-    let args = |o: &Path| -> Vec<String> {
-        ["align", "--mesh", obj.to_str().unwrap(), "--exemplar", ex.to_str().unwrap()]
-            .iter()
-            .map(|s| s.to_string())
-            .chain(["--size", "128", "--no-feature-align", "--quiet", "--out"].map(String::from))
-            .chain([o.to_str().unwrap().to_string()])
-            .collect()
-    };
-    let a = args(&out);
-    let o = run(&a.iter().map(String::as_str).collect::<Vec<_>>(), Duration::from_secs(300));
+    let extra = ["--size", "128", "--no-feature-align", "--quiet"];
+    let o = common::run_on_mesh("align", &obj, &ex, &out, &extra, Duration::from_secs(300));
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let r = report_without_timings(&out);
     let warned = r["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "no-curves");
@@ -574,18 +533,8 @@ fn align_fallback_ablation_and_bad_input() {
     let im = fieldtex::Image::new(16, 16, [0.5, 0.5, 0.5, 1.0]);
     fieldtex::crates::io::write_png(&small, &im).unwrap();
     for bad in [small.clone(), d.join("missing.png")] {
-        let o = run(
-            &[
-                "align",
-                "--mesh",
-                obj.to_str().unwrap(),
-                "--exemplar",
-                bad.to_str().unwrap(),
-                "--out",
-                d.join("bad").to_str().unwrap(),
-            ],
-            Duration::from_secs(60),
-        );
+        let o =
+            common::run_on_mesh("align", &obj, &bad, &d.join("bad"), &[], Duration::from_secs(60));
         assert_eq!(code(&o), 2, "{}", stderr(&o));
         assert!(stderr(&o).contains(bad.file_name().unwrap().to_str().unwrap()), "{}", stderr(&o));
     }

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
+use std::time::Duration;
 
 mod common;
 use common::shared;
@@ -11,8 +12,9 @@ fn tmp(name: &str) -> PathBuf {
     common::tmp_in("fieldtex-conformal", name)
 }
 
-fn run(args: &[&str]) -> Output {
-    common::run_limited(args, std::time::Duration::from_secs(900))
+/// `conformal --mesh MESH --exemplar EXEMPLAR --out OUT EXTRA…`.
+fn conformal(mesh: &Path, exemplar: &Path, out: &Path, extra: &[&str]) -> Output {
+    common::run_on_mesh("conformal", mesh, exemplar, out, extra, Duration::from_secs(900))
 }
 
 /// A torus (`skip_ring`: leave one ring of quads out, giving an open tube) as OBJ text.
@@ -48,51 +50,33 @@ fn torus_obj(nu: usize, nv: usize, skip_ring: bool) -> String {
     s
 }
 
+/// A fresh scratch folder `name` holding `torus.obj`, a closed `nu × nv` torus.
+fn torus_in(name: &str, nu: usize, nv: usize) -> (PathBuf, PathBuf) {
+    let d = tmp(name);
+    let mesh = d.join("torus.obj");
+    std::fs::write(&mesh, torus_obj(nu, nv, false)).unwrap();
+    (d, mesh)
+}
+
+fn pebbles() -> PathBuf {
+    shared().join("exemplars/pebbles_Rocks002.png")
+}
+
 fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
 }
 
 #[test]
 fn torus_and_tube_end_to_end_deterministic() {
-    let d = tmp("torus");
-    let mesh = d.join("torus.obj");
-    std::fs::write(&mesh, torus_obj(48, 24, false)).unwrap();
-    let ex = shared().join("exemplars/pebbles_Rocks002.png");
-    let (m, e) = (mesh.to_str().unwrap(), ex.to_str().unwrap());
+    let (d, mesh) = torus_in("torus", 48, 24);
+    let ex = pebbles();
     let o1 = d.join("t1");
     let o2 = d.join("t2");
-    let out = run(&[
-        "conformal",
-        "--mesh",
-        m,
-        "--exemplar",
-        e,
-        "--out",
-        o1.to_str().unwrap(),
-        "--size",
-        "256",
-        "--keep",
-        "--threads",
-        "1",
-        "--quiet",
-    ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = run(&[
-        "conformal",
-        "--mesh",
-        m,
-        "--exemplar",
-        e,
-        "--out",
-        o2.to_str().unwrap(),
-        "--size",
-        "256",
-        "--keep",
-        "--threads",
-        "2",
-        "--quiet",
-    ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for (o, threads) in [(&o1, "1"), (&o2, "2")] {
+        let out =
+            conformal(&mesh, &ex, o, &["--size", "256", "--keep", "--threads", threads, "--quiet"]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
     for f in ["model.glb", "preview.png", "patches.ply", "trajectories.obj"] {
         assert_eq!(
             std::fs::read(o1.join(f)).unwrap(),
@@ -117,18 +101,7 @@ fn torus_and_tube_end_to_end_deterministic() {
     let tube = d.join("tube.obj");
     std::fs::write(&tube, torus_obj(48, 16, true)).unwrap();
     let o3 = d.join("tube-out");
-    let out = run(&[
-        "conformal",
-        "--mesh",
-        tube.to_str().unwrap(),
-        "--exemplar",
-        e,
-        "--out",
-        o3.to_str().unwrap(),
-        "--size",
-        "256",
-        "--quiet",
-    ]);
+    let out = conformal(&tube, &ex, &o3, &["--size", "256", "--quiet"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let r = report(&o3);
     let c = &r["metrics"]["components"][0];
@@ -139,34 +112,12 @@ fn torus_and_tube_end_to_end_deterministic() {
 
 #[test]
 fn bad_inputs_exit_2() {
-    let d = tmp("bad");
-    let mesh = d.join("torus.obj");
-    std::fs::write(&mesh, torus_obj(12, 8, false)).unwrap();
-    let ex = shared().join("exemplars/pebbles_Rocks002.png");
+    let (d, mesh) = torus_in("bad", 12, 8);
+    let ex = pebbles();
     let o = d.join("o");
-    let out = run(&[
-        "conformal",
-        "--mesh",
-        "/nonexistent.obj",
-        "--exemplar",
-        ex.to_str().unwrap(),
-        "--out",
-        o.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let out = conformal(Path::new("/nonexistent.obj"), &ex, &o, &["--quiet"]);
     assert_eq!(out.status.code(), Some(2));
-    let out = run(&[
-        "conformal",
-        "--mesh",
-        mesh.to_str().unwrap(),
-        "--exemplar",
-        ex.to_str().unwrap(),
-        "--out",
-        o.to_str().unwrap(),
-        "--size",
-        "10",
-        "--quiet",
-    ]);
+    let out = conformal(&mesh, &ex, &o, &["--size", "10", "--quiet"]);
     assert_eq!(out.status.code(), Some(2));
 }
 
@@ -174,22 +125,11 @@ fn bad_inputs_exit_2() {
 /// has 2g − 2 = 6 (Wang et al. 2005 §3), and neither map flips a triangle.
 #[test]
 fn zero_points_of_shared_meshes() {
-    let ex = shared().join("exemplars/pebbles_Rocks002.png");
+    let ex = pebbles();
     for (name, genus, zeros) in [("rocker-arm", 1u64, 0u64), ("fertility", 4, 6)] {
         let d = tmp(name);
         let mesh = shared().join(format!("meshes/{name}.obj"));
-        let out = run(&[
-            "conformal",
-            "--mesh",
-            mesh.to_str().unwrap(),
-            "--exemplar",
-            ex.to_str().unwrap(),
-            "--out",
-            d.to_str().unwrap(),
-            "--size",
-            "256",
-            "--quiet",
-        ]);
+        let out = conformal(&mesh, &ex, &d, &["--size", "256", "--quiet"]);
         assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
         let r = report(&d);
         let c = &r["metrics"]["components"][0];

@@ -25,6 +25,20 @@ fn quick(args: &[&str]) -> Output {
     run(args, Duration::from_secs(30))
 }
 
+/// `orient --preset whorl --exemplar EXEMPLAR --out OUT EXTRA…` within 30 s.
+fn orient_whorl(exemplar: &Path, out: &Path, extra: &[&str]) -> Output {
+    quick(
+        &[&["orient", "--preset", "whorl", "--exemplar", s(exemplar), "--out", s(out)], extra]
+            .concat(),
+    )
+}
+
+/// `atlas MESH --out OUT --size 128 --quiet`, which must succeed.
+fn atlas_128(mesh: &Path, out: &Path) {
+    let o = quick(&["atlas", s(mesh), "--out", s(out), "--size", "128", "--quiet"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+}
+
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
@@ -92,7 +106,7 @@ fn atlas_out_dir_holding_the_mesh_replaced_it() {
     let d = tmp("atlas-out");
     let m = torus_in(&d);
     let first = d.join("first");
-    assert_eq!(code(&quick(&["atlas", s(&m), "--out", s(&first), "--size", "128", "--quiet"])), 0);
+    atlas_128(&m, &first);
     let glb = first.join("model.glb");
     let before = std::fs::read(&glb).unwrap();
     let o = quick(&["atlas", s(&glb), "--out", s(&first), "--size", "128", "--quiet"]);
@@ -215,17 +229,7 @@ fn inspect_json_into_a_closed_pipe_panicked() {
 fn orient_scale_1e_30_passed_validation() {
     let d = tmp("scale");
     let ex = exemplar_in(&d, "e.png");
-    let o = quick(&[
-        "orient",
-        "--preset",
-        "whorl",
-        "--exemplar",
-        s(&ex),
-        "--scale",
-        "1e-30",
-        "--out",
-        s(&d.join("o")),
-    ]);
+    let o = orient_whorl(&ex, &d.join("o"), &["--scale", "1e-30"]);
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("--scale must be in"), "{}", stderr(&o));
     assert!(!d.join("o").exists(), "validated before anything was created");
@@ -236,7 +240,7 @@ fn killed_rerun_left_a_mix_of_new_and_old_outputs() {
     let d = tmp("kill");
     let m = torus_in(&d);
     let out = d.join("out");
-    assert_eq!(code(&quick(&["atlas", s(&m), "--out", s(&out), "--size", "128", "--quiet"])), 0);
+    atlas_128(&m, &out);
     let names = ["model.glb", "preview.png", "report.json"];
     let old: Vec<Vec<u8>> = names.iter().map(|n| std::fs::read(out.join(n)).unwrap()).collect();
     // A different rerun, killed as soon as it starts writing (its staging folder exists).
@@ -265,7 +269,7 @@ fn killed_rerun_left_a_mix_of_new_and_old_outputs() {
     let all_new = now.iter().zip(&old).all(|(a, b)| a != b);
     assert!(all_old || all_new, "a mix of old and new outputs after a kill");
     // The next run removes the orphaned staging folder.
-    assert_eq!(code(&quick(&["atlas", s(&m), "--out", s(&out), "--size", "128", "--quiet"])), 0);
+    atlas_128(&m, &out);
     let left: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .flatten()
@@ -284,22 +288,8 @@ fn patch_with_a_negative_first_number_was_rejected_and_a_miss_printed_debug_text
     let d = tmp("patch");
     let m = torus_in(&d);
     let ex = exemplar_in(&d, "e.png");
-    let o = quick(&[
-        "orient",
-        "--preset",
-        "whorl",
-        "--exemplar",
-        s(&ex),
-        "--mesh",
-        s(&m),
-        "--patch",
-        "-7.2,11.8,5.3,5",
-        "--size",
-        "64",
-        "--no-metrics",
-        "--out",
-        s(&d.join("o")),
-    ]);
+    let extra = ["--mesh", s(&m), "--patch", "-7.2,11.8,5.3,5", "--size", "64", "--no-metrics"];
+    let o = orient_whorl(&ex, &d.join("o"), &extra);
     let e = stderr(&o);
     assert_eq!(code(&o), 2, "{e}");
     assert!(e.contains("no triangle centre lies within 5"), "parsed and a user message: {e}");

@@ -11,8 +11,22 @@ fn tmp(name: &str) -> PathBuf {
     common::tmp_in("fieldtex-cli-solid", name)
 }
 
-fn run(args: &[&str]) -> Output {
-    common::run_limited(args, std::time::Duration::from_secs(900))
+/// `solid --mesh MESH --exemplar EXEMPLAR --out OUT EXTRA…`.
+fn solid(mesh: &Path, exemplar: &Path, out: &Path, extra: &[&str]) -> Output {
+    let limit = std::time::Duration::from_secs(900);
+    common::run_on_mesh("solid", mesh, exemplar, out, extra, limit)
+}
+
+/// `solid` on the shared torus at a small size (`resolution` voxels along the longest
+/// side, a 128² atlas, 3 levels, 6-voxel blocks) with `exemplar`, then `extra`.
+fn small_torus(exemplar: &Path, out: &Path, resolution: &str, extra: &[&str]) -> Output {
+    let small =
+        ["--resolution", resolution, "--atlas-size", "128", "--levels", "3", "--block", "6"];
+    solid(&shared().join("meshes/torus.obj"), exemplar, out, &[&small[..], extra].concat())
+}
+
+fn woodgrain() -> PathBuf {
+    shared().join("exemplars/woodgrain_Wood022.png")
 }
 
 const SKETCH: &str = r#"{"curves": [
@@ -30,32 +44,10 @@ fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
     let y = -0.21875 + 0.0625 * k as f64;
     let cut = format!("0,{y},0,0,1,0");
     let out = dir.join("out");
-    run(&[
-        "solid",
-        "--mesh",
-        shared().join("meshes/torus.obj").to_str().unwrap(),
-        "--sketch",
-        sketch.to_str().unwrap(),
-        "--exemplar",
-        shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--resolution",
-        "40",
-        "--atlas-size",
-        "128",
-        "--levels",
-        "3",
-        "--block",
-        "6",
-        "--cut",
-        &cut,
-        "--volume",
-        "--keep",
-        "--threads",
-        threads,
-        "--quiet",
-    ])
+    let sketch = sketch.to_str().unwrap();
+    let extra =
+        ["--sketch", sketch, "--cut", &cut, "--volume", "--keep", "--threads", threads, "--quiet"];
+    small_torus(&woodgrain(), &out, "40", &extra)
 }
 
 fn weld_closed(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
@@ -157,24 +149,11 @@ fn bad_sketches_name_the_curve_and_point() {
         r#"{"curves": [{"points": [[0,0,0],[1,0,0]]}, {"points": [[0,0,0]]}]}"#,
     )
     .unwrap();
-    let (torus, wood) =
-        (shared().join("meshes/torus.obj"), shared().join("exemplars/woodgrain_Wood022.png"));
+    let torus = shared().join("meshes/torus.obj");
     let out = d.join("out");
     // The torus with the sketch file as it is now.
-    let solid_run = || {
-        run(&[
-            "solid",
-            "--mesh",
-            torus.to_str().unwrap(),
-            "--sketch",
-            sketch.to_str().unwrap(),
-            "--exemplar",
-            wood.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ])
-    };
+    let solid_run =
+        || solid(&torus, &woodgrain(), &out, &["--sketch", sketch.to_str().unwrap(), "--quiet"]);
     let o = solid_run();
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
@@ -192,34 +171,12 @@ fn interior_region_fills_the_deep_voxels() {
     let run_one = |name: &str, interior: bool| {
         let dir = tmp(name);
         let out = dir.join("out");
-        let mut args = vec![
-            "solid".to_string(),
-            "--mesh".into(),
-            shared().join("meshes/torus.obj").to_str().unwrap().into(),
-            "--exemplar".into(),
-            shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap().into(),
-            "--out".into(),
-            out.to_str().unwrap().into(),
-            "--resolution".into(),
-            "40".into(),
-            "--atlas-size".into(),
-            "128".into(),
-            "--levels".into(),
-            "3".into(),
-            "--block".into(),
-            "6".into(),
-            "--cut=0,0.03125,0,0,1,0".into(),
-            "--volume".into(),
-            "--quiet".into(),
-        ];
+        let stripes = shared().join("exemplars/stripes_Fabric071.png");
+        let mut extra = vec!["--cut=0,0.03125,0,0,1,0", "--volume", "--quiet"];
         if interior {
-            args.push("--interior".into());
-            args.push(shared().join("exemplars/stripes_Fabric071.png").to_str().unwrap().into());
-            args.push("--interior-depth".into());
-            args.push("0.12".into());
+            extra.extend(["--interior", stripes.to_str().unwrap(), "--interior-depth", "0.12"]);
         }
-        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-        let o = run(&refs);
+        let o = small_torus(&woodgrain(), &out, "40", &extra);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         out
     };
@@ -280,26 +237,7 @@ fn feature_mask_is_used_and_a_wrong_size_is_an_error() {
     let bad = d.join("small.png");
     write_png(&bad, &fieldtex::Image::new(20, 20, [1.0; 4])).unwrap();
     let solid_run = |mask: &Path, out: &Path| {
-        run(&[
-            "solid",
-            "--mesh",
-            shared().join("meshes/torus.obj").to_str().unwrap(),
-            "--exemplar",
-            bricks.to_str().unwrap(),
-            "--feature-mask",
-            mask.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--resolution",
-            "32",
-            "--atlas-size",
-            "128",
-            "--levels",
-            "3",
-            "--block",
-            "6",
-            "--quiet",
-        ])
+        small_torus(&bricks, out, "32", &["--feature-mask", mask.to_str().unwrap(), "--quiet"])
     };
     let o = solid_run(&bad, &d.join("bad"));
     assert_eq!(o.status.code(), Some(2));

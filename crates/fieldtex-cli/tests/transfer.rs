@@ -56,13 +56,7 @@ fn transfer_writes_outputs_and_is_identical_for_one_and_two_threads() {
     assert_eq!(g["descriptor_weights"].as_object().unwrap().len(), 12);
     let steps = report["metrics"]["feature_matching"]["steps"].as_array().unwrap();
     assert_eq!(steps.len(), 4, "3 bands and the values");
-    assert!(
-        report["notes"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .any(|n| n.as_str().unwrap().contains("parametric engine: k-means"))
-    );
+    assert!(transfer::has_note(&report, "parametric engine: k-means"));
 }
 
 #[test]
@@ -122,13 +116,7 @@ fn nonparametric_engine_runs_end_to_end_deterministically() {
     let levels = report["metrics"]["nonparametric"]["levels"].as_array().unwrap();
     assert_eq!(levels.len(), 3);
     assert!(report["metrics"].get("parametric").is_none());
-    assert!(
-        report["notes"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .any(|n| n.as_str().unwrap().contains("non-parametric engine"))
-    );
+    assert!(transfer::has_note(&report, "non-parametric engine"));
 }
 
 /// An OBJ with UVs but no MTL file (`spot`) is refused with a hint, and accepted with

@@ -5,13 +5,14 @@
 
 use fieldtex::crates::{io, mesh};
 use fieldtex::{AlignOptions, Image, NoProgress, align};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
+
+// The CLI tests' data and scratch-folder helpers.
+#[path = "../../fieldtex-cli/tests/common/paths.rs"]
+mod common;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fieldtex-align-real").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp_in("fieldtex-align-real", name)
 }
 
 fn hash(mut x: u64) -> f32 {

@@ -7,15 +7,13 @@ use fieldtex::{Error, FieldSource, NoProgress, OrientOptions, Report, orient};
 use mesh::TriMesh;
 use std::path::{Path, PathBuf};
 
-fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
-}
+// The CLI tests' data and scratch-folder helpers.
+#[path = "../../fieldtex-cli/tests/common/paths.rs"]
+mod common;
+use common::shared;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fieldtex-orient-patch").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp_in("fieldtex-orient-patch", name)
 }
 
 fn exemplar(name: &str) -> PathBuf {

@@ -6,15 +6,13 @@ use fieldtex::crates::{fields, io};
 use fieldtex::{NoProgress, SolidOptions, SolidSession, solid};
 use std::path::{Path, PathBuf};
 
-fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
-}
+// The CLI tests' data and scratch-folder helpers.
+#[path = "../../fieldtex-cli/tests/common/paths.rs"]
+mod common;
+use common::shared;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fieldtex-solid-session").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp_in("fieldtex-solid-session", name)
 }
 
 /// A surface curve around the torus (axis y) and a straight curve on the y = 0 plane.

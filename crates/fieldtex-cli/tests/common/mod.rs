@@ -13,18 +13,8 @@ pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_fieldtex")
 }
 
-/// `../shared/data` beside the repository (meshes, exemplars, textured meshes).
-pub fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
-}
-
-/// An empty scratch folder `suite/name` under Cargo's per-target temporary folder.
-pub fn tmp_in(suite: &str, name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(suite).join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod paths;
+pub use paths::{shared, tmp_in};
 
 /// Runs the binary with `args`, failing the test when it runs past `limit`.
 pub fn run_limited(args: &[&str], limit: Duration) -> Output {
@@ -45,6 +35,23 @@ pub fn run_limited(args: &[&str], limit: Duration) -> Output {
         }
         std::thread::sleep(Duration::from_millis(20));
     }
+}
+
+/// Runs `fieldtex CMD --mesh MESH --exemplar EXEMPLAR --out OUT EXTRA…` within `limit`
+/// (the argument head of every mesh pipeline: atlas-based ones, conformal, solid).
+pub fn run_on_mesh(
+    cmd: &str,
+    mesh: &Path,
+    exemplar: &Path,
+    out: &Path,
+    extra: &[&str],
+    limit: Duration,
+) -> Output {
+    let (mesh, exemplar, out) =
+        (mesh.to_str().unwrap(), exemplar.to_str().unwrap(), out.to_str().unwrap());
+    let mut args = vec![cmd, "--mesh", mesh, "--exemplar", exemplar, "--out", out];
+    args.extend_from_slice(extra);
+    run_limited(&args, limit)
 }
 
 /// The exit code (−1 when killed by a signal).

@@ -26,3 +26,8 @@ pub fn run(source: &Path, target: &Path, out: &Path, extra: &[&str], limit: Dura
 pub fn report(out: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap()
 }
+
+/// Whether one of the report's `notes` contains `text`.
+pub fn has_note(report: &serde_json::Value, text: &str) -> bool {
+    report["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains(text))
+}
