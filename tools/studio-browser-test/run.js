@@ -62,21 +62,26 @@ function startServer(ws) {
   });
 }
 
-// Statistics of a canvas (2-D or WebGL with preserveDrawingBuffer), computed in the page.
-const canvasStats = (sel) => {
+// Statistics of a canvas (2-D or WebGL with preserveDrawingBuffer) or an image, computed
+// in the page: the share of non-background (not near-white) pixels and the colour spread
+// over all pixels; with `opaque`, the share of opaque pixels and the spread over those.
+const pixelStats = ([sel, opaque]) => {
   const src = document.querySelector(sel);
   const c = document.createElement('canvas');
-  c.width = src.width; c.height = src.height;
+  c.width = src.naturalWidth || src.width; c.height = src.naturalHeight || src.height;
   const x = c.getContext('2d');
   x.drawImage(src, 0, 0);
   const d = x.getImageData(0, 0, c.width, c.height).data;
-  let non = 0; let sum = [0, 0, 0]; let sq = [0, 0, 0]; const n = c.width * c.height;
+  let n = 0; let non = 0; const sum = [0, 0, 0]; const sq = [0, 0, 0];
   for (let i = 0; i < d.length; i += 4) {
+    if (opaque && d[i + 3] < 128) continue;
+    n++;
     if (d[i] < 245 || d[i + 1] < 245 || d[i + 2] < 245) non++;
     for (let k = 0; k < 3; k++) { sum[k] += d[i + k]; sq[k] += d[i + k] * d[i + k]; }
   }
-  const varc = sq.map((s, k) => s / n - (sum[k] / n) ** 2);
-  return { nonBackground: non / n, colorStd: Math.sqrt((varc[0] + varc[1] + varc[2]) / 3), width: c.width, height: c.height };
+  const all = Math.max(1, c.width * c.height);
+  const varc = sq.map((s, k) => (n ? s / n - (sum[k] / n) ** 2 : 0));
+  return { nonBackground: non / all, opaque: n / all, colorStd: Math.sqrt(Math.max(0, (varc[0] + varc[1] + varc[2]) / 3)), width: c.width, height: c.height };
 };
 
 async function shot(page, name, selector) {
@@ -212,7 +217,7 @@ async function alignMode(page, url) {
   if (!await waitFor(page, () => window.studioMesh && window.studioMesh.ready && window.studioMesh.mesh, null, 30000, 'fandisk to open')) return;
   const crest = await page.evaluate(() => window.studioMesh.mesh.crest.length);
   check(crest > 5, `fandisk crest lines: ${crest}`);
-  const s0 = await page.evaluate(canvasStats, '#viewport canvas');
+  const s0 = await page.evaluate(pixelStats, ['#viewport canvas', false]);
   check(s0.nonBackground > 0.1, `mesh drawn: ${(100 * s0.nonBackground).toFixed(1)} % of the view`);
   await page.click('#show-field');
   await waitFor(page, () => window.studioMesh.timings.streamlines > 0, null, 20000, 'streamlines');
@@ -242,7 +247,7 @@ async function alignMode(page, url) {
   check(job.files.includes('model.glb') && job.files.includes('report.json'), `job outputs listed: ${job.files.join(', ')}`);
   await waitFor(page, () => window.studioMesh.glbLoaded, null, 20000, 'the GLB in the viewer');
   await page.waitForTimeout(300);
-  const sg = await page.evaluate(canvasStats, '#viewport canvas');
+  const sg = await page.evaluate(pixelStats, ['#viewport canvas', false]);
   check(sg.nonBackground > 0.1 && sg.colorStd > 20, `textured result shown: ${(100 * sg.nonBackground).toFixed(1)} % covered, colour std ${sg.colorStd.toFixed(1)}`);
   await shot(page, 'studio-viewer-texture', '#viewport');
   await page.check('input[name=display][value=patches]');
@@ -250,7 +255,7 @@ async function alignMode(page, url) {
   check(patches >= 2, `patch colours: ${patches} patches`);
   await shot(page, 'studio-viewer-patches', '#viewport');
   await page.check('input[name=display][value=checker]');
-  const sc = await page.evaluate(canvasStats, '#viewport canvas');
+  const sc = await page.evaluate(pixelStats, ['#viewport canvas', false]);
   check(sc.colorStd > 30, `UV checker shown: colour std ${sc.colorStd.toFixed(1)}`);
   await shot(page, 'studio-viewer-checker', '#viewport');
   await page.check('input[name=display][value=wireframe]');
@@ -258,24 +263,6 @@ async function alignMode(page, url) {
 }
 
 // ------------------------------------------------------------------ solid
-// Statistics of the cut image (opaque share, colour spread of the opaque pixels).
-const imageStats = (sel) => {
-  const img = document.querySelector(sel);
-  const c = document.createElement('canvas');
-  c.width = img.naturalWidth; c.height = img.naturalHeight;
-  const x = c.getContext('2d');
-  x.drawImage(img, 0, 0);
-  const d = x.getImageData(0, 0, c.width, c.height).data;
-  let n = 0; const sum = [0, 0, 0]; const sq = [0, 0, 0];
-  for (let i = 0; i < d.length; i += 4) {
-    if (d[i + 3] < 128) continue;
-    n++;
-    for (let k = 0; k < 3; k++) { sum[k] += d[i + k]; sq[k] += d[i + k] * d[i + k]; }
-  }
-  const varc = sq.map((s, k) => (n ? s / n - (sum[k] / n) ** 2 : 0));
-  return { opaque: n / Math.max(1, c.width * c.height), colorStd: Math.sqrt(Math.max(0, (varc[0] + varc[1] + varc[2]) / 3)), width: c.width, height: c.height };
-};
-
 async function dragAcross(page, from, to) {
   const v = await page.locator('#viewport canvas').boundingBox();
   await page.mouse.move(v.x + v.width * from[0], v.y + v.height * from[1]);
@@ -338,7 +325,7 @@ async function solidMode(page, url) {
   const later = cs.slice(1, -1).map((c) => c.shown_ms);
   check(cs.length === 7, `${cs.length} cuts drawn from the open solid`);
   check(cs[cs.length - 1].computed === 0, `the repeated cut came from the kept blocks (${cs[cs.length - 1].computed} voxels computed)`);
-  const st = await page.evaluate(imageStats, '#cut-image');
+  const st = await page.evaluate(pixelStats, ['#cut-image', true]);
   check(st.opaque > 0.2 && st.colorStd > 5, `cut image ${st.width}×${st.height}: ${(100 * st.opaque).toFixed(0)} % inside, colour std ${st.colorStd.toFixed(1)}`);
   log(`LATENCY cut plane moved → cut image shown: first cut ${cs[0].shown_ms.toFixed(0)} ms (server ${cs[0].server_ms.toFixed(0)} ms, ${cs[0].computed} voxels computed); later cuts median ${median(later).toFixed(0)} ms, max ${Math.max(...later).toFixed(0)} ms (server median ${median(cs.slice(1, -1).map((c) => c.server_ms)).toFixed(0)} ms); repeated cut ${cs[cs.length - 1].shown_ms.toFixed(0)} ms`);
   await shot(page, 'studio-solid', 'main');
@@ -353,7 +340,7 @@ async function solidMode(page, url) {
   if (!done || !job) return;
   check(job.state === 'done', `solid cut-mesh job ${job.state}${job.error ? ': ' + job.error : ''} in ${((Date.now() - tJob) / 1000).toFixed(1)} s`);
   await waitFor(page, () => (window.studioMesh.glbLoaded || '').endsWith('cut-1.glb'), null, 10000, 'the cut mesh');
-  const sg = await page.evaluate(canvasStats, '#viewport canvas');
+  const sg = await page.evaluate(pixelStats, ['#viewport canvas', false]);
   check(sg.nonBackground > 0.05 && sg.colorStd > 10, `cut mesh shown: ${(100 * sg.nonBackground).toFixed(1)} % covered, colour std ${sg.colorStd.toFixed(1)}`);
   await shot(page, 'studio-solid-cut-mesh', 'main');
   return { first: cs[0].shown_ms, later: median(later), firstServer: cs[0].server_ms };

@@ -25,6 +25,10 @@ const ASSETS: &[(&str, &str, &str)] = &[
     ("/app.js", "text/javascript; charset=utf-8", include_str!("../web/app.js")),
     ("/draw.js", "text/javascript; charset=utf-8", include_str!("../web/draw.js")),
     ("/mesh.js", "text/javascript; charset=utf-8", include_str!("../web/mesh.js")),
+    ("/page.js", "text/javascript; charset=utf-8", include_str!("../web/page.js")),
+    ("/view.js", "text/javascript; charset=utf-8", include_str!("../web/view.js")),
+    ("/jobs.js", "text/javascript; charset=utf-8", include_str!("../web/jobs.js")),
+    ("/display.js", "text/javascript; charset=utf-8", include_str!("../web/display.js")),
     ("/style.css", "text/css; charset=utf-8", include_str!("../web/style.css")),
 ];
 
@@ -181,16 +185,27 @@ impl State {
     }
 }
 
+/// Locks `m`; when a panic poisoned it, `forget` drops the object it guards and the
+/// answer is a 500 with `message`.
+fn lock_or_forget<'a, T>(
+    m: &'a Mutex<T>,
+    forget: impl FnOnce(),
+    message: &str,
+) -> Result<std::sync::MutexGuard<'a, T>, Response> {
+    m.lock().map_err(|_| {
+        forget();
+        Response::error(500, message)
+    })
+}
+
 /// Locks a session; a session whose lock was poisoned by a panic is dropped.
 fn lock<'a>(
     state: &State,
     id: &str,
     s: &'a SessionRef,
 ) -> Result<std::sync::MutexGuard<'a, Session>, Response> {
-    s.lock().map_err(|_| {
-        state.drop_session(id);
-        Response::error(500, "this design was dropped after an internal error; start a new one")
-    })
+    let message = "this design was dropped after an internal error; start a new one";
+    lock_or_forget(s, || state.drop_session(id), message)
 }
 
 /// Reads one request, answers it, closes.

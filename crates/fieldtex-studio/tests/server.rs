@@ -23,7 +23,8 @@ fn page_and_info_are_served() {
     let r = request(addr, "GET", "/", b"");
     assert_eq!(r.status, 200);
     assert!(String::from_utf8_lossy(&r.body).contains("/app.js"));
-    for p in ["/app.js", "/draw.js", "/style.css"] {
+    let assets = ["/app.js", "/draw.js", "/mesh.js", "/page.js", "/view.js", "/jobs.js"];
+    for p in assets.into_iter().chain(["/display.js", "/style.css"]) {
         assert_eq!(request(addr, "GET", p, b"").status, 200, "{p}");
     }
     let info = request(addr, "GET", "/api/info", b"").json();

@@ -1,8 +1,8 @@
 // fieldtex studio, orient mode: the page keeps no design of its own; every edit goes to
 // the server, which re-solves the design and answers with the new state and field.
 import { drawStreamlines, drawElements, handlePos } from './draw.js';
+import { $, status, check, post } from './page.js';
 
-const $ = (id) => document.getElementById(id);
 const canvas = $('field');
 const ctx = canvas.getContext('2d');
 let info = null;
@@ -14,17 +14,6 @@ let drag = null;
 let textureTimer = null;
 let textureAbort = null;
 
-function status(text, error = false) {
-  $('status').textContent = text;
-  $('status').className = error ? 'error' : '';
-}
-
-async function check(resp) {
-  if (resp.ok) return resp;
-  let msg = `${resp.status}`;
-  try { msg += ': ' + (await resp.json()).error; } catch (_) { /* not JSON */ }
-  throw new Error(msg);
-}
 
 /** Decodes `[u32 json length][json][f32 field]`. */
 function decodeState(buf) {
@@ -73,11 +62,6 @@ async function setState(resp, t0, tEvent = t0) {
   updateSelectionUi();
   scheduleTexture(tEvent);
   return json;
-}
-
-async function post(path, body) {
-  const resp = await fetch(path, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
-  return check(resp);
 }
 
 async function newSession(body) {

@@ -4,17 +4,18 @@
 // the server, cut meshes by solid jobs) and the GLB viewer (texture, wireframe, UV checker, patch colours).
 // three.js comes from /vendor/ (embedded after scripts/setup-studio); without it the
 // page says which command to run.
+import { $, status, check, post } from './page.js';
+import { renderJob, watchJob } from './jobs.js';
+import { checkerTexture, patchGeometry } from './display.js';
+import { camera, clearGroup, controls, fitCamera, groups, polyline, render, renderer, setupView } from './view.js';
 
-const $ = (id) => document.getElementById(id);
 const params = new URLSearchParams(location.search);
 const mode = ['align', 'solid', 'viewer'].includes(params.get('mode')) ? params.get('mode') : 'align';
 let THREE, OrbitControls, GLTFLoader;
 let info = null;
-let renderer, scene, camera, controls;
 let meshData = null; // {id, root, path, bbox, crest, ...}
 let meshObj = null; // THREE.Mesh of the opened mesh
 let glbRoot = null; // the GLB scene shown in the viewer
-const groups = {};
 const crestUse = []; // per crest line: used as a curve
 let drawn = []; // curves drawn on the surface (align) — arrays of [x, y, z]
 let sketch = []; // solid sketch curves: {points, axis}
@@ -23,7 +24,6 @@ let cutPlaneObj = null;
 let refPlaneObj = null;
 let solid = null; // the open solid on the server: {id, key, sent}
 const cuts = []; // cut latencies: {round_trip_ms, shown_ms, server_ms, computed, requested}
-let checkerTexture = null;
 const timings = {};
 window.studioMesh = {
   get mesh() { return meshData; },
@@ -36,81 +36,11 @@ window.studioMesh = {
   jobs: {},
 };
 
-function status(text, error = false) {
-  $('status').textContent = text;
-  $('status').className = error ? 'error' : '';
-}
-
-async function check(resp) {
-  if (resp.ok) return resp;
-  let msg = `${resp.status}`;
-  try { msg += ': ' + (await resp.json()).error; } catch (_) { /* not JSON */ }
-  throw new Error(msg);
-}
-async function post(path, body) {
-  return check(await fetch(path, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) }));
-}
-
 // ---------------------------------------------------------------- 3-D view
-function setupView() {
-  const box = $('viewport');
-  renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(1);
-  renderer.setSize(720, 560);
-  renderer.setClearColor(0xffffff, 1);
-  box.appendChild(renderer.domElement);
-  scene = new THREE.Scene();
-  camera = new THREE.PerspectiveCamera(40, 720 / 560, 0.001, 1000);
-  camera.position.set(0, 0, 3);
-  controls = new OrbitControls(camera, renderer.domElement);
-  controls.addEventListener('change', render);
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x666677, 2.2));
-  const sun = new THREE.DirectionalLight(0xffffff, 1.6);
-  sun.position.set(1, 2, 3);
-  camera.add(sun);
-  scene.add(camera);
-  for (const g of ['mesh', 'crest', 'drawn', 'field', 'glb', 'cut', 'ref']) {
-    groups[g] = new THREE.Group();
-    scene.add(groups[g]);
-  }
-  renderer.domElement.addEventListener('pointerdown', onPointerDown);
-  renderer.domElement.addEventListener('pointermove', onPointerMove);
-  renderer.domElement.addEventListener('pointerup', onPointerUp);
-  render();
-}
-
-function render() {
-  if (renderer) renderer.render(scene, camera);
-}
-
-function clearGroup(g) {
-  for (const c of [...groups[g].children]) {
-    groups[g].remove(c);
-    c.traverse((o) => { if (o.geometry) o.geometry.dispose(); });
-  }
-}
-
-function fitCamera(lo, hi) {
-  const c = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
-  const r = Math.max(1e-6, Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2);
-  controls.target.copy(c);
-  camera.position.set(c.x + r * 0.9, c.y + r * 0.7, c.z + r * 2.4);
-  camera.near = r / 100; camera.far = r * 100;
-  camera.updateProjectionMatrix();
-  controls.update();
-}
-
 function diag() {
   if (!meshData) return 1;
   const [lo, hi] = meshData.bbox;
   return Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-}
-
-function polyline(points, color, width = 1) {
-  const g = new THREE.BufferGeometry();
-  g.setAttribute('position', new THREE.Float32BufferAttribute(points.flat(), 3));
-  const m = new THREE.LineBasicMaterial({ color, linewidth: width, depthTest: true });
-  return new THREE.Line(g, m);
 }
 
 // ---------------------------------------------------------------- meshes
@@ -511,70 +441,11 @@ async function runJob(kind = mode) {
   try {
     const job = await (await post('/api/jobs', body)).json();
     status(`${kind} job ${job.id} queued`);
-    watchJob(job);
+    watchJob(job, jobHandlers);
     return job;
   } catch (e) { status(e.message, true); return null; }
 }
 
-function jobRow(job) {
-  let row = document.getElementById(`job-${job.id}`);
-  if (!row) {
-    row = document.createElement('div');
-    row.id = `job-${job.id}`;
-    row.className = 'job';
-    $('jobs').prepend(row);
-  }
-  return row;
-}
-function renderJob(job) {
-  window.studioMesh.jobs[job.id] = job;
-  const row = jobRow(job);
-  row.textContent = '';
-  const head = document.createElement('div');
-  head.textContent = `${job.kind} ${job.id}: ${job.state}${job.stage ? ' — ' + job.stage : ''} (${job.seconds.toFixed(1)} s)`;
-  row.appendChild(head);
-  if (job.state === 'running' || job.state === 'queued') {
-    const bar = document.createElement('progress');
-    bar.max = Math.max(1, job.total); bar.value = job.done;
-    const cancel = document.createElement('button');
-    cancel.textContent = 'Cancel';
-    cancel.onclick = () => post(`/api/jobs/cancel?id=${job.id}`, {}).catch((e) => status(e.message, true));
-    row.append(bar, cancel);
-  }
-  if (job.error) {
-    const e = document.createElement('div');
-    e.className = 'error';
-    e.textContent = job.error;
-    row.appendChild(e);
-  }
-  for (const f of job.files || []) {
-    const a = document.createElement('a');
-    const rel = `${job.dir}/${f}`;
-    a.href = `/api/file?path=${encodeURIComponent(rel)}`;
-    a.textContent = f; a.download = f;
-    row.append(a, ' ');
-    if (f.endsWith('.glb')) {
-      const v = document.createElement('button');
-      v.textContent = 'view';
-      v.onclick = () => openGlb({ root: 'workspace', path: rel });
-      row.append(v, ' ');
-    }
-  }
-}
-function watchJob(job) {
-  renderJob(job);
-  const es = new EventSource(`/api/jobs/events?id=${encodeURIComponent(job.id)}`);
-  es.onmessage = (ev) => {
-    const j = JSON.parse(ev.data);
-    renderJob(j);
-    if (['done', 'failed', 'cancelled'].includes(j.state)) {
-      es.close();
-      onJobEnd(j);
-    }
-  };
-  es.addEventListener('end', () => es.close());
-  es.onerror = () => es.close();
-}
 async function onJobEnd(job) {
   if (job.state === 'failed') { status(`${job.kind} failed: ${job.error}`, true); return; }
   if (job.state !== 'done') { status(`${job.kind} ${job.state}`); return; }
@@ -586,6 +457,7 @@ async function onJobEnd(job) {
     await openGlb({ root: 'workspace', path: `${job.dir}/model.glb` });
   }
 }
+const jobHandlers = { onView: (ref) => openGlb(ref), onEnd: onJobEnd };
 
 // ---------------------------------------------------------------- viewer
 async function openGlb(ref, fit = true) {
@@ -614,48 +486,6 @@ async function openGlb(ref, fit = true) {
   } catch (e) { status(`${ref.path}: ${e.message || e}`, true); }
 }
 
-function checker() {
-  if (checkerTexture) return checkerTexture;
-  const c = document.createElement('canvas');
-  c.width = c.height = 512;
-  const x = c.getContext('2d');
-  for (let j = 0; j < 16; j++) for (let i = 0; i < 16; i++) {
-    x.fillStyle = (i + j) % 2 ? '#f2f2f2' : (i % 4 === 0 || j % 4 === 0 ? '#d04030' : '#303848');
-    x.fillRect(i * 32, j * 32, 32, 32);
-  }
-  checkerTexture = new THREE.CanvasTexture(c);
-  checkerTexture.colorSpace = THREE.SRGBColorSpace;
-  checkerTexture.flipY = false;
-  return checkerTexture;
-}
-
-/** Per-triangle colours of the connected components of the index graph: the GLB
- *  writer splits vertices at UV seams, so these are the atlas charts / conformal
- *  patches. Returns a non-indexed geometry with a colour attribute. */
-function patchGeometry(geom) {
-  const n = geom.attributes.position.count;
-  const index = geom.index ? geom.index.array : Array.from({ length: n }, (_, i) => i);
-  const parent = new Int32Array(n).map((_, i) => i);
-  const find = (a) => { while (parent[a] !== a) { parent[a] = parent[parent[a]]; a = parent[a]; } return a; };
-  for (let t = 0; t < index.length; t += 3) {
-    const a = find(index[t]), b = find(index[t + 1]), c = find(index[t + 2]);
-    parent[b] = a; parent[find(c)] = a;
-  }
-  const g = geom.index ? geom.toNonIndexed() : geom.clone();
-  const colors = new Float32Array(g.attributes.position.count * 3);
-  const ids = new Map();
-  for (let t = 0; t < index.length; t += 3) {
-    const root = find(index[t]);
-    if (!ids.has(root)) ids.set(root, ids.size);
-    const h = (ids.get(root) * 0.61803398875) % 1;
-    const col = new THREE.Color().setHSL(h, 0.65, 0.55);
-    for (let k = 0; k < 3; k++) colors.set([col.r, col.g, col.b], (t + k) * 3);
-  }
-  g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
-  g.userData.patches = ids.size;
-  return g;
-}
-
 function applyDisplay() {
   const d = document.querySelector('input[name=display]:checked').value;
   const targets = [];
@@ -670,10 +500,10 @@ function applyDisplay() {
     else if (d === 'wireframe') o.material = new THREE.MeshBasicMaterial({ color: 0x223355, wireframe: true });
     else if (d === 'checker') {
       o.material = o.geometry.attributes.uv
-        ? new THREE.MeshBasicMaterial({ map: checker() })
+        ? new THREE.MeshBasicMaterial({ map: checkerTexture(THREE) })
         : new THREE.MeshBasicMaterial({ color: 0xcc4444 });
     } else {
-      if (!o.userData.patchGeometry) o.userData.patchGeometry = patchGeometry(o.userData.geometry);
+      if (!o.userData.patchGeometry) o.userData.patchGeometry = patchGeometry(THREE, o.userData.geometry);
       o.geometry = o.userData.patchGeometry;
       patches += o.geometry.userData.patches;
       o.material = new THREE.MeshBasicMaterial({ vertexColors: true });
@@ -717,7 +547,7 @@ async function start() {
     ({ OrbitControls } = await import('three/addons/controls/OrbitControls.js'));
     ({ GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js'));
   } catch (e) { status(`cannot load three.js: ${e.message}`, true); return; }
-  setupView();
+  setupView(THREE, OrbitControls, $('viewport'), { onPointerDown, onPointerMove, onPointerUp });
   for (const ex of info.exemplars) {
     $('exemplar').appendChild(new Option((ex.root === 'workspace' ? 'workspace/' : '') + ex.path, JSON.stringify(ex)));
   }
@@ -752,7 +582,7 @@ async function start() {
   $('run').onclick = () => runJob(mode);
   for (const r of document.querySelectorAll('input[name=display]')) r.onchange = applyDisplay;
   const jobs = await (await fetch('/api/jobs')).json().catch(() => ({ jobs: [] }));
-  for (const j of jobs.jobs || []) renderJob(j);
+  for (const j of jobs.jobs || []) renderJob(j, jobHandlers);
   const want = params.get('mesh');
   if (want && mode !== 'viewer') await openMesh(JSON.parse(want)).catch((e) => status(e.message, true));
   const glb = params.get('glb');

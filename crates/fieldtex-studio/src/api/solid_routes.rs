@@ -69,10 +69,8 @@ fn lock_solid<'a>(
     id: &str,
     s: &'a SolidRef,
 ) -> Result<std::sync::MutexGuard<'a, SolidSession>, Response> {
-    s.lock().map_err(|_| {
-        state.solids.lock().unwrap_or_else(|e| e.into_inner()).retain(|(k, _)| k != id);
-        Response::error(500, "this solid was dropped after an internal error; open it again")
-    })
+    let forget = || state.solids.lock().unwrap_or_else(|e| e.into_inner()).retain(|(k, _)| k != id);
+    lock_or_forget(s, forget, "this solid was dropped after an internal error; open it again")
 }
 
 fn facade_err(e: fieldtex::Error) -> Response {
