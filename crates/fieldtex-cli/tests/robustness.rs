@@ -27,10 +27,9 @@ fn quick(args: &[&str]) -> Output {
 
 /// `orient --preset whorl --exemplar EXEMPLAR --out OUT EXTRA…` within 30 s.
 fn orient_whorl(exemplar: &Path, out: &Path, extra: &[&str]) -> Output {
-    quick(
-        &[&["orient", "--preset", "whorl", "--exemplar", s(exemplar), "--out", s(out)], extra]
-            .concat(),
-    )
+    let mut args = vec!["orient", "--preset", "whorl", "--exemplar", s(exemplar), "--out", s(out)];
+    args.extend_from_slice(extra);
+    quick(&args)
 }
 
 /// `atlas MESH --out OUT --size 128 --quiet`, which must succeed.
