@@ -20,6 +20,31 @@ const SKETCH: &str = r#"{"curves": [
   {"points": [[-1.0, 0.0, -0.5], [1.0, 0.0, -0.5]], "plane": {"point": [0, 0, 0], "normal": [0, 1, 0]}, "axis": "y"}
 ]}"#;
 
+/// `fieldtex solid` on the torus with `exemplar` into `out` on a small grid
+/// (`resolution` voxels along the longest side, atlas 128², 3 levels, blocks of 6),
+/// then `extra`: the setup every torus test shares.
+fn run_torus(exemplar: &Path, out: &Path, resolution: u32, extra: &[&str]) -> Output {
+    let (mesh, resolution) = (shared().join("meshes/torus.obj"), resolution.to_string());
+    let mut args = vec![
+        "solid",
+        "--mesh",
+        mesh.to_str().unwrap(),
+        "--exemplar",
+        exemplar.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--resolution",
+        &resolution,
+    ];
+    args.extend(["--atlas-size", "128", "--levels", "3", "--block", "6", "--quiet"]);
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
+fn woodgrain() -> PathBuf {
+    shared().join("exemplars/woodgrain_Wood022.png")
+}
+
 /// Runs the torus (axis y) at a small resolution with a y cut through the voxel
 /// centres of slice `k`.
 fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
@@ -30,32 +55,8 @@ fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
     let y = -0.21875 + 0.0625 * k as f64;
     let cut = format!("0,{y},0,0,1,0");
     let out = dir.join("out");
-    run(&[
-        "solid",
-        "--mesh",
-        shared().join("meshes/torus.obj").to_str().unwrap(),
-        "--sketch",
-        sketch.to_str().unwrap(),
-        "--exemplar",
-        shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--resolution",
-        "40",
-        "--atlas-size",
-        "128",
-        "--levels",
-        "3",
-        "--block",
-        "6",
-        "--cut",
-        &cut,
-        "--volume",
-        "--keep",
-        "--threads",
-        threads,
-        "--quiet",
-    ])
+    let extra = ["--sketch", sketch.to_str().unwrap(), "--cut", &cut, "--volume", "--keep"];
+    run_torus(&woodgrain(), &out, 40, &[&extra[..], &["--threads", threads]].concat())
 }
 
 fn weld_closed(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
@@ -157,8 +158,7 @@ fn bad_sketches_name_the_curve_and_point() {
         r#"{"curves": [{"points": [[0,0,0],[1,0,0]]}, {"points": [[0,0,0]]}]}"#,
     )
     .unwrap();
-    let (torus, wood) =
-        (shared().join("meshes/torus.obj"), shared().join("exemplars/woodgrain_Wood022.png"));
+    let (torus, wood) = (shared().join("meshes/torus.obj"), woodgrain());
     let out = d.join("out");
     // The torus with the sketch file as it is now.
     let solid_run = || {
@@ -190,36 +190,13 @@ fn bad_sketches_name_the_curve_and_point() {
 #[test]
 fn interior_region_fills_the_deep_voxels() {
     let run_one = |name: &str, interior: bool| {
-        let dir = tmp(name);
-        let out = dir.join("out");
-        let mut args = vec![
-            "solid".to_string(),
-            "--mesh".into(),
-            shared().join("meshes/torus.obj").to_str().unwrap().into(),
-            "--exemplar".into(),
-            shared().join("exemplars/woodgrain_Wood022.png").to_str().unwrap().into(),
-            "--out".into(),
-            out.to_str().unwrap().into(),
-            "--resolution".into(),
-            "40".into(),
-            "--atlas-size".into(),
-            "128".into(),
-            "--levels".into(),
-            "3".into(),
-            "--block".into(),
-            "6".into(),
-            "--cut=0,0.03125,0,0,1,0".into(),
-            "--volume".into(),
-            "--quiet".into(),
-        ];
+        let out = tmp(name).join("out");
+        let stripes = shared().join("exemplars/stripes_Fabric071.png");
+        let mut extra = vec!["--cut=0,0.03125,0,0,1,0", "--volume"];
         if interior {
-            args.push("--interior".into());
-            args.push(shared().join("exemplars/stripes_Fabric071.png").to_str().unwrap().into());
-            args.push("--interior-depth".into());
-            args.push("0.12".into());
+            extra.extend(["--interior", stripes.to_str().unwrap(), "--interior-depth", "0.12"]);
         }
-        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-        let o = run(&refs);
+        let o = run_torus(&woodgrain(), &out, 40, &extra);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         out
     };
@@ -280,26 +257,7 @@ fn feature_mask_is_used_and_a_wrong_size_is_an_error() {
     let bad = d.join("small.png");
     write_png(&bad, &fieldtex::Image::new(20, 20, [1.0; 4])).unwrap();
     let solid_run = |mask: &Path, out: &Path| {
-        run(&[
-            "solid",
-            "--mesh",
-            shared().join("meshes/torus.obj").to_str().unwrap(),
-            "--exemplar",
-            bricks.to_str().unwrap(),
-            "--feature-mask",
-            mask.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--resolution",
-            "32",
-            "--atlas-size",
-            "128",
-            "--levels",
-            "3",
-            "--block",
-            "6",
-            "--quiet",
-        ])
+        run_torus(&bricks, out, 32, &["--feature-mask", mask.to_str().unwrap()])
     };
     let o = solid_run(&bad, &d.join("bad"));
     assert_eq!(o.status.code(), Some(2));
