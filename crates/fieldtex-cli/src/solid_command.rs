@@ -65,6 +65,10 @@ pub struct SolidArgs {
     /// Correction passes per level (half primary grid, half dual grid).
     #[arg(long, default_value_t = 2)]
     passes: usize,
+    /// Correction passes per level, finest first (e.g. 2,4,4,4,4), overriding
+    /// --passes (and the coarsest level's 4) on the levels listed.
+    #[arg(long, value_delimiter = ',')]
+    level_passes: Vec<usize>,
     /// Block side M of the dual-grid correction.
     #[arg(long, default_value_t = 12)]
     block: usize,
@@ -140,6 +144,7 @@ pub fn run_solid(
         ..Default::default()
     };
     opts.synthesis.passes = a.passes;
+    opts.synthesis.level_passes = a.level_passes;
     opts.synthesis.block = a.block;
     opts.synthesis.seed = seed;
     opts.synthesis.trilinear_levels = a.trilinear_levels;

@@ -138,14 +138,8 @@ impl ExemplarLevel {
     /// overlap that work instead of stalling the candidate gathering after it.
     #[inline(always)]
     pub(crate) fn prefetch_coherence(&self, u: [f32; 2]) {
-        #[cfg(target_arch = "x86_64")]
         if let Some(v) = self.coherence.get(self.pixel(u) * self.k_store) {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            // SAFETY: SSE is part of the x86_64 baseline, and a prefetch only hints the
-            // cache (the address is in bounds anyway).
-            unsafe { _mm_prefetch::<_MM_HINT_T0>((v as *const [f32; 2]).cast()) };
+            crate::prefetch::prefetch_read(v);
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = u;
     }
 }

@@ -54,6 +54,7 @@ pub mod k_coherence;
 pub mod lattice_domain;
 mod level_tables;
 pub mod parallel_synthesis;
+mod prefetch;
 pub mod regular_lattice;
 pub mod solid;
 pub mod synthesis_options;

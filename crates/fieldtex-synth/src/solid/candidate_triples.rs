@@ -48,10 +48,24 @@ impl CandidateTriples {
     /// The `k`-th candidate of pixel `(x, y)` (wrapped).
     #[inline]
     pub fn get(&self, x: i32, y: i32, k: usize) -> &Triple {
-        let xi = x.rem_euclid(self.width as i32) as usize;
-        let yi = y.rem_euclid(self.height as i32) as usize;
-        &self.triples[(yi * self.width + xi) * self.n_t + k]
+        let pixel = wrapped(y, self.height) * self.width + wrapped(x, self.width);
+        &self.triples[pixel * self.n_t + k]
     }
+
+    /// Asks the CPU to fetch pixel `(x, y)`'s first candidates ahead of [`Self::get`]
+    /// (no effect on results).
+    #[inline]
+    pub fn prefetch(&self, x: i32, y: i32) {
+        let pixel = wrapped(y, self.height) * self.width + wrapped(x, self.width);
+        crate::prefetch::prefetch_read(&self.triples[pixel * self.n_t]);
+    }
+}
+
+/// `x` wrapped into `[0, n)` (`x.rem_euclid(n)`, without the division when `x` is
+/// already inside, as exemplar coordinates mostly are).
+#[inline]
+pub(crate) fn wrapped(x: i32, n: usize) -> usize {
+    if (x as u32) < n as u32 { x as usize } else { x.rem_euclid(n as i32) as usize }
 }
 
 /// Row and column sticks of every pixel (`N × ch` floats each).

@@ -45,7 +45,7 @@
 //! and whole-level tabulation replaced by evaluation of a requested subset from its
 //! dependency (block) set.
 
-use super::candidate_triples::Triple;
+use super::candidate_triples::{Triple, wrapped};
 use super::solid_exemplar::SolidExemplar;
 use super::voxel_lattice::{
     FrameSource, VoxelLattice, dual_block, dual_origin, floor_div, primary_block, primary_origin,
@@ -57,7 +57,9 @@ use std::collections::{BTreeSet, HashMap};
 use std::sync::Arc;
 use std::time::Instant;
 
+mod block_regions;
 mod voxel_correction;
+use block_regions::{BlockCursor, for_box, local_index, region_of};
 
 /// Options of [`SolidSynthesizer`].
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -69,6 +71,10 @@ pub struct SolidSynthesisOptions {
     pub passes: usize,
     /// Correction passes at the coarsest level. Default 4 (paper: 3–5).
     pub coarse_passes: usize,
+    /// Per-level pass counts, finest level first, overriding `passes` / `coarse_passes`
+    /// on the levels they cover (e.g. more passes only on the coarse levels, where
+    /// voxels are few). Default empty.
+    pub level_passes: Vec<usize>,
     /// `s³ = 8` parity subpasses per pass (default true).
     pub subpasses: bool,
     /// Candidate triples taken per predicted pixel in the correction (`k`). Default 2.
@@ -91,6 +97,7 @@ impl Default for SolidSynthesisOptions {
             block: 12,
             passes: 2,
             coarse_passes: 4,
+            level_passes: Vec::new(),
             subpasses: true,
             k: 2,
             subpart: 64,
@@ -165,6 +172,9 @@ impl<'a> SolidSynthesizer<'a> {
         }
         if options.passes > 16 || options.coarse_passes > 32 {
             return bad("SolidSynthesisOptions::passes", options.passes, "at most 16 (32 coarse)");
+        }
+        if let Some(&p) = options.level_passes.iter().find(|&&p| p > 32) {
+            return bad("SolidSynthesisOptions::level_passes", p, "at most 32 per level");
         }
         if options.k == 0 || options.k > exemplar.options.triples {
             return bad("SolidSynthesisOptions::k", options.k, "between 1 and the analysis's N_T");
@@ -274,47 +284,50 @@ impl<'a> SolidSynthesizer<'a> {
             let prim: Vec<[i32; 3]> = need_primary[c].iter().copied().collect();
             let dual: Vec<[i32; 3]> = need_dual[c].iter().copied().collect();
             progress.stage(&format!("solid level {c}"), (prim.len() + dual.len()) as u64);
-            let this = &*self;
-            let computed: Vec<(Vec<Triple>, Counts)> = prim
-                .par_iter()
-                .map(|b| {
-                    let out = this.primary_block(c, *b);
-                    progress.advance(1);
-                    out
-                })
-                .collect();
             let mut st = LevelStats {
                 level: c,
                 primary_blocks: prim.len(),
                 dual_blocks: dual.len(),
                 ..Default::default()
             };
-            for (b, (t, n)) in prim.iter().zip(computed) {
-                st.corrections += n.corrections;
-                st.candidate_evaluations += n.evaluations;
-                self.cache[c].primary.insert(*b, Arc::new(t));
-            }
-            let this = &*self;
-            let computed: Vec<(Vec<Triple>, Counts)> = dual
-                .par_iter()
-                .map(|b| {
-                    let out = this.dual_block(c, *b);
-                    progress.advance(1);
-                    out
-                })
-                .collect();
-            for (b, (t, n)) in dual.iter().zip(computed) {
-                st.corrections += n.corrections;
-                st.candidate_evaluations += n.evaluations;
-                self.cache[c].dual.insert(*b, Arc::new(t));
-            }
+            self.compute_blocks(c, &prim, false, &mut st, progress);
+            self.compute_blocks(c, &dual, true, &mut st, progress);
             st.voxels = dual.len() as u64 * (m as u64).pow(3);
             st.seconds = t0.elapsed().as_secs_f64();
             progress.finish_stage();
             stats[c] = st;
         }
-        let out = voxels.iter().map(|v| self.final_at(0, *v)).collect();
+        let mut finals = BlockCursor::new(&self.cache[0].dual, m, dual_block, dual_origin);
+        let out = voxels.iter().map(|v| finals.at(*v)).collect();
         (out, stats)
+    }
+
+    /// Computes the level-`c` primary (or `dual`) `blocks` in parallel into the cache,
+    /// counting the work in `st`.
+    fn compute_blocks(
+        &mut self,
+        c: usize,
+        blocks: &[[i32; 3]],
+        dual: bool,
+        st: &mut LevelStats,
+        progress: &dyn Progress,
+    ) {
+        let this = &*self;
+        let computed: Vec<(Vec<Triple>, Counts)> = blocks
+            .par_iter()
+            .map(|b| {
+                let out = if dual { this.dual_block(c, *b) } else { this.primary_block(c, *b) };
+                progress.advance(1);
+                out
+            })
+            .collect();
+        let level = &mut self.cache[c];
+        let map = if dual { &mut level.dual } else { &mut level.primary };
+        for (b, (t, n)) in blocks.iter().zip(computed) {
+            st.corrections += n.corrections;
+            st.candidate_evaluations += n.evaluations;
+            map.insert(*b, Arc::new(t));
+        }
     }
 
     /// Colours (RGB, sRGB-encoded as the exemplars) of `voxels`: the mean of the three
@@ -368,14 +381,6 @@ impl<'a> SolidSynthesizer<'a> {
         acc.map(|v| v / total)
     }
 
-    fn final_at(&self, c: usize, v: [i32; 3]) -> Triple {
-        let m = self.options.block as i32;
-        let b = dual_block(v, m);
-        let o = dual_origin(b, m);
-        let block = self.cache[c].dual.get(&b).expect("dual block computed by the dependency pass");
-        block[local_index(v, o, m)]
-    }
-
     fn frame_f32(&self, c: usize, v: [i32; 3]) -> [f32; 9] {
         self.frames.frame(self.lattice.centre(c, v)).map(|x| x as f32)
     }
@@ -383,58 +388,54 @@ impl<'a> SolidSynthesizer<'a> {
     fn wrap(&self, mut t: Triple) -> Triple {
         for p in 0..3 {
             let e = &self.exemplar.planes[p];
-            t[p][0] = t[p][0].rem_euclid(e.width as i32);
-            t[p][1] = t[p][1].rem_euclid(e.height as i32);
+            t[p][0] = wrapped(t[p][0], e.width) as i32;
+            t[p][1] = wrapped(t[p][1], e.height) as i32;
         }
         t
     }
 
-    /// Version 0 of voxel `v` at level `c`: initialisation or upsampling.
-    fn version0(
+    /// Version 0 of voxel `v` at the coarsest level `c`: candidate slabs warped by the
+    /// field in subparts (§4.1).
+    fn initial(&self, c: usize, v: [i32; 3]) -> Triple {
+        let n = self.exemplar.options.neighbourhood as i32;
+        let h = 1i32 << c;
+        let k = self.options.subpart as i32;
+        let s: [i32; 3] = std::array::from_fn(|a| floor_div(v[a], k));
+        let o: [f64; 3] = std::array::from_fn(|a| (s[a] * k) as f64 + 0.5 * (k - 1) as f64);
+        let rm = self.frames.frame(self.lattice.centre(c, v));
+        let d: [f64; 3] = std::array::from_fn(|a| v[a] as f64 - o[a]);
+        // Local coordinates Rᵀ d.
+        let w: [i32; 3] = std::array::from_fn(|col| {
+            round_f64_i32(rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2])
+        });
+        let layer = floor_div(w[2], n);
+        let t = w[2] - layer * n - n / 2;
+        let key = fieldtex_core::rng::mix64(
+            (s[0] as u32 as u64) ^ ((s[1] as u32 as u64) << 21) ^ ((s[2] as u32 as u64) << 42),
+        ) ^ (layer as u32 as u64);
+        let e0 = &self.exemplar.planes[0];
+        let ox = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-slab-x", key)
+            * e0.width as f64) as i32;
+        let oy = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-slab-y", key)
+            * e0.height as f64) as i32;
+        let table = &self.exemplar.triples[c][0];
+        let mut tr = *table.get(w[0] * h + ox, w[1] * h + oy, 0);
+        tr[1][1] += t * h;
+        tr[2][0] += t * h;
+        self.wrap(tr)
+    }
+
+    /// Version 0 of voxel `v` at level `c` below the coarsest: its parent `pv`'s final
+    /// triple `parent` moved by eq. 3–4 in the parent's frame `rm`.
+    fn upsampled(
         &self,
         c: usize,
         v: [i32; 3],
-        parent_cache: Option<(&[i32; 3], &Arc<Vec<Triple>>)>,
+        pv: [i32; 3],
+        parent: Triple,
+        rm: &[f64; 9],
     ) -> Triple {
-        let levels = self.cache.len();
-        let n = self.exemplar.options.neighbourhood as i32;
         let h = 1i32 << c;
-        if c + 1 == levels {
-            // Candidate slabs warped by the field in subparts (§4.1).
-            let k = self.options.subpart as i32;
-            let s: [i32; 3] = std::array::from_fn(|a| floor_div(v[a], k));
-            let o: [f64; 3] = std::array::from_fn(|a| (s[a] * k) as f64 + 0.5 * (k - 1) as f64);
-            let rm = self.frames.frame(self.lattice.centre(c, v));
-            let d: [f64; 3] = std::array::from_fn(|a| v[a] as f64 - o[a]);
-            // Local coordinates Rᵀ d.
-            let w: [i32; 3] = std::array::from_fn(|col| {
-                round_f64_i32(rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2])
-            });
-            let layer = floor_div(w[2], n);
-            let t = w[2] - layer * n - n / 2;
-            let key = fieldtex_core::rng::mix64(
-                (s[0] as u32 as u64) ^ ((s[1] as u32 as u64) << 21) ^ ((s[2] as u32 as u64) << 42),
-            ) ^ (layer as u32 as u64);
-            let e0 = &self.exemplar.planes[0];
-            let ox = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-slab-x", key)
-                * e0.width as f64) as i32;
-            let oy = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-slab-y", key)
-                * e0.height as f64) as i32;
-            let table = &self.exemplar.triples[c][0];
-            let mut tr = *table.get(w[0] * h + ox, w[1] * h + oy, 0);
-            tr[1][1] += t * h;
-            tr[2][0] += t * h;
-            return self.wrap(tr);
-        }
-        let m = self.options.block as i32;
-        let pv: [i32; 3] = std::array::from_fn(|a| floor_div(v[a], 2));
-        let pb = dual_block(pv, m);
-        let po = dual_origin(pb, m);
-        let parent = match parent_cache {
-            Some((b, blk)) if *b == pb => blk[local_index(pv, po, m)],
-            _ => self.final_at(c + 1, pv),
-        };
-        let rm = self.frames.frame(self.lattice.centre(c + 1, pv));
         let delta: [f64; 3] = std::array::from_fn(|a| (h * (v[a] - 2 * pv[a])) as f64);
         let d: [f64; 3] = std::array::from_fn(|col| {
             rm[col] * delta[0] + rm[3 + col] * delta[1] + rm[6 + col] * delta[2]
@@ -456,22 +457,23 @@ impl<'a> SolidSynthesizer<'a> {
         let s = m + 2 * r;
         let o = primary_origin(b, m);
         let origin: [i32; 3] = std::array::from_fn(|a| o[a] - r);
-        let mut region = Vec::with_capacity((s * s * s) as usize);
-        let mut last: Option<([i32; 3], Arc<Vec<Triple>>)> = None;
-        for z in 0..s {
-            for y in 0..s {
-                for x in 0..s {
-                    let v = [origin[0] + x, origin[1] + y, origin[2] + z];
-                    if c + 1 < self.cache.len() {
-                        let pb = dual_block(std::array::from_fn(|a| floor_div(v[a], 2)), m);
-                        if last.as_ref().is_none_or(|(lb, _)| *lb != pb) {
-                            last = self.cache[c + 1].dual.get(&pb).map(|blk| (pb, blk.clone()));
-                        }
-                    }
-                    region.push(self.version0(c, v, last.as_ref().map(|(b, k)| (b, k))));
-                }
-            }
-        }
+        let mut region = if c + 1 == self.cache.len() {
+            region_of(origin, s, |v| self.initial(c, v))
+        } else {
+            // The parents of the region: a box at level c + 1, whose frames are looked
+            // up once each (eight children share one).
+            let lo: [i32; 3] = origin.map(|x| floor_div(x, 2));
+            // floor((o + s − 1) / 2) − floor(o / 2) + 1 ≤ s / 2 + 1 for either parity of o.
+            let side = s / 2 + 1;
+            let frames =
+                region_of(lo, side, |pv| self.frames.frame(self.lattice.centre(c + 1, pv)));
+            let mut parents = BlockCursor::new(&self.cache[c + 1].dual, m, dual_block, dual_origin);
+            region_of(origin, s, |v| {
+                let pv: [i32; 3] = v.map(|x| floor_div(x, 2));
+                let f = &frames[local_index(pv, lo, side)];
+                self.upsampled(c, v, pv, parents.at(pv), f)
+            })
+        };
         let passes = self.primary_passes(c);
         self.correct(c, origin, s, r, m, &mut region, passes)
     }
@@ -482,29 +484,21 @@ impl<'a> SolidSynthesizer<'a> {
         let s = m + 2 * r;
         let o = dual_origin(b, m);
         let origin: [i32; 3] = std::array::from_fn(|a| o[a] - r);
-        let mut region = Vec::with_capacity((s * s * s) as usize);
-        let mut last: Option<([i32; 3], Arc<Vec<Triple>>)> = None;
-        for z in 0..s {
-            for y in 0..s {
-                for x in 0..s {
-                    let v = [origin[0] + x, origin[1] + y, origin[2] + z];
-                    let pb = primary_block(v, m);
-                    if last.as_ref().is_none_or(|(lb, _)| *lb != pb) {
-                        let blk =
-                            self.cache[c].primary.get(&pb).expect("primary block computed first");
-                        last = Some((pb, blk.clone()));
-                    }
-                    let (_, blk) = last.as_ref().expect("set above");
-                    region.push(blk[local_index(v, primary_origin(pb, m), m)]);
-                }
-            }
-        }
+        let mut primary =
+            BlockCursor::new(&self.cache[c].primary, m, primary_block, primary_origin);
+        let mut region = region_of(origin, s, |v| primary.at(v));
         let passes = self.dual_passes(c);
         self.correct(c, origin, s, r, m, &mut region, passes)
     }
 
     fn level_passes(&self, c: usize) -> usize {
-        if c + 1 == self.cache.len() { self.options.coarse_passes } else { self.options.passes }
+        if let Some(&p) = self.options.level_passes.get(c) {
+            p
+        } else if c + 1 == self.cache.len() {
+            self.options.coarse_passes
+        } else {
+            self.options.passes
+        }
     }
 
     fn primary_passes(&self, c: usize) -> usize {
@@ -536,21 +530,6 @@ fn round_f64_i32(x: f64) -> i32 {
         t - 1
     } else {
         t
-    }
-}
-
-#[inline]
-fn local_index(v: [i32; 3], o: [i32; 3], m: i32) -> usize {
-    (((v[2] - o[2]) * m + (v[1] - o[1])) * m + (v[0] - o[0])) as usize
-}
-
-fn for_box(lo: [i32; 3], hi: [i32; 3], mut f: impl FnMut([i32; 3])) {
-    for z in lo[2]..=hi[2] {
-        for y in lo[1]..=hi[1] {
-            for x in lo[0]..=hi[0] {
-                f([x, y, z]);
-            }
-        }
     }
 }
 

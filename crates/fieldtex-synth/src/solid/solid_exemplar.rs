@@ -25,7 +25,7 @@
 //! Identical exemplars share one analysis: the triple search is symmetric under the
 //! cyclic exchange of the planes, so one table serves all three.
 
-use super::candidate_triples::{CandidateTriples, candidate_triples};
+use super::candidate_triples::{CandidateTriples, candidate_triples, wrapped};
 use crate::SynthError;
 use crate::gaussian_stack::next_stack_level;
 use fieldtex_core::{Image, Progress};
@@ -284,20 +284,31 @@ impl SolidExemplar {
     /// Level-`c` colour (RGB) of plane `p` at pixel `(x, y)` (wrapped).
     #[inline]
     pub fn color(&self, p: usize, c: usize, x: i32, y: i32) -> [f32; 3] {
-        let e = &self.planes[p];
-        let xi = x.rem_euclid(e.width as i32) as usize;
-        let yi = y.rem_euclid(e.height as i32) as usize;
-        e.levels[c].colors[yi * e.width + xi]
+        self.planes[p].levels[c].colors[self.wrapped_pixel(p, x, y)]
     }
 
     /// Level-`c` matched values (RGB + weighted feature, [`PlaneLevel::matched`]) of
     /// plane `p` at pixel `(x, y)` (wrapped).
     #[inline]
     pub fn matched(&self, p: usize, c: usize, x: i32, y: i32) -> [f32; 4] {
+        self.planes[p].levels[c].matched[self.wrapped_pixel(p, x, y)]
+    }
+
+    /// Index of pixel `(x, y)` of plane `p`, wrapped into the exemplar.
+    #[inline]
+    fn wrapped_pixel(&self, p: usize, x: i32, y: i32) -> usize {
         let e = &self.planes[p];
-        let xi = x.rem_euclid(e.width as i32) as usize;
-        let yi = y.rem_euclid(e.height as i32) as usize;
-        e.levels[c].matched[yi * e.width + xi]
+        wrapped(y, e.height) * e.width + wrapped(x, e.width)
+    }
+
+    /// Asks the CPU to fetch the level-`c` appearance vector of plane `p` at pixel
+    /// `xy` ahead of its use (no effect on results).
+    #[inline]
+    pub(crate) fn prefetch_appearance(&self, p: usize, c: usize, xy: [i32; 2]) {
+        let lvl = &self.planes[p].levels[c];
+        if let Some(v) = lvl.appearance.get(self.wrapped_pixel(p, xy[0], xy[1]) * lvl.dims()) {
+            crate::prefetch::prefetch_read(v);
+        }
     }
 
     /// Matched channels: 4 with feature masks, else 3.

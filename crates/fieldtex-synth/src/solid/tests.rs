@@ -80,6 +80,29 @@ fn voxels_are_identical_alone_in_subsets_and_in_the_full_volume() {
     assert!(stats_alone[0].voxels < stats[0].voxels);
 }
 
+/// Per-level pass counts (`level_passes`) are used (the triples differ from the
+/// default counts') and keep the on-demand equality: a few voxels alone equal the same
+/// voxels of the full volume.
+#[test]
+fn per_level_passes_keep_the_on_demand_equality() {
+    let img = exemplar();
+    let (ao, so) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let voxels = all_voxels(10);
+    let run = |level_passes: Vec<usize>, voxels: &[[i32; 3]]| {
+        let o = SolidSynthesisOptions { level_passes, ..so.clone() };
+        SolidSynthesizer::new(&ex, lattice, &Bent, o).unwrap().triples(voxels, &NoProgress)
+    };
+    let (plain, _) = run(Vec::new(), &voxels);
+    let (more, stats) = run(vec![4, 5, 6], &voxels);
+    assert_ne!(plain, more, "the per-level counts changed nothing");
+    assert!(stats[2].corrections > 0);
+    let few = [voxels[3], voxels[500], voxels[999]];
+    let (t, _) = run(vec![4, 5, 6], &few);
+    assert_eq!(t, [more[3], more[500], more[999]]);
+}
+
 #[test]
 fn one_and_two_threads_give_the_same_voxels() {
     let img = exemplar();
@@ -218,24 +241,16 @@ fn mortar_connectivity(mask: &[f32], w: usize, h: usize) -> f64 {
         let mut size = 0;
         while let Some(i) = stack.pop() {
             size += 1;
-            let (x, y) = (i % w, i / w);
-            let mut push = |j: usize| {
+            let (x, y) = ((i % w) as isize, (i / w) as isize);
+            for (nx, ny) in [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)] {
+                if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
+                    continue;
+                }
+                let j = ny as usize * w + nx as usize;
                 if mask[j] >= 0.5 && label[j] == usize::MAX {
                     label[j] = start;
                     stack.push(j);
                 }
-            };
-            if x > 0 {
-                push(i - 1);
-            }
-            if x + 1 < w {
-                push(i + 1);
-            }
-            if y > 0 {
-                push(i - w);
-            }
-            if y + 1 < h {
-                push(i + w);
             }
         }
         total += size;

@@ -49,8 +49,8 @@ impl SolidSynthesizer<'_> {
                                 if subpasses == 8 && class != sub {
                                     continue;
                                 }
-                                let f = &frames[((z * m + y) * m + x) as usize];
                                 let at = [x + r, y + r, z + r];
+                                let f = &frames[((z * m + y) * m + x) as usize];
                                 let (best, evals) = self.best_candidate(
                                     c,
                                     region,
@@ -156,26 +156,48 @@ impl SolidSynthesizer<'_> {
         let integrate = c + self.options.integrate_levels >= self.cache.len();
         // Integrated samples stay where trilinear interpolation has both corners.
         let reach = self.halo() as f32;
+        let nn = (n * n) as usize;
+        let base = idx(at) as isize;
+        // Region index of every in-plane offset `(s, t)` of every plane (the voxel
+        // nearest `at + s·u + t·w`), shared by the neighbourhoods and the candidate
+        // predictions; the pixels the 3 × 3 in-plane neighbours predict (the voxel's
+        // own at the centre), whose candidate-table entries are asked into the cache
+        // now so that those misses overlap the neighbourhood work below (no effect on
+        // results).
         for p in 0..3 {
             let (a1, a2) = (p, (p + 1) % 3);
             let u = [f[a1], f[3 + a1], f[6 + a1]];
             let w = [f[a2], f[3 + a2], f[6 + a2]];
-            let lvl = &self.exemplar.planes[p].levels[c];
-            // Region index of every in-plane offset `(s, t)` (the voxel nearest
-            // `at + s·u + t·w`), computed once and shared by the neighbourhood and the
-            // candidate prediction below.
-            let base = idx(at) as isize;
+            let offsets = &mut scratch.offsets[p * nn..(p + 1) * nn];
             let mut k = 0;
             for t in -half..=half {
                 for ss in -half..=half {
                     let (sf, tf) = (ss as f32, t as f32);
                     let d: [i32; 3] = std::array::from_fn(|a| round_i32(sf * u[a] + tf * w[a]));
-                    scratch.offsets[k] = base + ((d[2] * s + d[1]) * s + d[0]) as isize;
+                    offsets[k] = base + ((d[2] * s + d[1]) * s + d[0]) as isize;
                     k += 1;
                 }
             }
-            let offset =
-                |ss: i32, t: i32| scratch.offsets[((t + half) * n + ss + half) as usize] as usize;
+            let table = &self.exemplar.triples[c][p];
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let pix = if dx == 0 && dy == 0 {
+                        current[p]
+                    } else {
+                        let o = offsets[((dy + half) * n + dx + half) as usize] as usize;
+                        let nb = region[o][p];
+                        [nb[0] - h * dx, nb[1] - h * dy]
+                    };
+                    scratch.predicted[p][((dy + 1) * 3 + dx + 1) as usize] = pix;
+                    table.prefetch(pix[0], pix[1]);
+                }
+            }
+        }
+        for p in 0..3 {
+            let (a1, a2) = (p, (p + 1) % 3);
+            let u = [f[a1], f[3 + a1], f[6 + a1]];
+            let w = [f[a2], f[3 + a2], f[6 + a2]];
+            let lvl = &self.exemplar.planes[p].levels[c];
             // A zero-weight plane contributes candidates but no neighbourhood.
             if weights[p] > 0.0 && trilinear {
                 // The halo `r ≥ ⌈N_h √2⌉` holds both corners of every axis: each
@@ -224,7 +246,7 @@ impl SolidSynthesizer<'_> {
                     scratch.buf[ch * j..ch * (j + 1)].copy_from_slice(&colors[o as usize][..ch]);
                 }
             } else if weights[p] > 0.0 {
-                for (j, &o) in scratch.offsets[..(n * n) as usize].iter().enumerate() {
+                for (j, &o) in scratch.offsets[p * nn..(p + 1) * nn].iter().enumerate() {
                     scratch.buf[ch * j..ch * (j + 1)].copy_from_slice(&colors[o as usize][..ch]);
                 }
             }
@@ -238,22 +260,28 @@ impl SolidSynthesizer<'_> {
                 }
                 scratch.proj[p][j] = acc - lvl.bias[j];
             }
+        }
+        // The candidates: each predicted pixel's `k` table entries, plane by plane in
+        // the 3 × 3 offsets' order. A pixel predicted again within a plane adds the
+        // same triples again, whose costs equal the first ones', so it is skipped (the
+        // earliest of equal costs wins either way: same result).
+        for p in 0..3 {
             let table = &self.exemplar.triples[c][p];
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    if dx == 0 && dy == 0 {
-                        // The voxel's own coordinate: its table entries.
-                        let pix = current[p];
-                        for kk in 0..self.options.k {
-                            scratch.candidates.push(*table.get(pix[0], pix[1], kk));
-                        }
-                        continue;
-                    }
-                    let nb = region[offset(dx, dy)];
-                    let pred = [nb[p][0] - h * dx, nb[p][1] - h * dy];
-                    for kk in 0..self.options.k {
-                        scratch.candidates.push(*table.get(pred[0], pred[1], kk));
-                    }
+            let pred = &scratch.predicted[p];
+            for (j, pix) in pred.iter().enumerate() {
+                if pred[..j].contains(pix) {
+                    continue;
+                }
+                for kk in 0..self.options.k {
+                    scratch.candidates.push(*table.get(pix[0], pix[1], kk));
+                }
+            }
+        }
+        // Their appearance vectors into the cache, all at once (no effect on results).
+        for cand in &scratch.candidates {
+            for p in 0..3 {
+                if weights[p] > 0.0 {
+                    self.exemplar.prefetch_appearance(p, c, cand[p]);
                 }
             }
         }
@@ -287,8 +315,10 @@ impl SolidSynthesizer<'_> {
 /// Per-block scratch buffers.
 struct Scratch {
     buf: Vec<f32>,
-    /// Region indices of the `N × N` in-plane offsets of the current plane.
+    /// Region indices of the `N × N` in-plane offsets of each plane (plane-major).
     offsets: Vec<isize>,
+    /// Per plane, the pixels predicted by the 3 × 3 in-plane offsets (row-major).
+    predicted: [[[i32; 2]; 9]; 3],
     proj: [[f32; 32]; 3],
     candidates: Vec<Triple>,
     /// Integrated sample offsets (`N × N`) and the first axis's path (`N`).
@@ -301,7 +331,8 @@ impl Scratch {
         let n = e.options.neighbourhood;
         Self {
             buf: vec![0.0; n * n * e.channels()],
-            offsets: vec![0; n * n],
+            offsets: vec![0; 3 * n * n],
+            predicted: [[[0; 2]; 9]; 3],
             proj: [[0.0; 32]; 3],
             candidates: Vec::with_capacity(64),
             path: vec![[0.0; 3]; n * n],
