@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
 //!  [DIR…] [--const DEG…] [--ideal DEG…] [--both] [--no-rosy-fix] [--free-flips]
-//!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid]
+//!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid] [--warp | --no-warp]
 //!  [--passes N] [--finest-passes N] [--coarse-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
 //!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--radius R] [--analysis-k K]
 //!  [--no-metrics]`
@@ -119,6 +119,8 @@ fn main() {
             "--no-rosy-fix" => opts.rosy_fix = false,
             "--coarse-passes" => opts.coarse_passes = Some(num(args.next(), &a)),
             "--no-trapezoid" => opts.trapezoid_frames = false,
+            "--warp" => opts.warped_corners = true,
+            "--no-warp" => opts.warped_corners = false,
             "--passes" => opts.correction_passes = num(args.next(), &a),
             "--finest-passes" => opts.finest_passes = Some(num(args.next(), &a)),
             "--jitter" => opts.jitter = num(args.next(), &a),

@@ -60,6 +60,7 @@ pub mod solid;
 pub mod synthesis_options;
 mod synthesis_subset;
 pub mod volume_synthesis;
+pub mod warped_neighbourhood;
 
 pub use characteristic_scale::{CharacteristicScale, characteristic_scale};
 pub use color_lookup::{ColorFilter, color_lookup};

@@ -80,6 +80,7 @@ use crate::level_tables::{LevelTables, NONE, tabulate};
 pub use crate::synthesis_options::SynthesisOptions;
 use crate::synthesis_options::{MAX_K, validate};
 use crate::synthesis_subset::SubsetPlan;
+use crate::warped_neighbourhood::{corner_map, inverse_frame, warped_corner};
 use crate::{SynthError, SynthesisDomain};
 
 /// Result of [`synthesize`]: per finest-level sample (row-major over
@@ -116,6 +117,9 @@ struct Pass<'a, const D: usize, const S: usize, const C: usize> {
     avx2: bool,
     /// [`SynthesisOptions::trapezoid_frames`] (with the 2-RoSy fix).
     trapezoid: bool,
+    /// [`SynthesisOptions::warped_corners`] (with the 2-RoSy fix): the appearance
+    /// images `[Ẽ₀, Ẽ₁]` the warped corners read.
+    warp: Option<[&'a [[i8; APPEARANCE_DIMS]]; 2]>,
 }
 
 impl<const D: usize, const S: usize, const C: usize> Pass<'_, D, S, C>
@@ -151,6 +155,9 @@ where
         // neighbour's effective offset h F(q) δ).
         let mut pred = [([0.0f32; 2], false, [0.0f32; 2]); S];
         let mut valid = [false; S];
+        // Corner maps of the warped reads (warped_neighbourhood.rs), per neighbour.
+        let jinv = self.warp.and_then(|_| inverse_frame(&jp));
+        let mut corner_maps = [None; S];
         for k in 0..S {
             let q = nb[k];
             if q == NONE {
@@ -174,6 +181,10 @@ where
                 let fpa = if alpha { negated(&jp) } else { jp };
                 fq = mean(&fq, &fpa);
             }
+            if let Some(ji) = &jinv {
+                let fpa = if alpha { negated(&jp) } else { jp };
+                corner_maps[k] = corner_map(&fq, &fpa, ji, h);
+            }
             let d = <Dim<D> as Stencil<D, S>>::OFFSETS[k];
             let off = mat_vec(&fq, d.map(|c| c as f32 * h));
             pred[k] = (ex.wrap([s[q][0] - off[0], s[q][1] - off[1]]), alpha, off);
@@ -195,7 +206,10 @@ where
                     continue;
                 }
                 let (u, a, _) = pred[t];
-                let v = &ex.nv[a as usize][ex.pixel(u)].0[lanes.clone()];
+                let v = match (&corner_maps[t], self.warp) {
+                    (Some(m), Some(app)) => &warped_corner(ex, app[a as usize], u, m, ci)[..],
+                    _ => &ex.nv[a as usize][ex.pixel(u)].0[lanes.clone()],
+                };
                 for (o, &x) in tc.iter_mut().zip(v) {
                     *o += x as i16;
                 }
@@ -540,6 +554,10 @@ where
             avx2,
             keep_flips: rosy && options.keep_flips,
             trapezoid: rosy && options.trapezoid_frames,
+            warp: (rosy && options.warped_corners).then(|| {
+                let d = &an.appearance_q.data;
+                [&d[0][..], &d[1][..]]
+            }),
         };
         let n_classes = tables.classes.len();
         for pass_index in 0..passes_of(level) {

@@ -50,6 +50,13 @@ pub struct SynthesisOptions {
     /// keeps `J(p)` and the parent's `J` (plain Lefebvre & Hoppe 2006).
     #[serde(default = "default_true")]
     pub trapezoid_frames: bool,
+    /// With [`Self::rosy_fix`], on 2-D domains: where the field curves, each corner of
+    /// the output's four-corner neighbourhood is read along its predicting neighbour's
+    /// frame (the corner offset turned from `p`'s frame to the neighbour segment's,
+    /// [`mod@crate::warped_neighbourhood`]) instead of in `p`'s own frame. Where the
+    /// field is constant the reads, and so the results, are unchanged.
+    #[serde(default)]
+    pub warped_corners: bool,
     /// Subpasses per correction pass: 4 (2×2 interleaving, Lefebvre & Hoppe 2005 §3.4)
     /// or 1 (all samples at once from the previous state). Default 4.
     pub subpasses: usize,
@@ -121,6 +128,7 @@ impl Default for SynthesisOptions {
             finest_passes: default_finest_passes(),
             coarse_passes: default_coarse_passes(),
             trapezoid_frames: true,
+            warped_corners: false,
             subpasses: 4,
             jitter: 0.4,
             unjittered_levels: default_unjittered_levels(),
