@@ -22,7 +22,7 @@ pub fn meridian(lon: f64, lat0: f64, lat1: f64, n: usize) -> Vec<V3> {
 }
 
 /// Scalar reference: locate every pixel centre, interpolate the vertex values.
-fn reference_pixels(d: &FieldDesign, f: &SolvedField, w: usize, h: usize) -> Vec<[f64; 2]> {
+pub fn reference_pixels(d: &FieldDesign, f: &SolvedField, w: usize, h: usize) -> Vec<[f64; 2]> {
     let zv = orientation_field::vertex_complex(d, f);
     let g = *d.plane().unwrap();
     (0..w * h)
