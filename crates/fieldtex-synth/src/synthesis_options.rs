@@ -55,6 +55,9 @@ pub struct SynthesisOptions {
     /// frame (the corner offset turned from `p`'s frame to the neighbour segment's,
     /// [`mod@crate::warped_neighbourhood`]) instead of in `p`'s own frame. Where the
     /// field is constant the reads, and so the results, are unchanged.
+    /// Default false: on bands-fingerprint-like whorl it left the guided coherence at
+    /// 0.000456 and raised the phase defects 757 → 858 (`examples/orient_probe --warp`,
+    /// seed 1; docs/real-exemplars.md).
     #[serde(default)]
     pub warped_corners: bool,
     /// Subpasses per correction pass: 4 (2×2 interleaving, Lefebvre & Hoppe 2005 §3.4)
