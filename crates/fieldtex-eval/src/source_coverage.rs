@@ -30,11 +30,10 @@
 //!
 //! The distances are exact: the squared Euclidean distance transform of Felzenszwalb &
 //! Huttenlocher (2012, "Distance transforms of sampled functions", Theory of Computing
-//! 8, §2, the lower envelope of parabolas), one pass per axis; on the torus each line is
-//! processed as three copies of itself and the middle copy kept, which is exact because
-//! the nearest periodic image of a source is at most half a period away.
+//! 8, §2), toroidal on a tiling exemplar (`fieldtex_features::distance_transform`).
 
 use crate::EvalError;
+use fieldtex_features::squared_distance_transform;
 use serde::Serialize;
 
 /// Options of [`source_coverage`].
@@ -170,124 +169,9 @@ pub fn source_coverage(
     })
 }
 
-/// Squared Euclidean distance from every pixel of a `w × h` grid to the nearest `true`
-/// of `site` (toroidal when `wrap`); `f64::INFINITY` everywhere when there is none.
-/// Separable (Felzenszwalb & Huttenlocher 2012): columns, then rows.
-pub fn squared_distance_transform(site: &[bool], w: usize, h: usize, wrap: bool) -> Vec<f64> {
-    let mut d: Vec<f64> = site.iter().map(|&s| if s { 0.0 } else { f64::INFINITY }).collect();
-    let mut line = Vec::with_capacity(w.max(h));
-    let mut out = Vec::with_capacity(w.max(h));
-    for x in 0..w {
-        line.clear();
-        line.extend((0..h).map(|y| d[y * w + x]));
-        lower_envelope_1d(&line, wrap, &mut out);
-        for y in 0..h {
-            d[y * w + x] = out[y];
-        }
-    }
-    for y in 0..h {
-        line.clear();
-        line.extend_from_slice(&d[y * w..(y + 1) * w]);
-        lower_envelope_1d(&line, wrap, &mut out);
-        d[y * w..(y + 1) * w].copy_from_slice(&out);
-    }
-    d
-}
-
-/// `out[q] = min_p (q − p)² + f[p]` (toroidal `q − p` when `wrap`), by the lower
-/// envelope of the parabolas rooted at the finite samples (Felzenszwalb & Huttenlocher
-/// 2012, Algorithm 1).
-fn lower_envelope_1d(f: &[f64], wrap: bool, out: &mut Vec<f64>) {
-    let n = f.len();
-    let copies = if wrap { 3 } else { 1 };
-    let m = n * copies;
-    // Parabola roots (positions in the tiled line) and the boundaries between them.
-    let mut roots: Vec<usize> = Vec::new();
-    let mut bounds: Vec<f64> = Vec::new();
-    let value = |p: usize| f[p % n];
-    for p in 0..m {
-        let fp = value(p);
-        if !fp.is_finite() {
-            continue;
-        }
-        loop {
-            let Some(&r) = roots.last() else { break };
-            // Where the parabola at p starts to lie below the one at r.
-            let s = ((fp + (p * p) as f64) - (value(r) + (r * r) as f64)) / (2.0 * (p - r) as f64);
-            if s <= *bounds.last().unwrap_or(&f64::NEG_INFINITY) {
-                roots.pop();
-                bounds.pop();
-            } else {
-                roots.push(p);
-                bounds.push(s);
-                break;
-            }
-        }
-        if roots.is_empty() {
-            roots.push(p);
-            bounds.push(f64::NEG_INFINITY);
-        }
-    }
-    out.clear();
-    if roots.is_empty() {
-        out.resize(n, f64::INFINITY);
-        return;
-    }
-    let offset = if wrap { n } else { 0 };
-    let mut k = 0;
-    for q in offset..offset + n {
-        while k + 1 < roots.len() && bounds[k + 1] < q as f64 {
-            k += 1;
-        }
-        let r = roots[k];
-        let dq = q as f64 - r as f64;
-        out.push(dq * dq + value(r));
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn brute(site: &[bool], w: usize, h: usize, wrap: bool) -> Vec<f64> {
-        let mut d = vec![f64::INFINITY; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                for sy in 0..h {
-                    for sx in 0..w {
-                        if !site[sy * w + sx] {
-                            continue;
-                        }
-                        let (mut dx, mut dy) = (x.abs_diff(sx), y.abs_diff(sy));
-                        if wrap {
-                            dx = dx.min(w - dx);
-                            dy = dy.min(h - dy);
-                        }
-                        d[y * w + x] = d[y * w + x].min((dx * dx + dy * dy) as f64);
-                    }
-                }
-            }
-        }
-        d
-    }
-
-    #[test]
-    fn distance_transform_equals_brute_force() {
-        for (w, h, density, seed) in [(17, 11, 0.05, 1), (9, 23, 0.2, 2), (13, 13, 0.01, 3)] {
-            let site: Vec<bool> = (0..w * h)
-                .map(|i| fieldtex_core::rng::hash_unit(seed, "dt", i as u64) < density)
-                .collect();
-            for wrap in [false, true] {
-                assert_eq!(
-                    squared_distance_transform(&site, w, h, wrap),
-                    brute(&site, w, h, wrap),
-                    "{w}×{h} wrap {wrap}"
-                );
-            }
-        }
-        let none = vec![false; 12];
-        assert!(squared_distance_transform(&none, 4, 3, true).iter().all(|v| v.is_infinite()));
-    }
 
     #[test]
     fn half_the_exemplar_is_half_covered() {

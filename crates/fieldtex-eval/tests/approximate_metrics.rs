@@ -9,7 +9,7 @@
 use fieldtex_eval::*;
 
 mod common;
-use common::{load, patchwork};
+use common::{TEST_EXEMPLARS, load, patchwork};
 
 /// Relative gap of the approximate means over the exact ones, on four exemplars: the
 /// search alone (every query) within the stated bound and never below the exact
@@ -20,12 +20,7 @@ fn approximate_coherence_and_completeness_stay_within_the_stated_bound() {
     let size = 128;
     let bound = fieldtex_eval::approximate_nearest_patch::ERROR_BOUND_PERCENT / 100.0;
     let mut worst_search: f64 = 0.0;
-    for name in [
-        "stripes_Fabric071.png",
-        "bricks_Bricks012.png",
-        "pebbles_Rocks002.png",
-        "bands-fingerprint-like_Onyx013.png",
-    ] {
+    for name in TEST_EXEMPLARS {
         let (ex, w, h) = load(name);
         let out = patchwork(&ex, w, h, size, 3);
         let o = ImageView::new(&out, size, size, 3).unwrap();
@@ -154,12 +149,7 @@ fn sampled_sliced_wasserstein_stays_within_the_stated_bound() {
         SAMPLED_ERROR_BOUND_ABS, SAMPLED_ERROR_BOUND_PERCENT, SAMPLED_PIXELS,
     };
     let size = 384;
-    for name in [
-        "stripes_Fabric071.png",
-        "bricks_Bricks012.png",
-        "pebbles_Rocks002.png",
-        "bands-fingerprint-like_Onyx013.png",
-    ] {
+    for name in TEST_EXEMPLARS {
         let (ex, w, h) = load(name);
         for shift in [0.0f32, 0.05] {
             let out: Vec<f32> =

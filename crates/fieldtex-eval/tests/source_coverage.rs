@@ -3,7 +3,7 @@
 //! stated in `fieldtex_eval::source_coverage`'s docs and `docs/perf/orient.md`.
 
 mod common;
-use common::{load, patchwork_with_coords};
+use common::{TEST_EXEMPLARS, load, patchwork_with_coords};
 use fieldtex_eval::*;
 
 /// A patchwork drawing its blocks from the whole exemplar against one drawing only from
@@ -12,12 +12,7 @@ use fieldtex_eval::*;
 #[test]
 fn coverage_and_search_completeness_agree_on_the_test_exemplars() {
     let size = 160;
-    for name in [
-        "stripes_Fabric071.png",
-        "bricks_Bricks012.png",
-        "pebbles_Rocks002.png",
-        "bands-fingerprint-like_Onyx013.png",
-    ] {
+    for name in TEST_EXEMPLARS {
         let (ex, w, h) = load(name);
         let e = ImageView::new(&ex, w, h, 3).unwrap();
         let exact = PatchDistanceOptions::default().with_wrap_exemplar(true);

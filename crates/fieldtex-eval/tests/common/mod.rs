@@ -2,6 +2,14 @@
 
 use std::path::Path;
 
+/// The four shared exemplars the approximate metrics are measured on.
+pub const TEST_EXEMPLARS: [&str; 4] = [
+    "stripes_Fabric071.png",
+    "bricks_Bricks012.png",
+    "pebbles_Rocks002.png",
+    "bands-fingerprint-like_Onyx013.png",
+];
+
 /// A shared test exemplar as interleaved RGB in [0, 1], with its width and height.
 pub fn load(name: &str) -> (Vec<f32>, usize, usize) {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/exemplars").join(name);
