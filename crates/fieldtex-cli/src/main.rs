@@ -128,6 +128,12 @@ enum Command {
         /// within a few per cent; see docs/first-hour.md); tens of seconds at 512².
         #[arg(long)]
         exact_metrics: bool,
+        /// Also the search-based completeness (nearest output patch of every exemplar
+        /// patch) beside the default source coverage read from the synthesis's own
+        /// exemplar coordinates (no search; see docs/first-hour.md). Implied by
+        /// --exact-metrics and by --mesh.
+        #[arg(long)]
+        search_completeness: bool,
         /// Mesh file (OBJ, PLY, STL, glTF/GLB) of a disk-topology patch; default: the
         /// plane. Parameterise it (LSCM), design the field on it and
         /// synthesise in parameter space; also writes model.glb. Plane designs and
@@ -416,6 +422,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             no_rosy_fix,
             no_metrics,
             exact_metrics,
+            search_completeness,
             mesh,
             patch,
             out,
@@ -438,6 +445,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             opts.rosy_fix = !no_rosy_fix;
             opts.metrics = !no_metrics;
             opts.exact_metrics = exact_metrics;
+            opts.search_completeness = search_completeness;
             opts.seed = g.seed;
             let model = if mesh.is_some() { "model.glb, " } else { "coords.npy, " };
             opts.mesh = mesh;

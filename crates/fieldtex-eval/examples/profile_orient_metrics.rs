@@ -1,7 +1,7 @@
 //! Times each metric of `fieldtex orient`'s default report on a real orient output:
 //! `profile_orient_metrics OUT_DIR EXEMPLAR.png [--exact]` where `OUT_DIR` holds the
 //! `texture.png` and `field.npy` of an orient run at the exemplar's own size (no
-//! reduction). Prints one `STAGE name ms` line per metric in the facade's order
+//! reduction; its `coords.npy` too, if present, for the source coverage). Prints one `STAGE name ms` line per metric in the facade's order
 //! (`crates/fieldtex/src/pipelines/eval.rs::image_metrics`, plus the exemplar's own
 //! orientation of `orient.rs`). Used for `docs/perf/orient.md`.
 
@@ -84,6 +84,18 @@ fn main() {
     if std::env::args().any(|s| s == "--split") {
         stage("  coherence only", || coherence(&ov, &ev, &popts).unwrap());
         stage("  completeness only", || completeness(&ov, &ev, &popts).unwrap());
+    }
+    // Orient's default completeness: the source coverage of its coords.npy (no search).
+    let coords_path = format!("{}/coords.npy", a[1]);
+    if std::path::Path::new(&coords_path).exists() {
+        let coords = npy(&coords_path);
+        let r = stage("source_coverage", || {
+            source_coverage(&coords, [ew, eh], &SourceCoverageOptions::default()).unwrap()
+        });
+        println!(
+            "source coverage {:.4} (copied {:.4}, mean distance {:.2} px, max {:.1} px)",
+            r.covered_share, r.copied_share, r.mean_distance_px, r.max_distance_px
+        );
     }
     let sw = stage("color_sliced_wasserstein", || {
         color_sliced_wasserstein(

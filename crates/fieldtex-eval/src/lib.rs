@@ -3,6 +3,8 @@
 //!
 //! - [`coherence()`] / [`completeness()`]: exact nearest-patch distances output → exemplar
 //!   and back, per pixel and channel;
+//! - [`source_coverage()`]: completeness from a synthesis's own exemplar coordinates
+//!   (share of exemplar patches it copies from), no search;
 //! - [`guided_coherence()`]: coherence with output patches taken in the local frame of a
 //!   direction field (field-guided synthesis);
 //! - [`color_sliced_wasserstein()`]: distance between colour distributions;
@@ -39,6 +41,7 @@ pub mod query_sampling;
 pub mod rosy_seam;
 pub mod seam_metrics;
 pub mod singularities;
+pub mod source_coverage;
 pub mod surface_metrics;
 pub mod transfer_fidelity;
 
@@ -74,6 +77,7 @@ pub use singularities::{
     ExpectedSingularity, Singularity, SingularityCluster, SingularityMatch, SingularityOptions,
     SingularityReport, match_singularities, singularities,
 };
+pub use source_coverage::{SourceCoverageOptions, SourceCoverageReport, source_coverage};
 pub use surface_metrics::{
     CurveSample, FeatureCoverageOptions, FeatureCoverageReport, SurfaceOrientationOptions,
     SurfaceOrientationReport, feature_line_coverage, surface_orientation_error,

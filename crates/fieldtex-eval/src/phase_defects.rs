@@ -287,30 +287,48 @@ pub fn phase_defects(
         if !bins.contains(&(b as u16)) {
             continue;
         }
-        // Row pass: complex T(x, y) = Σ hx(d) l0(x + d, y), only on the rows the column
-        // pass below reads (within the kernel's reach of a pixel of this bin).
-        let mut needed = vec![false; h];
+        // Row pass: complex T(x, y) = Σ hx(d) l0(x + d, y), only where the column pass
+        // below reads it: at (x, y') with a pixel of this bin in column x within the
+        // kernel's reach of row y'.
+        let mut needed = vec![false; w * h];
         for y in 0..h {
-            if bins[y * w..(y + 1) * w].iter().any(|&v| v as usize == b) {
-                for j in 0..hy.len() {
-                    needed[mirror(y as isize + j as isize - r, h)] = true;
+            for x in 0..w {
+                if bins[y * w + x] as usize == b {
+                    for j in 0..hy.len() {
+                        needed[mirror(y as isize + j as isize - r, h) * w + x] = true;
+                    }
                 }
             }
         }
         let mut tre = vec![0f32; w * h];
         let mut tim = vec![0f32; w * h];
         tre.par_chunks_mut(w).zip(tim.par_chunks_mut(w)).enumerate().for_each(|(y, (tr, ti))| {
-            if !needed[y] {
+            let need = &needed[y * w..(y + 1) * w];
+            if !need.contains(&true) {
                 return;
             }
             let padded = mirrored_row(&l0[y * w..(y + 1) * w], r as usize);
-            // Tap by tap over the whole row (vectorisable; each value sums its taps in
-            // kernel order from 0, as a per-pixel loop would).
-            for (j, &(hr, hi)) in hx.iter().enumerate() {
-                for ((a, c), &v) in tr.iter_mut().zip(ti.iter_mut()).zip(&padded[j..j + w]) {
-                    *a += hr * v;
-                    *c += hi * v;
+            // Tap by tap over each run of needed pixels (vectorisable; each value sums
+            // its taps in kernel order from 0, as a per-pixel loop would, so the values
+            // do not depend on the runs).
+            let mut x0 = 0;
+            while x0 < w {
+                if !need[x0] {
+                    x0 += 1;
+                    continue;
                 }
+                let x1 = need[x0..].iter().position(|&v| !v).map_or(w, |k| x0 + k);
+                for (j, &(hr, hi)) in hx.iter().enumerate() {
+                    for ((a, c), &v) in tr[x0..x1]
+                        .iter_mut()
+                        .zip(ti[x0..x1].iter_mut())
+                        .zip(&padded[j + x0..j + x1])
+                    {
+                        *a += hr * v;
+                        *c += hi * v;
+                    }
+                }
+                x0 = x1;
             }
         });
         // Column pass at the pixels of this bin: R = Σ hy(d) T(x, y + d).

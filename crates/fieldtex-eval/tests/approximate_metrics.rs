@@ -7,49 +7,9 @@
 //! seams do not.
 
 use fieldtex_eval::*;
-use std::path::Path;
 
-/// The four exemplars the bound tests run on (lines, cells, blobs, curved bands).
-const EXEMPLARS: [&str; 4] = [
-    "stripes_Fabric071.png",
-    "bricks_Bricks012.png",
-    "pebbles_Rocks002.png",
-    "bands-fingerprint-like_Onyx013.png",
-];
-
-fn load(name: &str) -> (Vec<f32>, usize, usize) {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/exemplars").join(name);
-    let im = image::open(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).to_rgb32f();
-    let (w, h) = (im.width() as usize, im.height() as usize);
-    (im.into_raw(), w, h)
-}
-
-fn patchwork(ex: &[f32], w: usize, h: usize, size: usize, seed: u64) -> Vec<f32> {
-    let mut out = vec![0f32; size * size * 3];
-    let block = 16;
-    for by in (0..size).step_by(block) {
-        for bx in (0..size).step_by(block) {
-            let k = (by / block * 1000 + bx / block) as u64;
-            let sx = (fieldtex_core::rng::hash_unit(seed, "pw-x", k) * w as f64) as usize;
-            let sy = (fieldtex_core::rng::hash_unit(seed, "pw-y", k) * h as f64) as usize;
-            for y in by..(by + block).min(size) {
-                for x in bx..(bx + block).min(size) {
-                    let (ex_x, ex_y) = ((sx + x - bx) % w, (sy + y - by) % h);
-                    for c in 0..3 {
-                        let n = 0.02
-                            * (fieldtex_core::rng::hash_unit(
-                                seed,
-                                "pw-n",
-                                ((y * size + x) * 3 + c) as u64,
-                            ) - 0.5) as f32;
-                        out[(y * size + x) * 3 + c] = ex[(ex_y * w + ex_x) * 3 + c] + n;
-                    }
-                }
-            }
-        }
-    }
-    out
-}
+mod common;
+use common::{TEST_EXEMPLARS, load, patchwork};
 
 /// Relative gap of the approximate means over the exact ones, on four exemplars: the
 /// search alone (every query) within the stated bound and never below the exact
@@ -60,7 +20,7 @@ fn approximate_coherence_and_completeness_stay_within_the_stated_bound() {
     let size = 128;
     let bound = fieldtex_eval::approximate_nearest_patch::ERROR_BOUND_PERCENT / 100.0;
     let mut worst_search: f64 = 0.0;
-    for name in EXEMPLARS {
+    for name in TEST_EXEMPLARS {
         let (ex, w, h) = load(name);
         let out = patchwork(&ex, w, h, size, 3);
         let o = ImageView::new(&out, size, size, 3).unwrap();
@@ -183,7 +143,7 @@ fn sampled_sliced_wasserstein_stays_within_the_stated_bound() {
         SAMPLED_ERROR_BOUND_ABS, SAMPLED_ERROR_BOUND_PERCENT, SAMPLED_PIXELS,
     };
     let size = 384;
-    for name in EXEMPLARS {
+    for name in TEST_EXEMPLARS {
         let (ex, w, h) = load(name);
         for shift in [0.0f32, 0.05] {
             let out: Vec<f32> =

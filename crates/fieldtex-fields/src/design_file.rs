@@ -347,6 +347,23 @@ impl DesignFile {
     /// Builds and factors the design, then adds its singularities and strokes. A mesh
     /// design needs `mesh`; a plane design ignores it.
     pub fn build(&self, mesh: Option<TriMesh>) -> Result<FieldDesign, FieldsError> {
+        self.build_with(mesh, self.options())
+    }
+
+    /// [`DesignFile::build`] for a design that is solved once and never edited (the
+    /// CLI's plane `orient`): `rank1_update_limit = 0`, so the factorisation keeps no
+    /// checkpoint copy for later stroke edits ([`crate::design_factor`]). The factor,
+    /// the solve and so the field are bit-identical to [`DesignFile::build`]'s; only
+    /// the copy's time and memory are saved.
+    pub fn build_once(&self, mesh: Option<TriMesh>) -> Result<FieldDesign, FieldsError> {
+        self.build_with(mesh, self.options().with_rank1_update_limit(0))
+    }
+
+    fn build_with(
+        &self,
+        mesh: Option<TriMesh>,
+        options: FieldDesignOptions,
+    ) -> Result<FieldDesign, FieldsError> {
         self.validate()?;
         let domain = match self.domain.kind {
             DomainKind::Plane => Domain::Plane(self.plane_grid().expect("validated")),
@@ -354,7 +371,7 @@ impl DesignFile {
                 bad("[domain] kind = \"mesh\" needs a mesh (pass --mesh PATCH)".into())
             })?),
         };
-        let mut design = FieldDesign::new(domain, self.symmetry()?, self.options())?;
+        let mut design = FieldDesign::new(domain, self.symmetry()?, options)?;
         for s in self.singularity_list()? {
             design.add_singularity(s)?;
         }

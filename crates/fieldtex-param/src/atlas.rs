@@ -18,7 +18,7 @@ use crate::distortion::parameterization_distortion;
 use crate::face_graph::FaceGraph;
 use crate::lscm::{flattening_defects, lscm, planar_projection};
 use crate::min_area_rectangle::min_area_rectangle_angle;
-use crate::packing::{PackChart, PackingOptions, SEQUENTIAL_BELOW_TRIANGLES, pack_charts};
+use crate::packing::{PackChart, PackingOptions, pack_charts};
 use fieldtex_core::{Progress, Warning, Warnings};
 use fieldtex_mesh::{CornerUvs, MeshError, TriMesh};
 use rayon::prelude::*;
@@ -194,19 +194,13 @@ pub fn build_atlas(
     progress.finish_stage();
 
     progress.stage("atlas: flattening charts", mesh.n_triangles() as u64);
-    // Small meshes: a few charts of a few hundred triangles each, less work than
-    // waking the thread pool (the result is the same either way).
-    let sequential = mesh.n_triangles() < SEQUENTIAL_BELOW_TRIANGLES;
     let mut work = seg.charts;
     let mut done: Vec<FlatChart> = Vec::new();
     let mut unresolved = 0usize;
     while !work.is_empty() {
         let batch = std::mem::take(&mut work);
-        let results: Vec<Flattened> = if sequential {
-            batch.into_iter().map(|f| flatten(f, mesh, &graph)).collect()
-        } else {
-            batch.into_par_iter().map(|f| flatten(f, mesh, &graph)).collect()
-        };
+        let results: Vec<Flattened> =
+            batch.into_par_iter().map(|f| flatten(f, mesh, &graph)).collect();
         for r in results {
             match r {
                 Flattened::Done(fc, bad) => {
@@ -250,11 +244,7 @@ pub fn build_atlas(
             .collect();
         PackChart { points, triangles: fc.chart.corners.clone(), simple_outline: fc.clean }
     };
-    let pack_charts_in: Vec<PackChart> = if sequential {
-        done.iter().map(prepare).collect()
-    } else {
-        done.par_iter().map(prepare).collect()
-    };
+    let pack_charts_in: Vec<PackChart> = done.par_iter().map(prepare).collect();
     let packing = pack_charts(&pack_charts_in, &pack_opts)?;
     progress.finish_stage();
 

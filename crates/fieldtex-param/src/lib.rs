@@ -44,6 +44,7 @@ pub mod lscm;
 pub mod min_area_rectangle;
 pub mod packing;
 mod packing_grid;
+mod packing_scale_search;
 mod planar_units;
 pub mod raster;
 pub mod texel_map;

@@ -27,7 +27,7 @@
 //! height it used; the height grows roughly like the square of the scale, which gives
 //! the next guess, and the bracket between the best fitting and the smallest failing
 //! scale is then narrowed with three trial scales per round, evaluated in parallel
-//! (one after the other for inputs under `SEQUENTIAL_BELOW_TRIANGLES` triangles).
+//! (module `packing_scale_search`).
 //! The search runs first on cells twice as large (a quarter of the work per trial)
 //! and then, from just above the scale found there, for at most three rounds on the
 //! final cells; the coarse packing is valid as it stands and is kept if no finer one
@@ -55,6 +55,7 @@
 use crate::ParamError;
 use crate::chart_footprint::{Footprint, Grown};
 use crate::packing_grid::Grid;
+use crate::packing_scale_search::{Search, SearchState, search_scale};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -162,19 +163,13 @@ pub const SMALL_INPUT_CHART_SIDE: f64 = 256.0;
 /// cells then refine it; 0.01 elsewhere).
 const SMALL_INPUT_COARSE_TOLERANCE: f64 = 0.03;
 
-/// Inputs with fewer triangles than this (all charts together) run their trial
-/// packings one after the other on the calling thread: a trial takes a fraction of a
-/// millisecond there, less than handing it to the thread pool costs (results do not
-/// depend on it). The atlas flattens such meshes on the calling thread too.
-pub(crate) const SEQUENTIAL_BELOW_TRIANGLES: usize = 4096;
-
 /// Footprints of at most this many cells are remembered per shape within a trial (the
 /// lowest row still worth testing; this only skips rows that cannot fit, so results
 /// are the same with or without it).
 const SHAPE_CACHE_CELLS: i64 = 4096;
 
 /// Offset of chart points inside their footprint, in texels (keeps columns ≥ 0).
-const INSET: f64 = 0.5;
+pub(crate) const INSET: f64 = 0.5;
 /// Rasterisation margin of the packer, in texels (covers rounding in later steps).
 const PACK_EPS: f64 = 1e-3;
 
@@ -203,22 +198,22 @@ impl Packing {
 }
 
 /// A packing at one scale: placements and the top row used (exclusive).
-struct Trial {
-    placements: Vec<Placement>,
-    top: i64,
+pub(crate) struct Trial {
+    pub(crate) placements: Vec<Placement>,
+    pub(crate) top: i64,
 }
 
 /// The packing grid of one trial: `k × k`-texel cells.
 #[derive(Debug, Clone, Copy)]
-struct CellGrid {
+pub(crate) struct CellGrid {
     /// Texels per cell side.
-    k: i64,
+    pub(crate) k: i64,
     /// Cells per atlas side.
-    size: i64,
+    pub(crate) size: i64,
     /// Gutter radius in cells (see the module docs).
     gutter: f64,
     /// Free cells along the border.
-    margin: i64,
+    pub(crate) margin: i64,
 }
 
 impl CellGrid {
@@ -234,7 +229,7 @@ impl CellGrid {
 
 /// Packs all charts at scale `scale` (texels per unit) into a grid twice as tall as
 /// the atlas; `None` when a chart is wider than the atlas or the grid overflows.
-fn try_pack(
+pub(crate) fn try_pack(
     charts: &[PackChart],
     outlines: &[Option<Vec<[u32; 2]>>],
     origins: &[[f64; 2]],
@@ -417,8 +412,6 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
     } else {
         vec![(fine, tol, 40)]
     };
-    let parallel =
-        charts.iter().map(|c| c.triangles.len()).sum::<usize>() >= SEQUENTIAL_BELOW_TRIANGLES;
     for (k, &(cells, stage_tol, rounds)) in stages.iter().enumerate() {
         if k > 0
             && let Some(lo) = &state.lo
@@ -428,7 +421,7 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
         }
         let search =
             Search { charts, outlines: &outlines, origins: &origins, order: &order, options };
-        search_scale(&search, cells, &mut state, stage_tol, rounds, parallel);
+        search_scale(&search, cells, &mut state, stage_tol, rounds);
     }
     let Some(found) = state.lo else { return Err(fail(state.guess)) };
     if found.scale < upper * 1e-9 {
@@ -441,104 +434,6 @@ pub fn pack_charts(charts: &[PackChart], options: &PackingOptions) -> Result<Pac
         placements: found.placements,
         inset: found.inset,
     })
-}
-
-/// The inputs every trial of a scale search packs.
-#[derive(Clone, Copy)]
-struct Search<'a> {
-    charts: &'a [PackChart],
-    outlines: &'a [Option<Vec<[u32; 2]>>],
-    origins: &'a [[f64; 2]],
-    order: &'a [usize],
-    options: &'a PackingOptions,
-}
-
-/// The best packing found so far.
-struct Found {
-    scale: f64,
-    placements: Vec<Placement>,
-    inset: f64,
-}
-
-/// Scale search state: `lo` fits, `hi` does not (or is the upper bound).
-struct SearchState {
-    lo: Option<Found>,
-    hi: f64,
-    guess: f64,
-}
-
-/// Narrows the scale on `cells` until `hi ≤ lo·(1 + tol)` or `max_rounds` rounds.
-/// Each trial's packing height h(s) ∝ s² roughly, so `s·√(limit / h)` estimates the
-/// best scale.
-fn search_scale(
-    search: &Search,
-    cells: CellGrid,
-    st: &mut SearchState,
-    tol: f64,
-    max_rounds: usize,
-    parallel: bool,
-) {
-    let Search { charts, outlines, origins, order, options } = *search;
-    let limit = (cells.size - cells.margin) as f64;
-    let upper = st.hi;
-    for _round in 0..max_rounds {
-        let lo_s = st.lo.as_ref().map_or(0.0, |l| l.scale);
-        if st.lo.is_some() && st.hi <= lo_s * (1.0 + tol) {
-            break;
-        }
-        let trials: Vec<f64> = if st.lo.is_some() && st.hi <= lo_s * 1.05 {
-            let r = st.hi / lo_s;
-            (1..=3).map(|k| lo_s * r.powf(k as f64 / 4.0)).collect()
-        } else {
-            let c = st.guess.min(st.hi / (1.0 + 0.25 * tol)).max(lo_s * (1.0 + 0.25 * tol));
-            [c, c * 0.99, c * 0.98].into_iter().filter(|&t| t > lo_s && t < st.hi).collect()
-        };
-        if trials.is_empty() {
-            break;
-        }
-        let run = |&t: &f64| try_pack(charts, outlines, origins, order, t, options, cells);
-        let results: Vec<Option<Trial>> = if parallel {
-            trials.par_iter().map(run).collect()
-        } else {
-            trials.iter().map(run).collect()
-        };
-        let mut estimate: Option<f64> = None;
-        let mut smallest_failed: Option<f64> = None;
-        for (&t, r) in trials.iter().zip(results) {
-            match r {
-                Some(trial) if trial.top as f64 <= limit => {
-                    if t > st.lo.as_ref().map_or(0.0, |l| l.scale) {
-                        let est = t * (limit / trial.top.max(1) as f64).sqrt();
-                        estimate = Some(estimate.map_or(est, |e: f64| e.max(est)));
-                        st.lo = Some(Found {
-                            scale: t,
-                            placements: trial.placements,
-                            inset: cells.k as f64 * INSET,
-                        });
-                    }
-                }
-                Some(trial) => {
-                    st.hi = st.hi.min(t);
-                    if st.lo.is_none() {
-                        let est = t * (limit / trial.top as f64).sqrt() * 0.995;
-                        estimate = Some(estimate.map_or(est, |e: f64| e.min(est)));
-                    }
-                }
-                None => {
-                    st.hi = st.hi.min(t);
-                    smallest_failed = Some(smallest_failed.map_or(t, |m: f64| m.min(t)));
-                }
-            }
-        }
-        st.guess = match (estimate, smallest_failed) {
-            (Some(e), _) => e,
-            (None, Some(m)) => m * 0.6,
-            (None, None) => st.guess,
-        };
-        if st.lo.is_none() && st.guess < upper * 1e-9 {
-            return;
-        }
-    }
 }
 
 #[cfg(test)]

@@ -24,7 +24,14 @@ pub struct ImageMetrics {
     /// (`fieldtex_eval::guided_coherence`, default stride 8); only with a field.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub guided_coherence: Option<ev::GuidedCoherenceReport>,
-    pub completeness: ev::PatchDistanceReport,
+    /// The search-based completeness (nearest output patch of each exemplar patch);
+    /// absent where `source_coverage` stands for it (orient's default).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub completeness: Option<ev::PatchDistanceReport>,
+    /// Completeness read from the synthesis's own exemplar coordinates, no search
+    /// (`fieldtex_eval::source_coverage`): only with a coordinate map (`orient`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub source_coverage: Option<ev::SourceCoverageReport>,
     pub color_sliced_wasserstein: ev::SlicedWassersteinReport,
     pub orientation_error: Option<ev::OrientationErrorReport>,
     /// ±1/2 singularities of the output's own orientation (structure tensor).
@@ -52,6 +59,15 @@ pub struct SingularitySummary {
     pub positions: Vec<(f64, f64, f64)>,
 }
 
+/// A synthesis's exemplar coordinates, for [`image_metrics`]'s source coverage.
+pub(crate) struct SourceCoordinates<'a> {
+    /// `H×W×2` exemplar coordinates `(x, y)` of the output, in pixels of the exemplar
+    /// passed to [`image_metrics`] (orient's `coords.npy`).
+    pub coords: &'a [f32],
+    /// Also the search-based completeness.
+    pub search_too: bool,
+}
+
 pub(crate) fn bad(e: ev::EvalError, what: &Path) -> Error {
     Error::classify(&e, Some(what), "")
 }
@@ -59,6 +75,8 @@ pub(crate) fn bad(e: ev::EvalError, what: &Path) -> Error {
 /// Computes every metric; `field` is `H×W×2` of the output's size when present.
 /// `exemplar_angle_deg` is the exemplar's own stripe direction for the orientation error
 /// (the texture is expected at field angle + this; 0 = stripes along the exemplar's x).
+/// With `sources` (the output's exemplar coordinates) completeness is their source
+/// coverage, and the search-based completeness is computed only if asked for.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn image_metrics(
     output: &Image,
@@ -66,6 +84,7 @@ pub(crate) fn image_metrics(
     field: Option<&[f32]>,
     angle_deg: Option<f64>,
     exemplar_angle_deg: f64,
+    sources: Option<SourceCoordinates>,
     seed: u64,
     exact: bool,
     progress: &dyn Progress,
@@ -99,9 +118,14 @@ pub(crate) fn image_metrics(
     // with serial parts (tree building, period estimate, merging), which overlap on
     // few cores. Each metric is deterministic on its own; the results are assembled
     // in a fixed order.
+    let search_completeness = sources.as_ref().is_none_or(|s| s.search_too);
     let (pair, rest) = rayon::join(
         || {
-            let r = ev::coherence_and_completeness(&o, &e, &popts);
+            let r = if search_completeness {
+                ev::coherence_and_completeness(&o, &e, &popts).map(|(c, p)| (c, Some(p)))
+            } else {
+                ev::coherence(&o, &e, &popts).map(|c| (c, None))
+            };
             progress.advance(2);
             r
         },
@@ -116,11 +140,26 @@ pub(crate) fn image_metrics(
         phase_defects,
         skipped,
     ) = rest?;
+    let source_coverage = match &sources {
+        Some(s) => {
+            let opts =
+                ev::SourceCoverageOptions { patch_size: popts.patch_size, ..Default::default() };
+            Some(ev::source_coverage(s.coords, [exemplar.width, exemplar.height], &opts)?)
+        }
+        None => None,
+    };
     drop(stage);
+    let coverage_note = if source_coverage.is_some() && completeness.is_none() {
+        "; completeness is source_coverage, read from the synthesis's exemplar coordinates \
+         without a search (docs/first-hour.md; --search-completeness adds the search-based one)"
+    } else {
+        ""
+    };
     Ok(ImageMetrics {
         coherence,
         guided_coherence,
         completeness,
+        source_coverage,
         color_sliced_wasserstein,
         orientation_error,
         singularities,
@@ -130,7 +169,7 @@ pub(crate) fn image_metrics(
         search: if exact {
             "exact: exhaustive nearest-patch searches".into()
         } else {
-            format!(
+            let search = format!(
                 "approximate: coherence, completeness and guided_coherence use the approximate \
                  nearest-patch search (one PCA basis for both images, k-d trees searched \
                  with a bounded budget, coherent candidates); coherence and completeness \
@@ -147,7 +186,8 @@ pub(crate) fn image_metrics(
                 ev::color_sliced_wasserstein::SAMPLED_PIXELS,
                 ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_ABS,
                 ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_PERCENT,
-            )
+            );
+            search + coverage_note
         },
     })
 }
@@ -346,16 +386,17 @@ pub fn eval_files(
             Some(r)
         }
     };
-    let mut metrics = image_metrics(&out, &ex, field.as_deref(), angle, 0.0, seed, exact, progress)
-        .map_err(|e| {
-            let about_exemplar = match &e {
-                ev::EvalError::TooSmall { what, .. }
-                | ev::EvalError::NonFinite { what, .. }
-                | ev::EvalError::BufferSize { what, .. } => what.starts_with("exemplar"),
-                _ => false,
-            };
-            bad(e, if about_exemplar { exemplar } else { image })
-        })?;
+    let mut metrics =
+        image_metrics(&out, &ex, field.as_deref(), angle, 0.0, None, seed, exact, progress)
+            .map_err(|e| {
+                let about_exemplar = match &e {
+                    ev::EvalError::TooSmall { what, .. }
+                    | ev::EvalError::NonFinite { what, .. }
+                    | ev::EvalError::BufferSize { what, .. } => what.starts_with("exemplar"),
+                    _ => false,
+                };
+                bad(e, if about_exemplar { exemplar } else { image })
+            })?;
     metrics.rosy_seam = seam;
     Ok(metrics)
 }

@@ -59,6 +59,11 @@ pub struct OrientOptions {
     /// Exact (exhaustive) nearest-patch searches in the metrics instead of the
     /// approximate ones (`--exact-metrics`; tens of seconds at 512²). Default false.
     pub exact_metrics: bool,
+    /// Also the search-based completeness beside the source coverage (completeness read
+    /// from the synthesis's exemplar coordinates, `fieldtex_eval::source_coverage`,
+    /// the default on the plane). Implied by `exact_metrics`; a mesh patch always uses
+    /// the search. Default false.
+    pub search_completeness: bool,
 }
 
 impl OrientOptions {
@@ -82,6 +87,7 @@ impl OrientOptions {
             patch: None,
             metrics: true,
             exact_metrics: false,
+            search_completeness: false,
         }
     }
 }
@@ -140,7 +146,7 @@ fn build_field(
         _ => None,
     };
     let mut fd = report
-        .time("field_factor", || design.build(None))
+        .time("field_factor", || design.build_once(None))
         .map_err(|e| Error::classify(&e, src, ""))?;
     let solved = report
         .time("field_solve", || fd.solve())
@@ -263,8 +269,16 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     report.metric("designed_singularities", &designed);
     if options.metrics {
         let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-        let (mut metrics, _) =
-            texture_metrics(&mut report, synth, &exemplar, &flat, &pts, options, progress)?;
+        let (mut metrics, _) = texture_metrics(
+            &mut report,
+            synth,
+            &exemplar,
+            &flat,
+            Some(&coords[..]),
+            &pts,
+            options,
+            progress,
+        )?;
         metrics.rosy_seam =
             Some(seam_metric(&coords, &flat, &result.flips, n, &exemplar, per_pixel)?);
         report.metric("texture", &metrics);
@@ -299,9 +313,17 @@ pub(crate) fn orient_in_memory(
     report.metric("designed_singularities", &designed);
     if options.metrics {
         let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-        let (mut metrics, _) =
-            texture_metrics(report, synth, exemplar, &flat, &pts, options, progress)?;
         let coords: Vec<f32> = result.coords.iter().flat_map(|c| [c[0], c[1]]).collect();
+        let (mut metrics, _) = texture_metrics(
+            report,
+            synth,
+            exemplar,
+            &flat,
+            Some(&coords[..]),
+            &pts,
+            options,
+            progress,
+        )?;
         metrics.rosy_seam =
             Some(seam_metric(&coords, &flat, &result.flips, n, exemplar, per_pixel)?);
         report.metric("texture", &metrics);
@@ -340,12 +362,17 @@ fn seam_metric(
 /// turned by the exemplar's own stripe direction, which is reported as
 /// `exemplar_orientation` (as `align` measures on surfaces; 0 when the exemplar has no
 /// measurable orientation), plus the phase defects within 3 exemplar periods of the
-/// designed singularities `points`. Returns the metrics and that direction in degrees.
+/// designed singularities `points`. With the synthesis's exemplar coordinates `coords`
+/// (`H×W×2`, pixels of `exemplar`), completeness is their source coverage (no search)
+/// unless `options` asks for the search too. Returns the metrics and that direction in
+/// degrees.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn texture_metrics(
     report: &mut Report,
     texture: &Image,
     exemplar: &Image,
     flat: &[f32],
+    coords: Option<&[f32]>,
     points: &[[f64; 2]],
     options: &OrientOptions,
     progress: &dyn Progress,
@@ -358,7 +385,21 @@ pub(crate) fn texture_metrics(
     }
     let metrics = report
         .stage(progress, "metrics", || {
-            image_metrics(texture, exemplar, Some(flat), None, angle, seed, exact, progress)
+            let sources = coords.map(|coords| super::eval::SourceCoordinates {
+                coords,
+                search_too: exact || options.search_completeness,
+            });
+            image_metrics(
+                texture,
+                exemplar,
+                Some(flat),
+                None,
+                angle,
+                sources,
+                seed,
+                exact,
+                progress,
+            )
         })
         .map_err(|e| Error::internal("metrics", e))?;
     if let Some(pd) = &metrics.phase_defects {

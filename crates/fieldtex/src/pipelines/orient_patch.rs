@@ -182,6 +182,7 @@ pub(crate) fn orient_patch(
             &texture,
             &exemplar,
             &flat,
+            None,
             &pts,
             options,
             progress,
