@@ -212,6 +212,7 @@ impl GeometryImage {
             paired[b as usize] = true;
         }
         let mut seam_pairs: Vec<(u32, u32)> = Vec::new();
+        let mut near_of = vec![u32::MAX; width * height];
         for (f, shift, cu) in &ghost_corners {
             let ghost = cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]);
             let (dx, dy) = (shift[0] * sx, -shift[1] * sy);
@@ -224,7 +225,15 @@ impl GeometryImage {
                 if !real[i] || i == j || contains(&ghost, centre) {
                     return;
                 }
+                // A near texel that is itself the far end of a pair passes on its own near
+                // texel, so pairs never chain and one copy pass settles them.
+                let i = if near_of[i] != u32::MAX { near_of[i] as usize } else { i };
+                if i == j {
+                    return;
+                }
+                near_of[j] = i as u32;
                 paired[j] = true;
+                paired[i] = true;
                 links.push((i as u32, j as u32));
                 links.push((j as u32, i as u32));
                 seam_pairs.push((j as u32, i as u32));
