@@ -161,10 +161,10 @@ impl GeometryImage {
                 (!face_lambda[f].is_nan()).then(|| [1.0 / face_lambda[f]; 3])
             }
         };
-        for f in 0..nf {
+        for (f, ct) in corner_texel.iter().enumerate() {
             let Some(tv) = corner_tau(f) else { continue };
             for sh in &shifts {
-                let t = corner_texel[f].map(|p| [p[0] + sh[0], p[1] + sh[1]]);
+                let t = ct.map(|p| [p[0] + sh[0], p[1] + sh[1]]);
                 let det = doubled_area(&t);
                 if det.abs() <= 0.0 {
                     continue;
