@@ -94,19 +94,13 @@ mod tests {
     fn doubled_annulus_is_a_closed_torus() {
         // A grid with a square hole is an annulus (g = 0, b = 2): its double is a torus.
         let grid = primitives::grid(9, 9, 1.0, 1.0);
-        let keep: Vec<[u32; 3]> = grid
-            .triangles
-            .iter()
-            .copied()
-            .filter(|t| {
-                let c = t.iter().fold([0.0; 2], |c, &v| {
-                    let p = grid.positions[v as usize];
-                    [c[0] + p[0] / 3.0, c[1] + p[1] / 3.0]
-                });
-                !((0.35..0.65).contains(&c[0]) && (0.35..0.65).contains(&c[1]))
-            })
-            .collect();
-        let annulus = TriMesh::new(grid.positions.clone(), keep);
+        let annulus = super::super::tests::keep_faces(&grid, |_, t| {
+            let c = t.iter().fold([0.0; 2], |c, &v| {
+                let p = grid.positions[v as usize];
+                [c[0] + p[0] / 3.0, c[1] + p[1] / 3.0]
+            });
+            !((0.35..0.65).contains(&c[0]) && (0.35..0.65).contains(&c[1]))
+        });
         let d = double_cover(&annulus);
         let topo = Topology::build(d.mesh.n_vertices(), &d.mesh.triangles);
         assert!((0..topo.n_edges()).all(|e| topo.edge_faces(e).len() == 2), "not closed");

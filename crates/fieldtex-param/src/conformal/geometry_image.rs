@@ -44,6 +44,10 @@ pub struct GeometryImage {
     pub links: Vec<(u32, u32)>,
     /// `(margin texel, texel it continues, face)` for every ghost-drawn margin texel.
     pub margin_copies: Vec<(u32, u32, u32)>,
+    /// `(far texel, near texel)`: real texels on the two sides of a cut that show points
+    /// less than a texel apart but that no ghost texel links (the cut passes between
+    /// their centres); also in [`Self::links`].
+    pub seam_pairs: Vec<(u32, u32)>,
 }
 
 impl GeometryImage {
@@ -147,44 +151,25 @@ impl GeometryImage {
             shifts.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
             shifts.dedup();
         }
-        for f in 0..nf {
+        // Per-corner τ of a face: its vertices' values, or the face's own when a vertex
+        // has none; `None` without either.
+        let corner_tau = |f: usize| {
             let tv = mesh.triangles[f].map(|v| vtau[v as usize]);
-            let tv = if tv.iter().any(|t| t.is_nan()) {
-                let fl = face_lambda[f];
-                if fl.is_nan() {
-                    continue;
-                }
-                [1.0 / fl; 3]
+            if !tv.iter().any(|t| t.is_nan()) {
+                Some(tv)
             } else {
-                tv
-            };
+                (!face_lambda[f].is_nan()).then(|| [1.0 / face_lambda[f]; 3])
+            }
+        };
+        for (f, ct) in corner_texel.iter().enumerate() {
+            let Some(tv) = corner_tau(f) else { continue };
             for sh in &shifts {
-                let t = corner_texel[f].map(|p| [p[0] + sh[0], p[1] + sh[1]]);
-                let det = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
-                    - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]);
+                let t = ct.map(|p| [p[0] + sh[0], p[1] + sh[1]]);
+                let det = doubled_area(&t);
                 if det.abs() <= 0.0 {
                     continue;
                 }
-                triangle_row_spans(t, 0.0, |row, c0, c1| {
-                    if row < 0 || row >= height as i64 {
-                        return;
-                    }
-                    let py = row as f64 + 0.5;
-                    for col in c0.max(0)..=c1.min(width as i64 - 1) {
-                        let px = col as f64 + 0.5;
-                        let l1 = ((px - t[0][0]) * (t[2][1] - t[0][1])
-                            - (py - t[0][1]) * (t[2][0] - t[0][0]))
-                            / det;
-                        let l2 = ((t[1][0] - t[0][0]) * (py - t[0][1])
-                            - (t[1][1] - t[0][1]) * (px - t[0][0]))
-                            / det;
-                        let (l1, l2) = (l1.clamp(0.0, 1.0), l2.clamp(0.0, 1.0));
-                        let l0 = (1.0 - l1 - l2).max(0.0);
-                        let sum = l0 + l1 + l2;
-                        tau[row as usize * width + col as usize] =
-                            ((l0 * tv[0] + l1 * tv[1] + l2 * tv[2]) / sum) as f32;
-                    }
-                });
+                for_texels(t, width, height, |i, p| tau[i] = interpolate(&t, det, p, tv));
             }
         }
         // Ghosts fill uncovered margin texels and link them to the texels they continue.
@@ -193,55 +178,65 @@ impl GeometryImage {
         let real: Vec<bool> = tau.iter().map(|t| !t.is_nan()).collect();
         for (f, shift, cu) in &ghost_corners {
             let f = *f;
-            let fl = face_lambda[f];
-            let tv = mesh.triangles[f].map(|v| vtau[v as usize]);
-            let tv = if tv.iter().any(|t| t.is_nan()) {
-                if fl.is_nan() {
-                    continue;
-                }
-                [1.0 / fl; 3]
-            } else {
-                tv
-            };
+            let Some(tv) = corner_tau(f) else { continue };
             let t = cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]);
             let (dx, dy) = (shift[0] * sx, -shift[1] * sy);
-            let det = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
-                - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]);
+            let det = doubled_area(&t);
             if det.abs() <= 0.0 {
                 continue;
             }
-            triangle_row_spans(t, 0.0, |row, c0, c1| {
-                if row < 0 || row >= height as i64 {
+            for_texels(t, width, height, |i, p| {
+                if !tau[i].is_nan() {
                     return;
                 }
-                let py = row as f64 + 0.5;
-                for col in c0.max(0)..=c1.min(width as i64 - 1) {
-                    let i = row as usize * width + col as usize;
-                    if !tau[i].is_nan() {
-                        continue;
-                    }
-                    let px = col as f64 + 0.5;
-                    let (qx, qy) = ((px + dx).floor(), (py + dy).floor());
-                    if qx < 0.0 || qy < 0.0 || qx >= width as f64 || qy >= height as f64 {
-                        continue;
-                    }
-                    let j = qy as usize * width + qx as usize;
-                    if !real[j] {
-                        continue; // rounding landed off the surface: leave it free
-                    }
-                    let l1 = ((px - t[0][0]) * (t[2][1] - t[0][1])
-                        - (py - t[0][1]) * (t[2][0] - t[0][0]))
-                        / det;
-                    let l2 = ((t[1][0] - t[0][0]) * (py - t[0][1])
-                        - (t[1][1] - t[0][1]) * (px - t[0][0]))
-                        / det;
-                    let (l1, l2) = (l1.clamp(0.0, 1.0), l2.clamp(0.0, 1.0));
-                    let l0 = (1.0 - l1 - l2).max(0.0);
-                    tau[i] = ((l0 * tv[0] + l1 * tv[1] + l2 * tv[2]) / (l0 + l1 + l2)) as f32;
-                    links.push((i as u32, j as u32));
-                    links.push((j as u32, i as u32));
-                    margin_copies.push((i as u32, j as u32, f as u32));
+                let Some(j) = texel_at([p[0] + dx, p[1] + dy], width, height) else { return };
+                if !real[j] {
+                    return; // rounding landed off the surface: leave it free
                 }
+                tau[i] = interpolate(&t, det, p, tv);
+                links.push((i as u32, j as u32));
+                links.push((j as u32, i as u32));
+                margin_copies.push((i as u32, j as u32, f as u32));
+            });
+        }
+        // The far side of each cut: a real texel of a ghost's face whose centre, moved back
+        // by the cut's translation, falls in a texel that is *real* on the near side (the
+        // cut passes between the two centres) has no ghost texel pointing at it, so it
+        // would be synthesised on its own right at the cut. It is paired with that near
+        // texel instead (both are real; they show points less than one texel apart). The
+        // near texel must lie outside the ghost triangle: one inside it belongs to another
+        // chart the ghost overlaps, not to the cut.
+        let mut paired = vec![false; width * height];
+        for &(a, b) in &links {
+            paired[a as usize] = true;
+            paired[b as usize] = true;
+        }
+        let mut seam_pairs: Vec<(u32, u32)> = Vec::new();
+        let mut near_of = vec![u32::MAX; width * height];
+        for (f, shift, cu) in &ghost_corners {
+            let ghost = cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]);
+            let (dx, dy) = (shift[0] * sx, -shift[1] * sy);
+            for_texels(corner_texel[*f], width, height, |j, p| {
+                if !real[j] || paired[j] {
+                    return;
+                }
+                let Some(i) = texel_at([p[0] - dx, p[1] - dy], width, height) else { return };
+                let centre = [(i % width) as f64 + 0.5, (i / width) as f64 + 0.5];
+                if !real[i] || i == j || contains(&ghost, centre) {
+                    return;
+                }
+                // A near texel that is itself the far end of a pair passes on its own near
+                // texel, so pairs never chain and one copy pass settles them.
+                let i = if near_of[i] != u32::MAX { near_of[i] as usize } else { i };
+                if i == j {
+                    return;
+                }
+                near_of[j] = i as u32;
+                paired[j] = true;
+                paired[i] = true;
+                links.push((i as u32, j as u32));
+                links.push((j as u32, i as u32));
+                seam_pairs.push((j as u32, i as u32));
             });
         }
         links.sort_unstable();
@@ -260,6 +255,7 @@ impl GeometryImage {
             face_area,
             links,
             margin_copies,
+            seam_pairs,
         }
     }
 
@@ -267,7 +263,12 @@ impl GeometryImage {
     /// image 2"): every ghost-drawn margin texel takes the colour of the texel it
     /// continues, so the texture matches across every cut whatever order the synthesis
     /// visited the two sides in. `pixels` is `width × height`, row-major.
+    /// [`Self::seam_pairs`] take the near texel's colour too (the quilting makes them
+    /// equal unless one patch wrote both).
     pub fn copy_margins<T: Copy>(&self, pixels: &mut [T]) {
+        for &(far, near) in &self.seam_pairs {
+            pixels[far as usize] = pixels[near as usize];
+        }
         for &(g, r, _) in &self.margin_copies {
             pixels[g as usize] = pixels[r as usize];
         }
@@ -305,4 +306,54 @@ impl GeometryImage {
             }
         }
     }
+}
+
+/// Barycentric interpolation of the corner values `v` of triangle `t` (signed doubled
+/// area `det`) at `p`, with the coordinates clamped to the triangle (texel centres just
+/// outside it take the nearest boundary value).
+fn interpolate(t: &[[f64; 2]; 3], det: f64, p: [f64; 2], v: [f64; 3]) -> f32 {
+    let l1 =
+        ((p[0] - t[0][0]) * (t[2][1] - t[0][1]) - (p[1] - t[0][1]) * (t[2][0] - t[0][0])) / det;
+    let l2 =
+        ((t[1][0] - t[0][0]) * (p[1] - t[0][1]) - (t[1][1] - t[0][1]) * (p[0] - t[0][0])) / det;
+    let (l1, l2) = (l1.clamp(0.0, 1.0), l2.clamp(0.0, 1.0));
+    let l0 = (1.0 - l1 - l2).max(0.0);
+    ((l0 * v[0] + l1 * v[1] + l2 * v[2]) / (l0 + l1 + l2)) as f32
+}
+
+/// Whether `p` lies in triangle `t` (either orientation, boundary included).
+fn contains(t: &[[f64; 2]; 3], p: [f64; 2]) -> bool {
+    let side =
+        |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+    let s = [side(t[0], t[1]), side(t[1], t[2]), side(t[2], t[0])];
+    s.iter().all(|&v| v >= 0.0) || s.iter().all(|&v| v <= 0.0)
+}
+
+/// Twice the signed area of `t` (negative for the clockwise canvas triangles).
+fn doubled_area(t: &[[f64; 2]; 3]) -> f64 {
+    (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0])
+}
+
+/// Calls `visit(index, centre)` for every canvas texel whose centre `t` covers.
+fn for_texels(
+    t: [[f64; 2]; 3],
+    width: usize,
+    height: usize,
+    mut visit: impl FnMut(usize, [f64; 2]),
+) {
+    triangle_row_spans(t, 0.0, |row, c0, c1| {
+        if row < 0 || row >= height as i64 {
+            return;
+        }
+        for col in c0.max(0)..=c1.min(width as i64 - 1) {
+            visit(row as usize * width + col as usize, [col as f64 + 0.5, row as f64 + 0.5]);
+        }
+    });
+}
+
+/// Row-major index of the canvas texel containing `p`, if inside the canvas.
+fn texel_at(p: [f64; 2], width: usize, height: usize) -> Option<usize> {
+    let (x, y) = (p[0].floor(), p[1].floor());
+    (x >= 0.0 && y >= 0.0 && x < width as f64 && y < height as f64)
+        .then(|| y as usize * width + x as usize)
 }

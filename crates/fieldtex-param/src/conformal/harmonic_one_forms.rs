@@ -92,3 +92,15 @@ pub fn face_vectors(
         })
         .collect()
 }
+
+/// Per triangle: area and unit normal (`[0, 0, 1]` for a degenerate triangle), the
+/// frame in which a face vector is turned by the Hodge star (`n × X`).
+pub fn face_areas_normals(mesh: &fieldtex_mesh::TriMesh) -> (Vec<f64>, Vec<[f64; 3]>) {
+    (0..mesh.n_triangles())
+        .map(|f| {
+            let p = mesh.triangle_positions(f);
+            let n2 = vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0]));
+            (0.5 * vec3::norm(n2), vec3::normalize(n2).unwrap_or([0.0, 0.0, 1.0]))
+        })
+        .unzip()
+}

@@ -19,7 +19,7 @@
 
 use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
 use super::critical_trajectories::critical_trajectories;
-use super::harmonic_one_forms::{face_vectors, harmonic_projection};
+use super::harmonic_one_forms::{face_areas_normals, face_vectors, harmonic_projection};
 use super::holomorphic_basis::conjugates;
 use super::periodic_uv::{Lattice, along2, integrate, reduce_basis, reduce_faces, signed_area};
 use super::seam_placement::shortest_level;
@@ -90,14 +90,7 @@ pub fn holomorphic_map_with(
     }
     let xs: Vec<Vec<[f64; 3]>> =
         forms.iter().map(|om| face_vectors(&topo, &mesh.positions, tris, om, &keep)).collect();
-    let mut areas = vec![0.0; nf];
-    let mut normals = vec![[0.0; 3]; nf];
-    for f in 0..nf {
-        let p = mesh.triangle_positions(f);
-        let n2 = vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0]));
-        areas[f] = 0.5 * vec3::norm(n2);
-        normals[f] = vec3::normalize(n2).unwrap_or([0.0, 0.0, 1.0]);
-    }
+    let (areas, normals) = face_areas_normals(mesh);
     let conj = conjugates(&forms, &w, &xs, &areas, &normals)?;
     // Genus 1: the form is unique up to a complex factor (the best basis form, no
     // search). Genus ≥ 2: the combination with the most uniform conformal factor.

@@ -292,15 +292,7 @@ pub fn global_conformal(
         // long; smaller holes stay capped (doubled, a tiny hole becomes a thin handle
         // whose conformal factor is extreme). A disk or an annulus (double genus 0 or
         // 1) stays capped: the slit cylinder gives the map an annulus's double gives.
-        let sub_area: f64 = (0..sub.n_triangles())
-            .map(|f| {
-                let p = sub.triangle_positions(f);
-                0.5 * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
-                    fieldtex_core::vec3::sub(p[1], p[0]),
-                    fieldtex_core::vec3::sub(p[2], p[0]),
-                ))
-            })
-            .sum();
+        let sub_area = fieldtex_mesh::areas::total_area(&sub);
         let large: Vec<u32> = capped
             .caps
             .iter()
@@ -346,16 +338,7 @@ pub fn global_conformal(
                 caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
                 // A hole becomes a cylinder end only when it is large (its boundary at least
                 // 0.3 √area); small holes stay capped and the slits go to extremal points.
-                let area: f64 = (0..sub.n_triangles())
-                    .map(|f| {
-                        let p = sub.triangle_positions(f);
-                        0.5 * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
-                            fieldtex_core::vec3::sub(p[1], p[0]),
-                            fieldtex_core::vec3::sub(p[2], p[0]),
-                        ))
-                    })
-                    .sum();
-                caps.retain(|c| c.1 >= 0.3 * area.sqrt());
+                caps.retain(|c| c.1 >= LARGE_HOLE * sub_area.sqrt());
                 let a = caps.first().map(|c| c.0 as usize);
                 let b = match (caps.first(), caps.get(1)) {
                     (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),

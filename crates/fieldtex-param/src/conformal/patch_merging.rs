@@ -47,31 +47,53 @@ pub struct MergeOutcome {
     pub attached_folded: usize,
 }
 
+/// The faces being laid out, as [`merge_patches`] and [`shorten_seams`] read them:
+/// `keep` the faces of the layout, `folded` the faces laid out on their own (their
+/// corners are not the form's development), `cell` the hash-grid cell size and `tol`
+/// the tolerance under which two shifts are equal.
+#[derive(Debug, Clone, Copy)]
+pub struct LayoutFaces<'a> {
+    pub positions: &'a [[f64; 3]],
+    pub triangles: &'a [[u32; 3]],
+    pub topology: &'a Topology,
+    pub keep: &'a [bool],
+    pub folded: &'a [bool],
+    pub cell: f64,
+    pub tol: f64,
+}
+
+impl LayoutFaces<'_> {
+    /// Hash-grid cell of a point.
+    fn key(&self, p: [f64; 2]) -> (i64, i64) {
+        ((p[0] / self.cell).floor() as i64, (p[1] / self.cell).floor() as i64)
+    }
+
+    /// Number of patch ids in use, and per patch: its faces and their hash grid.
+    fn patch_grids(&self, corner: &[[[f64; 2]; 3]], patch: &[u32]) -> (Vec<Vec<u32>>, Vec<Grid>) {
+        let n =
+            patch.iter().filter(|&&p| p != u32::MAX).map(|&p| p as usize + 1).max().unwrap_or(0);
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); n];
+        let mut grids: Vec<Grid> = vec![Grid::new(); n];
+        let key = |p| self.key(p);
+        for f in (0..self.triangles.len()).filter(|&f| self.keep[f] && patch[f] != u32::MAX) {
+            members[patch[f] as usize].push(f as u32);
+            insert(&mut grids[patch[f] as usize], &key, f as u32, &corner[f]);
+        }
+        (members, grids)
+    }
+}
+
 /// Merges patches as in the module docs. `corner` and `patch` (per face, `u32::MAX`
-/// outside `keep`) are updated in place; `folded` flags faces laid out on their own
-/// (their corners are not the form's development); `cell` is the hash-grid cell size and
-/// `tol` the tolerance under which two shifts are equal.
-#[allow(clippy::too_many_arguments)]
+/// outside `keep`) are updated in place.
 pub fn merge_patches(
-    positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-    topology: &Topology,
+    faces: &LayoutFaces,
     corner: &mut [[[f64; 2]; 3]],
     patch: &mut [u32],
-    keep: &[bool],
-    folded: &[bool],
-    cell: f64,
-    tol: f64,
 ) -> MergeOutcome {
+    let LayoutFaces { positions, triangles, topology, keep, folded, tol, .. } = *faces;
     let nf = triangles.len();
-    let n0 = patch.iter().filter(|&&p| p != u32::MAX).map(|&p| p as usize + 1).max().unwrap_or(0);
-    let key = |p: [f64; 2]| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
-    let mut members: Vec<Vec<u32>> = vec![Vec::new(); n0];
-    let mut grids: Vec<Grid> = vec![Grid::new(); n0];
-    for f in (0..nf).filter(|&f| keep[f] && patch[f] != u32::MAX) {
-        members[patch[f] as usize].push(f as u32);
-        insert(&mut grids[patch[f] as usize], &key, f as u32, &corner[f]);
-    }
+    let key = |p| faces.key(p);
+    let (mut members, mut grids) = faces.patch_grids(corner, patch);
     let corner_of = |f: usize, v: u32| (0..3).find(|&k| triangles[f][k] == v).unwrap_or(0);
     let fits = |grid: &Grid, corner: &[[[f64; 2]; 3]], c: &[[f64; 2]; 3]| {
         let (lo, hi) = cell_range(&key, c);
@@ -167,7 +189,7 @@ pub fn merge_patches(
     let mut order: Vec<(CandKey, CandVal)> = cands.into_iter().collect();
     order.sort_by(|x, y| y.1.0.total_cmp(&x.1.0).then(x.0.cmp(&y.0)));
     // 3. Greedy merging with union–find over patch ids; corners move with their group.
-    let mut parent: Vec<u32> = (0..n0 as u32).collect();
+    let mut parent: Vec<u32> = (0..members.len() as u32).collect();
     let find = |parent: &mut Vec<u32>, mut p: u32| {
         while parent[p as usize] != p {
             let up = parent[parent[p as usize] as usize];
@@ -231,27 +253,17 @@ pub fn merge_patches(
 /// moved face overlaps nothing in its new patch. Jagged fronts where a breadth-first
 /// patch met itself around a handle become straighter; each move lowers the total seam
 /// length, so the faces are swept in index order until no move helps (at most `rounds`
-/// sweeps). Faces in `fixed` (laid out on their own) are not moved. Returns the moves.
-#[allow(clippy::too_many_arguments)]
+/// sweeps). Folded faces (laid out on their own) are not moved. Returns the moves.
 pub fn shorten_seams(
-    positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-    topology: &Topology,
+    faces: &LayoutFaces,
     corner: &mut [[[f64; 2]; 3]],
     patch: &mut [u32],
-    keep: &[bool],
-    fixed: &[bool],
-    cell: f64,
-    tol: f64,
     rounds: usize,
 ) -> usize {
+    let LayoutFaces { positions, triangles, topology, keep, folded: fixed, tol, .. } = *faces;
     let nf = triangles.len();
-    let n = patch.iter().filter(|&&p| p != u32::MAX).map(|&p| p as usize + 1).max().unwrap_or(0);
-    let key = |p: [f64; 2]| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
-    let mut grids: Vec<Grid> = vec![Grid::new(); n];
-    for f in (0..nf).filter(|&f| keep[f] && patch[f] != u32::MAX) {
-        insert(&mut grids[patch[f] as usize], &key, f as u32, &corner[f]);
-    }
+    let key = |p| faces.key(p);
+    let (_, mut grids) = faces.patch_grids(corner, patch);
     let corner_of = |f: usize, v: u32| (0..3).find(|&k| triangles[f][k] == v).unwrap_or(0);
     let edge_len: Vec<f64> = topology
         .edges

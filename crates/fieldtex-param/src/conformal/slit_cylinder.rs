@@ -16,7 +16,7 @@
 
 use super::ComponentMap;
 use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
-use super::harmonic_one_forms::{face_vectors, harmonic_projection};
+use super::harmonic_one_forms::{face_areas_normals, face_vectors, harmonic_projection};
 use super::periodic_uv::{Lattice, along2, integrate, reduce_faces, signed_area};
 use super::tree_cotree::edge_sign_in_face;
 use crate::ParamError;
@@ -164,13 +164,8 @@ pub fn slit_cylinder(mesh: &TriMesh, ends: [Option<usize>; 2]) -> Result<Compone
     let x = face_vectors(&topo, &mesh.positions, tris, &omega, &keep);
     let gu = face_vectors(&topo, &mesh.positions, tris, &du, &keep);
     let (mut num, mut den, mut gg) = (0.0, 0.0, 0.0);
-    let mut areas = vec![0.0; nf];
-    let mut normals = vec![[0.0; 3]; nf];
+    let (areas, normals) = face_areas_normals(mesh);
     for f in 0..nf {
-        let p = mesh.triangle_positions(f);
-        let n2 = vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0]));
-        areas[f] = 0.5 * vec3::norm(n2);
-        normals[f] = vec3::normalize(n2).unwrap_or([0.0, 0.0, 1.0]);
         if !keep[f] {
             continue;
         }

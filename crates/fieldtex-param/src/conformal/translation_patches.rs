@@ -28,7 +28,7 @@
 //! listed as [`Ghost`]s: drawn shifted beside the near side they fill the image margin
 //! with the continuation of the surface, for boundary consistency (§4.2).
 
-use super::patch_merging::{merge_patches, shorten_seams};
+use super::patch_merging::{LayoutFaces, merge_patches, shorten_seams};
 use super::periodic_uv::{along2, signed_area};
 use fieldtex_core::vec3;
 use fieldtex_mesh::Topology;
@@ -170,32 +170,13 @@ pub fn translation_patches(
     }
     let tol = 1e-9 * mean_len.max(1e-300) * 1e3;
     let (n_patches, merges) = if merge {
-        let m = merge_patches(
-            positions,
-            triangles,
-            topology,
-            &mut corner,
-            &mut patch,
-            keep,
-            &is_folded,
-            cell,
-            tol,
-        );
+        let faces =
+            LayoutFaces { positions, triangles, topology, keep, folded: &is_folded, cell, tol };
+        let m = merge_patches(&faces, &mut corner, &mut patch);
         folded -= m.attached_folded;
         // Faces still on one-face charts are not moved; attached ones are not
         // translation-developed either.
-        shorten_seams(
-            positions,
-            triangles,
-            topology,
-            &mut corner,
-            &mut patch,
-            keep,
-            &is_folded,
-            cell,
-            tol,
-            SEAM_ROUNDS,
-        );
+        shorten_seams(&faces, &mut corner, &mut patch, SEAM_ROUNDS);
         let n = patch.iter().filter(|&&p| p != u32::MAX).map(|&p| p + 1).max().unwrap_or(0);
         (n, m.merges)
     } else {

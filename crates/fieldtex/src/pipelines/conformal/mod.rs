@@ -263,8 +263,13 @@ pub fn conformal(
             .iter()
             .filter(|&&(g, r, _)| image.pixels[g as usize] != image.pixels[r as usize])
             .count();
+        let pairs_changed = img
+            .seam_pairs
+            .iter()
+            .filter(|&&(a, b)| image.pixels[a as usize] != image.pixels[b as usize])
+            .count();
         img.copy_margins(&mut image.pixels);
-        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len(), "margin_texels_changed_by_copy": changed}));
+        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len(), "margin_texels_changed_by_copy": changed, "seam_texel_pairs": img.seam_pairs.len(), "seam_texel_pairs_changed_by_copy": pairs_changed}));
         let faces = c.faces.iter().copied().zip(img.corner_texel.iter().copied()).collect();
         blocks.push(Block {
             image,
