@@ -2,7 +2,8 @@
 `BENCH <name> <value>`) lines — the base tree's and this tree's, measured in the same
 run — and prints, per line, base, new, the ratio new/base and a flag when this tree is
 more than the threshold (default 10 %) worse. Lines whose name ends in `_per_s` (or
-contains `speedup`) are better when higher; all others (times) when lower. Each side's
+contains `speedup` or `_over_`, a ratio of a slower path's time over a faster one's) are
+better when higher; all others (times) when lower. Each side's
 value is its best over the runs in its file.
 Usage: python3 bench/regression.py BASE.log NEW.log [--threshold 0.10]
 Exit status 0 always (a report, not a gate); the last line counts the flags."""
@@ -10,7 +11,7 @@ import sys
 
 
 def higher_is_better(name):
-    return name.endswith("_per_s") or "speedup" in name
+    return name.endswith("_per_s") or "speedup" in name or "_over_" in name
 
 
 def read(path):
