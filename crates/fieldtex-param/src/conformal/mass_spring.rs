@@ -11,24 +11,38 @@
 //! form).
 //!
 //! **Integration (substitute for the paper's explicit steps, which take an hour on the
-//! bunny):** each step is *implicit* — the spring energy `Σ (φ_v − φ_u − t_uv)²` with
-//! every edge's target `t_uv` along its current direction and of length
-//! `|e| (r_uv / |e|)^κ` is minimised by one sparse solve (graph Laplacian, factorised
-//! once, [`super::cotan_system::FixedLaplacian`]). The move towards that minimiser is
-//! then scaled by a backtracking line search, starting at the full move and halved
-//! until no triangle flips or collapses (signed area above 5 % of its conformal and its
-//! previous value) — the paper's "ε chosen so that no triangle flips", without the
-//! force-limited step length that makes explicit integration slow in regions the map
-//! compressed by orders of magnitude. The relaxation stops where the mean angle
-//! distortion `σ1/σ2` would pass the bound (the last step is bisected onto it), when a
-//! step no longer lowers the area distortion, or after `iterations` steps. Lattice
-//! translations (the periods) are kept, so periodic images stay periodic. Sequential and
-//! deterministic.
+//! bunny):** each step is *implicit* — an energy `Σ w_uv |φ_v − φ_u − t_uv|²` is
+//! minimised by one sparse solve (a weighted graph Laplacian,
+//! [`super::cotan_system::FixedLaplacian`]). Two choices of targets `t_uv`:
+//! - **rigid triangles** ([`Targets::RigidTriangles`]): each
+//!   triangle's own 3-D shape at the image's global scale, rotated onto the current
+//!   triangle (the ARAP local step of Liu et al. 2008), with the cotangent weights of
+//!   the rest shape scaled per face by the symmetric Dirichlet weight of its current
+//!   stretch (an isotropic simplification of SLIM's reweighting, Rabinovich et al.
+//!   2017), so faces the conformal map squeezed pull hardest; the system is
+//!   refactorised each step ([`super::rigid_triangles`]);
+//! - **edge springs** ([`Targets::Springs`], eq. 2's rest lengths): every edge's target along its current
+//!   direction with length `|e| (r_uv / |e|)^κ`, stiffness `1/|e|²` of the conformal
+//!   edge, factorised once.
+//!
+//! Both replace eq. 2's explicit forces. The rigid targets also restore angles; at the
+//! same angle bound they lower the area distortion further on some meshes (bunny −44 %
+//! against −37 %) and less on others (armadillo), so the default ([`Targets::Best`])
+//! runs both and keeps the better map (numbers in `docs/conformal.md`). The move towards the minimiser is then scaled by a
+//! backtracking line search, starting at the full move and halved until no triangle
+//! flips or collapses (signed area above 5 % of its conformal and its previous value) —
+//! the paper's "ε chosen so that no triangle flips", without the force-limited step
+//! length that makes explicit integration slow in regions the map compressed by orders
+//! of magnitude. The relaxation stops where the mean angle distortion `σ1/σ2` would
+//! pass the bound (the last step is bisected onto it), when a step no longer lowers the
+//! area distortion, or after `iterations` steps. Lattice translations (the periods) are
+//! kept, so periodic images stay periodic. Sequential and deterministic.
 #![allow(clippy::needless_range_loop)] // index loops over parallel per-face tables
 
 use super::ComponentMap;
 use super::cotan_system::FixedLaplacian;
 use super::periodic_uv::{reduce_faces, signed_area};
+use super::rigid_triangles::RigidTriangles;
 use crate::distortion::triangle_jacobian;
 use fieldtex_core::vec3;
 use fieldtex_mesh::{Topology, TriMesh};
@@ -40,16 +54,34 @@ pub struct MassSpringOptions {
     /// Largest number of implicit steps. Default 40.
     pub iterations: usize,
     /// Fraction `κ ∈ (0, 1]` of the way (in log length) from each edge's current
-    /// length to its rest length that a step's targets ask for. Default 0.5.
+    /// length to its rest length that a step's targets ask for (edge springs only).
+    /// Default 0.25.
     pub step: f64,
     /// Stop (keeping the last state within the bound) when the mean angle distortion
-    /// `σ1/σ2` passes this value: the trade-off between angle and area. Default 1.25.
+    /// `σ1/σ2` passes this value: the trade-off between angle and area. Default 1.3.
     pub max_angle_distortion: f64,
+    /// Which step targets (module docs). Default [`Targets::Best`].
+    pub targets: Targets,
+}
+
+/// The targets of the implicit steps (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Targets {
+    /// Eq. 2's rest lengths along the current edge directions.
+    Springs,
+    /// The triangles' own rest shapes rotated into place, reweighted
+    /// ([`super::rigid_triangles`]).
+    RigidTriangles,
+    /// Both, keeping the map with the lower area distortion (ties: springs). Neither
+    /// wins on every mesh: the rigid targets on the bunny, koala and rocker arm, the
+    /// springs on the armadillo, the bust and fandisk (`docs/conformal.md`).
+    Best,
 }
 
 impl Default for MassSpringOptions {
     fn default() -> Self {
-        Self { iterations: 40, step: 0.25, max_angle_distortion: 1.3 }
+        Self { iterations: 40, step: 0.25, max_angle_distortion: 1.3, targets: Targets::Best }
     }
 }
 
@@ -68,6 +100,8 @@ pub struct MassSpringStats {
     pub before: MapDistortion,
     pub after: MapDistortion,
     pub iterations: usize,
+    /// The targets whose map was kept.
+    pub targets: Targets,
     /// Halvings of the line search (moves shortened to avoid a flip), over all steps.
     pub frozen_moves: usize,
 }
@@ -121,6 +155,30 @@ pub fn relax(
     map: &mut ComponentMap,
     options: &MassSpringOptions,
 ) -> MassSpringStats {
+    match options.targets {
+        Targets::Best => {
+            let mut rigid_map = map.clone();
+            let rigid = relax_with(mesh, n_faces, &mut rigid_map, options, Targets::RigidTriangles);
+            let springs = relax_with(mesh, n_faces, map, options, Targets::Springs);
+            if rigid.after.flipped == 0 && rigid.after.log_area_std < springs.after.log_area_std {
+                *map = rigid_map;
+                rigid
+            } else {
+                springs
+            }
+        }
+        t => relax_with(mesh, n_faces, map, options, t),
+    }
+}
+
+/// [`relax`] with one kind of targets.
+fn relax_with(
+    mesh: &TriMesh,
+    n_faces: usize,
+    map: &mut ComponentMap,
+    options: &MassSpringOptions,
+    targets: Targets,
+) -> MassSpringStats {
     let tris = &mesh.triangles;
     let slit_of = |apex: &[Option<(u8, bool)>]| {
         let a: Vec<bool> = apex.iter().map(|x| x.is_some()).collect();
@@ -162,7 +220,7 @@ pub fn relax(
     springs.sort_by_key(|a| (a.0, a.1));
     springs.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
     if springs.is_empty() {
-        return MassSpringStats { before, after: before, iterations: 0, frozen_moves: 0 };
+        return MassSpringStats { before, after: before, iterations: 0, targets, frozen_moves: 0 };
     }
     let nv = mesh.n_vertices();
     let mut phi = map.base.clone();
@@ -205,7 +263,7 @@ pub fn relax(
             if l2 > 0.0 && l2.is_finite() { 1.0 / l2 } else { 0.0 }
         })
         .collect();
-    let weights: Vec<f64> = sub
+    let mut weights: Vec<f64> = sub
         .edges
         .iter()
         .map(|ed| {
@@ -213,14 +271,50 @@ pub fn relax(
             springs.binary_search_by_key(&key, |s| (s.0, s.1)).map_or(0.0, |s| spring_weight[s])
         })
         .collect();
+    // Rigid-triangle targets: rest shapes at the image's global length ratio, weights
+    // the rest triangles' cotangents.
+    let mut rigid = if targets == Targets::RigidTriangles {
+        let (mut a3, mut auv) = (0.0, 0.0);
+        for f in (0..n_faces).filter(|&f| map.apex[f].is_none()) {
+            let a = signed_area(&corners_of(&phi, f));
+            if a.is_finite() && a > 0.0 {
+                auv += a;
+                let p = mesh.triangle_positions(f);
+                a3 += 0.5 * vec3::norm(vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0])));
+            }
+        }
+        let use_face: Vec<bool> = (0..n_faces).map(|f| map.apex[f].is_none()).collect();
+        let eta = (a3 / auv).sqrt();
+        match RigidTriangles::new(mesh, n_faces, &use_face, eta) {
+            Ok(rt) if eta.is_finite() && eta > 0.0 => {
+                weights.iter_mut().for_each(|w| *w = 0.0);
+                for (f, fe) in sub.face_edges.iter().enumerate() {
+                    for k in 0..3 {
+                        weights[fe[k] as usize] += rt.weight(f, k);
+                    }
+                }
+                has_spring.iter_mut().for_each(|h| *h = false);
+                for (e, ed) in sub.edges.iter().enumerate() {
+                    if weights[e] != 0.0 {
+                        has_spring[ed[0] as usize] = true;
+                        has_spring[ed[1] as usize] = true;
+                    }
+                }
+                Some(rt)
+            }
+            _ => None,
+        }
+    } else {
+        None
+    };
     let gauge = (0..nv).find(|&v| has_spring[v] && !phi[v][0].is_nan());
     let fixed: Vec<Option<f64>> = (0..nv)
         .map(|v| {
             if !has_spring[v] || Some(v) == gauge || phi[v][0].is_nan() { Some(0.0) } else { None }
         })
         .collect();
-    let Ok(lap) = FixedLaplacian::new(&sub, &weights, &fixed) else {
-        return MassSpringStats { before, after: before, iterations: 0, frozen_moves: 0 };
+    let Ok(mut lap) = FixedLaplacian::new(&sub, &weights, &fixed) else {
+        return MassSpringStats { before, after: before, iterations: 0, targets, frozen_moves: 0 };
     };
     let kappa = options.step.clamp(1e-3, 1.0);
     let apex_flags: Vec<bool> = map.apex.iter().map(|x| x.is_some()).collect();
@@ -235,6 +329,7 @@ pub fn relax(
     let moved = |phi: &[[f64; 2]], delta: &[[f64; 2]], t: f64| -> Vec<[f64; 2]> {
         phi.iter().zip(delta).map(|(p, d)| [p[0] + t * d[0], p[1] + t * d[1]]).collect()
     };
+    let max_angle = options.max_angle_distortion;
     let mut frozen_moves = 0usize;
     let mut iterations = 0;
     let mut current = before;
@@ -267,7 +362,36 @@ pub fn relax(
         }
         // Right-hand side of L δ = Σ (target − current edge vector), per coordinate.
         let (mut rx, mut ry) = (vec![0.0; nv], vec![0.0; nv]);
-        for (s, &(i, j, _, _)) in springs.iter().enumerate() {
+        if let Some(rt) = &mut rigid {
+            // Reweighted (the energy's local weights at the current map), refactorised.
+            for f in 0..n_faces {
+                rt.reweight(f, &corners_of(&phi, f));
+            }
+            weights.iter_mut().for_each(|w| *w = 0.0);
+            for (f, fe) in sub.face_edges.iter().enumerate() {
+                for k in 0..3 {
+                    weights[fe[k] as usize] += rt.weight(f, k);
+                }
+            }
+            let Ok(l) = FixedLaplacian::new(&sub, &weights, &fixed) else { break };
+            lap = l;
+            for f in 0..n_faces {
+                let c = corners_of(&phi, f);
+                let Some(t) = rt.targets(f, &c) else { continue };
+                for k in 0..3 {
+                    let l = (k + 1) % 3;
+                    let w = rt.weight(f, k);
+                    let r =
+                        [w * (t[k][0] - (c[l][0] - c[k][0])), w * (t[k][1] - (c[l][1] - c[k][1]))];
+                    let (i, j) = (tris[f][k] as usize, tris[f][l] as usize);
+                    rx[i] -= r[0];
+                    ry[i] -= r[1];
+                    rx[j] += r[0];
+                    ry[j] += r[1];
+                }
+            }
+        }
+        for (s, &(i, j, _, _)) in springs.iter().enumerate().filter(|_| rigid.is_none()) {
             let (e, luv) = lens[s];
             if luv <= 0.0 || !luv.is_finite() {
                 continue;
@@ -295,13 +419,13 @@ pub fn relax(
             break;
         }
         let d = distortion_at(&next);
-        if d.angle_mean > options.max_angle_distortion {
+        if d.angle_mean > max_angle {
             // Bisect the step onto the angle bound, then stop.
             let (mut lo, mut hi) = (0.0, t);
             for _ in 0..8 {
                 let mid = 0.5 * (lo + hi);
                 let cand = moved(&phi, &delta, mid);
-                if distortion_at(&cand).angle_mean <= options.max_angle_distortion {
+                if distortion_at(&cand).angle_mean <= max_angle {
                     lo = mid;
                 } else {
                     hi = mid;
@@ -325,5 +449,5 @@ pub fn relax(
     map.corner[..n_faces].copy_from_slice(&corner);
     map.base = phi;
     let after = map_distortion(mesh, n_faces, &map.corner, &slit_of(&map.apex));
-    MassSpringStats { before, after, iterations, frozen_moves }
+    MassSpringStats { before, after, iterations, targets, frozen_moves }
 }

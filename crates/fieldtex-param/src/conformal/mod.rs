@@ -30,6 +30,7 @@ pub mod holomorphic_map;
 pub mod mass_spring;
 pub mod patch_merging;
 pub mod periodic_uv;
+mod rigid_triangles;
 pub mod seam_placement;
 pub mod slit_cylinder;
 pub mod translation_patches;
@@ -38,7 +39,7 @@ pub mod uniform_form;
 pub mod zero_points;
 
 pub use geometry_image::GeometryImage;
-pub use mass_spring::{MassSpringOptions, MassSpringStats};
+pub use mass_spring::{MassSpringOptions, MassSpringStats, Targets};
 pub use periodic_uv::Lattice;
 pub use translation_patches::Ghost;
 

@@ -36,7 +36,7 @@ pub struct ConformalOptions {
     pub exemplar: PathBuf,
     /// Long side `C` of each geometry image in texels (paper: 1024). Default 1024.
     pub size: usize,
-    /// Mass-spring relaxation before synthesis (§5). Default false.
+    /// Quasi-isometric relaxation before synthesis (§5; `fieldtex_param::conformal::mass_spring`). Default false.
     pub quasi_isometric: bool,
     /// Pick the exemplar level per patch from `τ` (§4.2). Default true.
     pub multiscale: bool,

@@ -157,6 +157,6 @@ pub(super) fn add_notes(
     n.push("τ per texel: barycentric interpolation of per-vertex τ (substitute for the paper's Gaussian RBF).".into());
     n.push("Quilting: random candidate subset per patch (not exhaustive), old seams not re-cut; colours compared in sRGB.".into());
     if options.quasi_isometric {
-        n.push("Mass-spring (eq. 2) in a balanced spring form (rest length = 3-D length / mean conformal factor), integrated by implicit steps (one sparse solve of the spring energy per step, stiffness 1/|e|² of the conformal edge, a flip-free backtracking line search) instead of the paper's explicit steps (a substitute for speed), stopped when the mean angle distortion would exceed 1.25 or the area distortion stops falling.".into());
+        n.push("Quasi-isometric relaxation by implicit steps instead of the paper's explicit mass-spring steps (eq. 2; a substitute for speed and reach): each step's targets are the triangles' own 3-D shapes at the image's scale, rotated into place (ARAP's local step), weighted per face by the symmetric Dirichlet weight of its current stretch (SLIM's weights, made isotropic), one sparse solve and a flip-free backtracking line search per step; stopped when the mean angle distortion would exceed 1.3 or the area distortion stops falling.".into());
     }
 }
