@@ -2,7 +2,7 @@
 //! `fieldtex orient` (paper D §4 targets of issue 3).
 //!
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
-//!  [DIR…] [--const DEG…] [--ideal DEG…] [--prerotate DEG… [--residual R]] [--both] [--no-rosy-fix] [--free-flips]
+//!  [DIR…] [--const DEG…] [--ideal DEG…] [--prerotate DEG… [--residual R] [--copy-scale F]] [--tileable] [--both] [--no-rosy-fix] [--free-flips]
 //!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid] [--warp | --no-warp]
 //!  [--passes N] [--finest-passes N] [--coarse-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
 //!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--radius R] [--analysis-k K]
@@ -22,7 +22,8 @@
 //! constant field (the resampling floor of the metric; with `--png DIR` also written as
 //! `ideal-DEG.png` and its field `ideal-DEG.npy`). `--prerotate DEG` scores a constant
 //! design at DEG + `--residual` (default 0) synthesised against the exemplar pre-rotated
-//! by DEG (`fieldtex_synth::synthesize_rotated`). `--both` runs with and without the 2-RoSy fix. `--png DIR`
+//! by DEG (`fieldtex_synth::synthesize_rotated`, a copy `--copy-scale` × the exemplar's
+//! size); `--tileable` analyses the exemplar as tileable. `--both` runs with and without the 2-RoSy fix. `--png DIR`
 //! writes the texture, the texture with the defects marked (red: within 3 periods of a
 //! designed singularity), 3× crops around the singularities and the flip map.
 
@@ -107,6 +108,7 @@ fn main() {
     let mut consts: Vec<f32> = Vec::new();
     let mut prerotate: Vec<f32> = Vec::new();
     let mut residual = 0.0f32;
+    let mut copy_scale = 1.0f32;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--both" => both = true,
@@ -122,6 +124,8 @@ fn main() {
             "--const" => consts.push(num::<f32>(args.next(), &a)),
             "--prerotate" => prerotate.push(num::<f32>(args.next(), &a)),
             "--residual" => residual = num(args.next(), &a),
+            "--copy-scale" => copy_scale = num(args.next(), &a),
+            "--tileable" => aopts.tileable = true,
             "--no-rosy-fix" => opts.rosy_fix = false,
             "--coarse-passes" => opts.coarse_passes = Some(num(args.next(), &a)),
             "--no-trapezoid" => opts.trapezoid_frames = false,
@@ -203,6 +207,7 @@ fn main() {
             &aopts,
             &dom,
             deg.to_radians(),
+            copy_scale,
             &opts,
             &NoProgress,
         )

@@ -20,6 +20,12 @@
 //! `θ` gets a large residual rotation and is resampled as before. The copy wraps the
 //! exemplar toroidally, as the engine's coordinates do: a non-tileable exemplar's
 //! wrap seams show inside the copy (the synthesis avoids only the copy's own border).
+//!
+//! Not used by the pipelines: on the real exemplars (bands, stripes, a constant design
+//! at 30°) it scored the same as the plain engine within seed noise, so resampling is
+//! not what keeps rotated designs above the rotated-copy floor (measurements:
+//! `docs/real-exemplars.md`, session 12). On a synthetic tileable stripe exemplar it
+//! halves the guided coherence (`tests/rotated_exemplar.rs`).
 
 use fieldtex_core::{Image, Progress};
 
@@ -33,7 +39,7 @@ use crate::parallel_synthesis::{SynthesisOptions, SynthesisResult, synthesize};
 /// original exemplar at `R (x + ½, y + ½)` (wrapped).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RotatedExemplar {
-    /// The copy, the original exemplar's size.
+    /// The copy (the exemplar's size unless [`Self::with_size`] says otherwise).
     pub image: Image,
     /// `R = [c, s; −s, c]` (row-major), the frame of a unit field at the angle.
     frame: [f32; 4],
@@ -43,14 +49,26 @@ pub struct RotatedExemplar {
 
 impl RotatedExemplar {
     /// The copy of the analysed exemplar for a field at `angle` radians (from +x, y
-    /// down), colours read with `filter`.
+    /// down), colours read with `filter`, the exemplar's size.
     pub fn new(analysis: &ExemplarAnalysis, angle: f32, filter: ColorFilter) -> Self {
+        Self::with_size(analysis, angle, filter, analysis.width(), analysis.height())
+    }
+
+    /// [`Self::new`] with a copy of `w × h` pixels (a larger copy holds more of the
+    /// turned exemplar's periods, so its border band and wrap are a smaller share).
+    pub fn with_size(
+        analysis: &ExemplarAnalysis,
+        angle: f32,
+        filter: ColorFilter,
+        w: usize,
+        h: usize,
+    ) -> Self {
         let (s, c) = angle.sin_cos();
-        let (w, h) = (analysis.width(), analysis.height());
+        let source = (analysis.width() as f32, analysis.height() as f32);
         let mut this = Self {
             image: Image { width: w, height: h, pixels: Vec::with_capacity(w * h) },
             frame: [c, s, -s, c],
-            source: (w as f32, h as f32),
+            source,
         };
         for y in 0..h {
             for x in 0..w {
@@ -92,7 +110,7 @@ fn wrap(x: f32, n: f32) -> f32 {
 }
 
 /// [`synthesize`] over `domain` against the exemplar pre-rotated by `angle`
-/// ([`RotatedExemplar`]): analyses the copy with `analysis_options`, runs the engine on
+/// ([`RotatedExemplar`], `copy_scale` × the exemplar's size): analyses the copy with `analysis_options`, runs the engine on
 /// the residual frames and returns the result with coordinates of the original
 /// exemplar (the colours and flips are the copy's, i.e. the same exemplar turned).
 pub fn synthesize_rotated(
@@ -100,10 +118,13 @@ pub fn synthesize_rotated(
     analysis_options: &AnalysisOptions,
     domain: &ImageDomain,
     angle: f32,
+    copy_scale: f32,
     options: &SynthesisOptions,
     progress: &dyn Progress,
 ) -> Result<SynthesisResult, SynthError> {
-    let copy = RotatedExemplar::new(analysis, angle, options.color_filter);
+    let side = |n: usize| ((n as f32 * copy_scale).round() as usize).max(1);
+    let (w, h) = (side(analysis.width()), side(analysis.height()));
+    let copy = RotatedExemplar::with_size(analysis, angle, options.color_filter, w, h);
     let rotated = ExemplarAnalysis::new(&copy.image, analysis_options, progress)?;
     let jac = domain.jacobian.iter().map(|&j| copy.residual(j)).collect();
     let residual = ImageDomain::new(domain.width, domain.height, jac)?;

@@ -41,7 +41,7 @@ fn rotated_design_copies_pixels_of_the_rotated_copy() {
     let opts = SynthesisOptions { seed: 3, ..Default::default() };
     let copy = RotatedExemplar::new(&analysis, 30f32.to_radians(), opts.color_filter);
     let rotated =
-        synthesize_rotated(&analysis, &aopts, &dom, 30f32.to_radians(), &opts, &NoProgress)
+        synthesize_rotated(&analysis, &aopts, &dom, 30f32.to_radians(), 1.0, &opts, &NoProgress)
             .unwrap();
     let plain = synthesize(&analysis, &dom, &opts, &NoProgress).unwrap();
     let (r, p) =
@@ -80,7 +80,9 @@ fn rotated_design_is_more_coherent_than_the_plain_engine() {
         let opts = SynthesisOptions { seed, ..Default::default() };
         let a = 30f32.to_radians();
         rot += score(
-            &synthesize_rotated(&analysis, &aopts, &dom, a, &opts, &NoProgress).unwrap().colors,
+            &synthesize_rotated(&analysis, &aopts, &dom, a, 1.0, &opts, &NoProgress)
+                .unwrap()
+                .colors,
         );
         plain += score(&synthesize(&analysis, &dom, &opts, &NoProgress).unwrap().colors);
     }
@@ -92,7 +94,8 @@ fn rotated_design_is_more_coherent_than_the_plain_engine() {
 fn zero_angle_is_the_plain_engine() {
     let (_, aopts, analysis, dom) = setup(0.0);
     let opts = SynthesisOptions { seed: 5, ..Default::default() };
-    let rotated = synthesize_rotated(&analysis, &aopts, &dom, 0.0, &opts, &NoProgress).unwrap();
+    let rotated =
+        synthesize_rotated(&analysis, &aopts, &dom, 0.0, 1.0, &opts, &NoProgress).unwrap();
     let plain = synthesize(&analysis, &dom, &opts, &NoProgress).unwrap();
     assert_eq!(rotated.colors, plain.colors);
     assert_eq!(rotated.coords, plain.coords);
@@ -105,7 +108,7 @@ fn rotated_synthesis_is_deterministic_across_thread_counts() {
     let opts = SynthesisOptions { seed: 9, ..Default::default() };
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
-            synthesize_rotated(&analysis, &aopts, &dom, 0.7, &opts, &NoProgress).unwrap()
+            synthesize_rotated(&analysis, &aopts, &dom, 0.7, 1.0, &opts, &NoProgress).unwrap()
         })
     };
     let (a, b) = (run(1), run(3));
