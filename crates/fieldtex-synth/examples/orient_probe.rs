@@ -2,7 +2,7 @@
 //! `fieldtex orient` (paper D §4 targets of issue 3).
 //!
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
-//!  [DIR…] [--const DEG…] [--ideal DEG…] [--both] [--no-rosy-fix] [--free-flips]
+//!  [DIR…] [--const DEG…] [--ideal DEG…] [--prerotate DEG… [--residual R] [--copy-scale F]] [--tileable] [--no-wrap-metric] [--both] [--no-rosy-fix] [--free-flips]
 //!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid] [--warp | --no-warp]
 //!  [--passes N] [--finest-passes N] [--coarse-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
 //!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--radius R] [--analysis-k K]
@@ -20,7 +20,12 @@
 //! between neighbours) and the flipped share. `--const DEG` adds a constant-field
 //! case (no singularities); `--ideal DEG` scores the exemplar itself rotated to a
 //! constant field (the resampling floor of the metric; with `--png DIR` also written as
-//! `ideal-DEG.png` and its field `ideal-DEG.npy`). `--both` runs with and without the 2-RoSy fix. `--png DIR`
+//! `ideal-DEG.png` and its field `ideal-DEG.npy`). `--prerotate DEG` scores a constant
+//! design at DEG + `--residual` (default 0) synthesised against the exemplar pre-rotated
+//! by DEG (`fieldtex_synth::synthesize_rotated`, a copy `--copy-scale` × the exemplar's
+//! size); `--tileable` analyses the exemplar as tileable; `--no-wrap-metric` scores
+//! against the exemplar's patches without wrapping (its wrap seams are not exemplar
+//! content then). `--both` runs with and without the 2-RoSy fix. `--png DIR`
 //! writes the texture, the texture with the defects marked (red: within 3 periods of a
 //! designed singularity), 3× crops around the singularities and the flip map.
 
@@ -103,6 +108,10 @@ fn main() {
     let mut no_metrics = false;
     let mut ideal: Vec<f32> = Vec::new();
     let mut consts: Vec<f32> = Vec::new();
+    let mut prerotate: Vec<f32> = Vec::new();
+    let mut residual = 0.0f32;
+    let mut copy_scale = 1.0f32;
+    let mut wrap_exemplar = true;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--both" => both = true,
@@ -116,6 +125,11 @@ fn main() {
             "--nearest" => opts.color_filter = fieldtex_synth::ColorFilter::Nearest,
             "--free-flips" => opts.keep_flips = false,
             "--const" => consts.push(num::<f32>(args.next(), &a)),
+            "--prerotate" => prerotate.push(num::<f32>(args.next(), &a)),
+            "--residual" => residual = num(args.next(), &a),
+            "--copy-scale" => copy_scale = num(args.next(), &a),
+            "--tileable" => aopts.tileable = true,
+            "--no-wrap-metric" => wrap_exemplar = false,
             "--no-rosy-fix" => opts.rosy_fix = false,
             "--coarse-passes" => opts.coarse_passes = Some(num(args.next(), &a)),
             "--no-trapezoid" => opts.trapezoid_frames = false,
@@ -170,7 +184,7 @@ fn main() {
         let ob = ev::rgb_buffer(&img);
         let out = ev::ImageView::new(&ob, n, n, 3).unwrap();
         let fv = ev::FieldView::new(&field, n, n).unwrap();
-        let gopts = ev::GuidedCoherenceOptions { stride, ..Default::default() };
+        let gopts = ev::GuidedCoherenceOptions { stride, wrap_exemplar, ..Default::default() };
         let gc = ev::guided_coherence(&out, &ev_ex, &fv, &gopts).unwrap();
         println!("ideal rotated copy {deg:5.1}°: gc={:.6} (median {:.6})", gc.mean, gc.median);
         if let Some(dir) = &png {
@@ -180,6 +194,41 @@ fn main() {
             fieldtex_io::write_png(&dir.join(format!("ideal-{deg}.png")), &img).unwrap();
             fieldtex_io::write_npy_f32(&dir.join(format!("ideal-{deg}.npy")), &[n, n, 2], &field)
                 .unwrap();
+        }
+    }
+    // A constant field at DEG + `--residual` synthesised against the exemplar
+    // pre-rotated by DEG (`synthesize_rotated`): at residual 0 coherent patches copy
+    // the copy's pixels exactly. Scored against the original exemplar.
+    for &deg in &prerotate {
+        let n = 512usize;
+        // The design's field is at DEG + residual; the copy is turned by DEG.
+        let (ts, tc) = (deg + residual).to_radians().sin_cos();
+        let field: Vec<f32> = (0..n * n).flat_map(|_| [tc, ts]).collect();
+        let dom = ImageDomain::from_direction_field(n, n, &field, 1.0).unwrap();
+        let t = Instant::now();
+        let res = fieldtex_synth::synthesize_rotated(
+            &analysis,
+            &aopts,
+            &dom,
+            deg.to_radians(),
+            copy_scale,
+            &opts,
+            &NoProgress,
+        )
+        .unwrap();
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let ob = ev::rgb_buffer(&res.colors);
+        let out = ev::ImageView::new(&ob, n, n, 3).unwrap();
+        let fv = ev::FieldView::new(&field, n, n).unwrap();
+        let gopts = ev::GuidedCoherenceOptions { stride, wrap_exemplar, ..Default::default() };
+        let gc = ev::guided_coherence(&out, &ev_ex, &fv, &gopts).unwrap();
+        println!(
+            "prerotated copy {deg:5.1}° + {residual}°: syn_ms={ms:.0} gc={:.6} (median {:.6})",
+            gc.mean, gc.median
+        );
+        if let Some(dir) = &png {
+            std::fs::create_dir_all(dir).unwrap();
+            fieldtex_io::write_png(&dir.join(format!("prerot-{deg}.png")), &res.colors).unwrap();
         }
     }
     let fixes: Vec<bool> = if both { vec![true, false] } else { vec![opts.rosy_fix] };
@@ -265,7 +314,7 @@ fn main() {
             let ob = ev::rgb_buffer(&res.colors);
             let out = ev::ImageView::new(&ob, case.n, case.n, 3).unwrap();
             let fv = ev::FieldView::new(&case.field, case.n, case.n).unwrap();
-            let gopts = ev::GuidedCoherenceOptions { stride, ..Default::default() };
+            let gopts = ev::GuidedCoherenceOptions { stride, wrap_exemplar, ..Default::default() };
             let gc = ev::guided_coherence(&out, &ev_ex, &fv, &gopts).unwrap();
             let oe_raw = ev::orientation_error(
                 &out,

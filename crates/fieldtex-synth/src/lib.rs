@@ -15,6 +15,9 @@
 //!   [`RegularLattice`] is a box of samples in 2-D or 3-D computed arithmetically.
 //!   [`synthesize_volume`] runs the same engine on a 3-D lattice with the one 2-D
 //!   exemplar type.
+//! - [`synthesize_rotated`] (`rotated_exemplar.rs`): the same engine against a copy of
+//!   the exemplar pre-rotated to one angle, so that a design at that angle copies whole
+//!   pixels instead of resampling every one (off unless called; one angle, not bins).
 //! - [`synthesize`] (`parallel_synthesis.rs`): coarse-to-fine upsampling with the
 //!   Jacobian, seeded jitter, correction passes with 2×2 subpasses over four-corner
 //!   neighbourhoods, and the 2-RoSy flip indicator of paper D §4
@@ -56,6 +59,7 @@ mod level_tables;
 pub mod parallel_synthesis;
 mod prefetch;
 pub mod regular_lattice;
+pub mod rotated_exemplar;
 pub mod solid;
 pub mod synthesis_options;
 mod synthesis_subset;
@@ -74,4 +78,5 @@ pub use parallel_synthesis::{
     SubsetSynthesis, SynthesisOptions, SynthesisResult, synthesize, synthesize_subset,
 };
 pub use regular_lattice::{JacobianField, RegularLattice};
+pub use rotated_exemplar::{RotatedExemplar, synthesize_rotated};
 pub use volume_synthesis::synthesize_volume;
