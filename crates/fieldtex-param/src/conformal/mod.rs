@@ -27,6 +27,7 @@ pub mod harmonic_one_forms;
 pub mod hole_caps;
 pub mod holomorphic_basis;
 pub mod holomorphic_map;
+pub mod homology_loops;
 pub mod mass_spring;
 pub mod patch_merging;
 pub mod periodic_uv;
@@ -107,6 +108,11 @@ pub struct ComponentMap {
     pub patch_merges: usize,
     /// Area-stretch CV of the best basis form and of the optimised form (genus ≥ 2).
     pub stretch_cv: Option<[f64; 2]>,
+    /// Per capped edge: on a snapped critical trajectory (genus ≥ 2; empty otherwise).
+    pub trajectory_cut: Vec<bool>,
+    /// Per capped edge: on a shortest homology loop (genus ≥ 2 with the loop cut; empty
+    /// otherwise).
+    pub loop_cut: Vec<bool>,
 }
 
 impl ComponentMap {
@@ -130,6 +136,8 @@ impl ComponentMap {
             stretch_cv: None,
             folded_faces: 0,
             patch_merges: 0,
+            trajectory_cut: Vec::new(),
+            loop_cut: Vec::new(),
         }
     }
 
