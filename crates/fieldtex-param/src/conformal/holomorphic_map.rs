@@ -16,6 +16,8 @@
 //! compass search — a substitute for Jin et al.'s solver) and its zero points; then the critical
 //! horizontal trajectories through the zero points ([`super::critical_trajectories`])
 //! cut the surface into patches, each mapped by `∫φ` ([`super::translation_patches`]).
+//! Optionally ([`HOMOLOGY_LOOPS`], off: it did not shorten fertility's seams) a short
+//! homology basis ([`super::homology_loops`]) is cut first and the trajectories stop at it.
 
 use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
 use super::critical_trajectories::critical_trajectories;

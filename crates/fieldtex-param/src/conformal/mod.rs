@@ -12,7 +12,8 @@
 //!   trajectories through the zero points and each patch is mapped by integrating the
 //!   form; the patches are packed into one image, and [`translation_patches::Ghost`]s
 //!   across the cuts give the margins their partners
-//!   ([`ConformalMethod::CriticalTrajectoryPatches`]).
+//!   ([`ConformalMethod::CriticalTrajectoryPatches`]); optionally a short homology basis
+//!   ([`homology_loops`]) is cut as well.
 //!
 //! UVs are per corner: a triangle's corners are its local chart of `∫φ` moved into the
 //! fundamental domain by one lattice translation; corners may stick out of the domain by
