@@ -1,17 +1,19 @@
 //! Patch-layout probe for closed genus ≥ 2 meshes (issue 13):
 //! `cargo run --release -p fieldtex-param --example conformal_layout -- MESH.obj GENUS
-//! [TRAJECTORY_LENGTH] [PIECE_SIDE] [MERGE: 0|1]`.
+//! [TRAJECTORY_LENGTH] [PIECE_SIDE] [MERGE: 0|1] [LOOPS: 0|1]`.
 //!
 //! Runs [`holomorphic_map_with`] on a plain `v`/`f` triangle OBJ and prints the patch
 //! count, small patches, folded faces, the 3-D seam length (edges whose two faces
 //! disagree on a corner) relative to `√area`, the packing efficiency (UV area over the
-//! packed bounding box) and the layout time. No texture, no metrics of the pipeline:
+//! packed bounding box) and the layout time. The seam length is split into the part on
+//! snapped critical trajectories, on shortest homology loops (not trajectories) and
+//! elsewhere (fronts where a patch met itself, overlap-guard and folded-face charts). No texture, no metrics of the pipeline:
 //! a quick way to compare layout choices before running `bench/conformal_bench.sh`.
 
 use fieldtex_core::vec3;
 use fieldtex_mesh::{Topology, TriMesh};
 use fieldtex_param::conformal::holomorphic_map::{
-    PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with,
+    HOMOLOGY_LOOPS, PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with,
 };
 use fieldtex_param::conformal::periodic_uv::signed_area;
 use std::time::Instant;
@@ -27,15 +29,18 @@ fn main() -> Result<(), String> {
     let traj = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(TRAJECTORY_LENGTH);
     let piece = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(PIECE_SIDE);
     let merge = args.get(4).is_none_or(|s| s != "0");
+    let loops = args.get(5).map_or(HOMOLOGY_LOOPS, |s| s != "0");
     let mesh = load_mesh(path)?;
     let nf = mesh.n_triangles();
     let t = Instant::now();
-    let map =
-        holomorphic_map_with(&mesh, genus, nf, traj, piece, merge).map_err(|e| e.to_string())?;
+    let map = holomorphic_map_with(&mesh, genus, nf, traj, piece, merge, loops)
+        .map_err(|e| e.to_string())?;
     let secs = t.elapsed().as_secs_f64();
     let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
     let uv = |f: usize, v: u32| map.corner[f][(0..3).find(|&k| mesh.triangles[f][k] == v).unwrap()];
     let (mut seam, mut area, mut uv_area) = (0.0, 0.0, 0.0);
+    let (mut on_traj, mut on_loop) = (0.0, 0.0);
+    let flag = |v: &[bool], e: usize| v.get(e).is_some_and(|&c| c);
     let mut n_seam = 0;
     for e in 0..topo.n_edges() {
         let fs = topo.edge_faces(e);
@@ -47,7 +52,13 @@ fn main() -> Result<(), String> {
         let d = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
         if d(uv(f, a), uv(g, a)) + d(uv(f, b), uv(g, b)) > 1e-9 {
             n_seam += 1;
-            seam += vec3::norm(vec3::sub(mesh.positions[b as usize], mesh.positions[a as usize]));
+            let len = vec3::norm(vec3::sub(mesh.positions[b as usize], mesh.positions[a as usize]));
+            seam += len;
+            if flag(&map.trajectory_cut, e) {
+                on_traj += len;
+            } else if flag(&map.loop_cut, e) {
+                on_loop += len;
+            }
         }
     }
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -67,13 +78,17 @@ fn main() -> Result<(), String> {
     }
     let n_patches = map.patch.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
     println!(
-        "LAYOUT traj {traj} piece {piece} merge {merge}: patches {n_patches} (merges {}) small {} \
+        "LAYOUT traj {traj} piece {piece} merge {merge} loops {loops}: patches {n_patches} (merges {}) small {} \
          folded {} flipped {flipped} \
-         seam edges {n_seam} length {seam:.4} = {:.3} sqrt(area); packing {:.3}; {secs:.2} s",
+         seam edges {n_seam} length {seam:.4} = {:.3} sqrt(area) (trajectories {:.3}, loops {:.3}, \
+         elsewhere {:.3}); packing {:.3}; {secs:.2} s",
         map.patch_merges,
         map.small_patches,
         map.folded_faces,
         seam / area.sqrt(),
+        on_traj / area.sqrt(),
+        on_loop / area.sqrt(),
+        (seam - on_traj - on_loop) / area.sqrt(),
         uv_area / ((hi[0] - lo[0]) * (hi[1] - lo[1])),
     );
     Ok(())

@@ -49,8 +49,9 @@ pub struct Trajectory {
 
 /// Traces every critical horizontal trajectory of the form `d` (`#E` values of
 /// `(du, dv)`) from the `zeros`, in zero order and counter-clockwise fan order per zero,
-/// each at most `max_length` long. Returns the trajectories and a per-edge flag of the
-/// snapped cut edges.
+/// each at most `max_length` long. A trajectory also stops on reaching a vertex with
+/// `stop[v]` (cuts made before, e.g. homology loops; empty: none). Returns the
+/// trajectories and a per-edge flag of the snapped cut edges.
 pub fn critical_trajectories(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -58,13 +59,14 @@ pub fn critical_trajectories(
     d: &[[f64; 2]],
     zeros: &[u32],
     max_length: f64,
+    stop: &[bool],
 ) -> (Vec<Trajectory>, Vec<bool>) {
     let nv = positions.len();
     let mut is_zero = vec![false; nv];
     for &z in zeros {
         is_zero[z as usize] = true;
     }
-    let mut on_cut = vec![false; nv];
+    let mut on_cut: Vec<bool> = (0..nv).map(|v| stop.get(v).is_some_and(|&s| s)).collect();
     let mut cut_edge = vec![false; topology.n_edges()];
     let mut out = Vec::new();
     let pos = |v: u32| positions[v as usize];
@@ -175,7 +177,7 @@ mod tests {
             })
             .unwrap() as u32;
         let (tr, cut) =
-            critical_trajectories(&mesh.positions, &mesh.triangles, &topo, &d, &[z], 10.0);
+            critical_trajectories(&mesh.positions, &mesh.triangles, &topo, &d, &[z], 10.0, &[]);
         // A regular point has two horizontal directions (index 0 → 2 trajectories).
         assert_eq!(tr.len(), 2, "{tr:?}");
         for t in &tr {

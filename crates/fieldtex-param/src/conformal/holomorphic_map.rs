@@ -16,11 +16,14 @@
 //! compass search — a substitute for Jin et al.'s solver) and its zero points; then the critical
 //! horizontal trajectories through the zero points ([`super::critical_trajectories`])
 //! cut the surface into patches, each mapped by `∫φ` ([`super::translation_patches`]).
+//! Optionally ([`HOMOLOGY_LOOPS`], off: it did not shorten fertility's seams) a short
+//! homology basis ([`super::homology_loops`]) is cut first and the trajectories stop at it.
 
 use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
 use super::critical_trajectories::critical_trajectories;
 use super::harmonic_one_forms::{face_areas_normals, face_vectors, harmonic_projection};
 use super::holomorphic_basis::conjugates;
+use super::homology_loops::shortest_homology_basis;
 use super::periodic_uv::{Lattice, along2, integrate, reduce_basis, reduce_faces, signed_area};
 use super::seam_placement::shortest_level;
 use super::translation_patches::{PatchOptions, translation_patches};
@@ -40,6 +43,12 @@ pub const PIECE_SIDE: f64 = 3.0;
 pub const SEAM_LEVELS: usize = 64;
 /// Objective evaluations of the most-uniform-form search.
 pub const UNIFORM_FORM_EVALS: usize = 400;
+/// Cut genus ≥ 2 surfaces along the shortest homology loops as well as the critical
+/// trajectories ([`super::homology_loops`]).
+pub const HOMOLOGY_LOOPS: bool = false;
+/// Candidate base points (besides the zero points) whose loop systems feed the
+/// homology basis, spread by vertex index.
+pub const LOOP_BASES: usize = 32;
 /// Face rings drawn as ghosts beyond each cut (image margins, §4.2).
 pub const GHOST_RINGS: usize = 1;
 
@@ -51,11 +60,12 @@ pub fn holomorphic_map(
     genus: usize,
     n_keep: usize,
 ) -> Result<ComponentMap, ParamError> {
-    holomorphic_map_with(mesh, genus, n_keep, TRAJECTORY_LENGTH, PIECE_SIDE, true)
+    holomorphic_map_with(mesh, genus, n_keep, TRAJECTORY_LENGTH, PIECE_SIDE, true, HOMOLOGY_LOOPS)
 }
 
 /// [`holomorphic_map`] with the trajectory length budget (× `√area`), the patch piece
-/// side (× `√(UV area)`) and patch merging ([`super::patch_merging`]) given.
+/// side (× `√(UV area)`), patch merging ([`super::patch_merging`]) and the homology-loop
+/// cut ([`super::homology_loops`], genus ≥ 2) given.
 pub fn holomorphic_map_with(
     mesh: &TriMesh,
     genus: usize,
@@ -63,6 +73,7 @@ pub fn holomorphic_map_with(
     trajectory_length: f64,
     piece_side: f64,
     merge: bool,
+    loops: bool,
 ) -> Result<ComponentMap, ParamError> {
     let nv = mesh.n_vertices();
     let nf = mesh.n_triangles();
@@ -84,9 +95,11 @@ pub fn holomorphic_map_with(
         .collect();
     let lap = FixedLaplacian::new(&topo, &w, &fixed)?;
     let mut forms = Vec::with_capacity(tc.generators.len());
+    let mut cocycles = Vec::with_capacity(tc.generators.len());
     for &g in &tc.generators {
         let eta = tc.dual_loop_form(&topo, g);
         forms.push(harmonic_projection(&topo, &w, &lap, &eta)?);
+        cocycles.push(eta);
     }
     let xs: Vec<Vec<[f64; 3]>> =
         forms.iter().map(|om| face_vectors(&topo, &mesh.positions, tris, om, &keep)).collect();
@@ -128,6 +141,22 @@ pub fn holomorphic_map_with(
         }
         let zeros: Vec<u32> = zero_points.iter().map(|z| z.0).collect();
         let area: f64 = areas.iter().sum();
+        // A short homology basis opens every handle; the trajectories then split the
+        // cone angle at the zeros and stop at the loops.
+        let loop_cut = if loops {
+            let mut roots = zeros.clone();
+            roots.extend((0..nv as u32).step_by((nv / LOOP_BASES).max(1)));
+            shortest_homology_basis(&mesh.positions, &topo, &cocycles, &roots)
+                .map_or_else(|| vec![false; topo.n_edges()], |s| s.cut)
+        } else {
+            Vec::new()
+        };
+        let mut on_loop = vec![false; nv];
+        for (e, _) in loop_cut.iter().enumerate().filter(|(_, c)| **c) {
+            for v in topo.edges[e] {
+                on_loop[v as usize] = true;
+            }
+        }
         let (trajectories, cut) = critical_trajectories(
             &mesh.positions,
             tris,
@@ -135,14 +164,17 @@ pub fn holomorphic_map_with(
             &d,
             &zeros,
             trajectory_length * area.sqrt(),
+            &on_loop,
         );
+        let all_cut: Vec<bool> =
+            (0..cut.len()).map(|e| cut[e] || loop_cut.get(e).is_some_and(|&c| c)).collect();
         let kept: Vec<bool> = (0..nf).map(|f| f < n_keep).collect();
         let layout = translation_patches(
             &mesh.positions,
             tris,
             &topo,
             &d,
-            &cut,
+            &all_cut,
             &kept,
             PatchOptions { rings: GHOST_RINGS, piece_side, merge },
         );
@@ -162,6 +194,8 @@ pub fn holomorphic_map_with(
             folded_faces: layout.folded,
             patch_merges: layout.merges,
             stretch_cv: Some([uniform.cv_basis, uniform.cv]),
+            trajectory_cut: cut,
+            loop_cut,
             ..ComponentMap::empty(ConformalMethod::CriticalTrajectoryPatches)
         });
     }

@@ -12,7 +12,8 @@
 //!   trajectories through the zero points and each patch is mapped by integrating the
 //!   form; the patches are packed into one image, and [`translation_patches::Ghost`]s
 //!   across the cuts give the margins their partners
-//!   ([`ConformalMethod::CriticalTrajectoryPatches`]).
+//!   ([`ConformalMethod::CriticalTrajectoryPatches`]); optionally a short homology basis
+//!   ([`homology_loops`]) is cut as well.
 //!
 //! UVs are per corner: a triangle's corners are its local chart of `∫φ` moved into the
 //! fundamental domain by one lattice translation; corners may stick out of the domain by
@@ -27,6 +28,7 @@ pub mod harmonic_one_forms;
 pub mod hole_caps;
 pub mod holomorphic_basis;
 pub mod holomorphic_map;
+pub mod homology_loops;
 pub mod mass_spring;
 pub mod patch_merging;
 pub mod periodic_uv;
@@ -108,6 +110,11 @@ pub struct ComponentMap {
     pub patch_merges: usize,
     /// Area-stretch CV of the best basis form and of the optimised form (genus ≥ 2).
     pub stretch_cv: Option<[f64; 2]>,
+    /// Per capped edge: on a snapped critical trajectory (genus ≥ 2; empty otherwise).
+    pub trajectory_cut: Vec<bool>,
+    /// Per capped edge: on a shortest homology loop (genus ≥ 2 with the loop cut; empty
+    /// otherwise).
+    pub loop_cut: Vec<bool>,
 }
 
 impl ComponentMap {
@@ -131,6 +138,8 @@ impl ComponentMap {
             stretch_cv: None,
             folded_faces: 0,
             patch_merges: 0,
+            trajectory_cut: Vec::new(),
+            loop_cut: Vec::new(),
         }
     }
 

@@ -328,7 +328,8 @@ fn patch_merging_keeps_every_chart_injective_and_shortens_the_seams() {
     use holomorphic_map::{PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with};
     let mesh = genus_two_slab(4);
     let nf = mesh.n_triangles();
-    let run = |merge| holomorphic_map_with(&mesh, 2, nf, TRAJECTORY_LENGTH, PIECE_SIDE, merge);
+    let run =
+        |merge| holomorphic_map_with(&mesh, 2, nf, TRAJECTORY_LENGTH, PIECE_SIDE, merge, false);
     let (plain, merged) = (run(false).unwrap(), run(true).unwrap());
     assert_eq!(plain.patch_merges, 0);
     assert!(merged.patch_merges > 0, "nothing merged");
@@ -446,4 +447,164 @@ pub(super) fn keep_faces(
 ) -> fieldtex_mesh::TriMesh {
     let tris = mesh.triangles.iter().enumerate().filter(|(f, t)| keep(*f, t)).map(|(_, t)| *t);
     fieldtex_mesh::TriMesh::new(mesh.positions.clone(), tris.collect())
+}
+
+/// The surface cut open along `cut` (per edge): its face components over uncut edges
+/// and its Euler characteristic (a vertex with `k ≥ 1` cut edges becomes `k` copies,
+/// a cut edge two).
+fn cut_open(mesh: &fieldtex_mesh::TriMesh, cut: &[bool]) -> (usize, i64) {
+    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
+    let mut at = vec![0i64; mesh.n_vertices()];
+    let mut faces = fieldtex_mesh::UnionFind::new(mesh.n_triangles());
+    let mut n_cut = 0i64;
+    for (e, &is_cut) in cut.iter().enumerate() {
+        let fs = topo.edge_faces(e);
+        if is_cut {
+            n_cut += 1;
+            for v in topo.edges[e] {
+                at[v as usize] += 1;
+            }
+        } else {
+            faces.union(fs[0] as usize, fs[1] as usize);
+        }
+    }
+    let roots: std::collections::BTreeSet<usize> =
+        (0..mesh.n_triangles()).map(|f| faces.find(f)).collect();
+    let v: i64 = at.iter().map(|&k| k.max(1)).sum();
+    let chi = v - (topo.n_edges() as i64 + n_cut) + mesh.n_triangles() as i64;
+    (roots.len(), chi)
+}
+
+/// Whether the closed 1-form `eta` (per edge, low → high) integrates to one value per
+/// vertex on every face component of the surface cut along `cut`.
+fn single_valued(
+    mesh: &fieldtex_mesh::TriMesh,
+    topo: &fieldtex_mesh::Topology,
+    eta: &[f64],
+    cut: &[bool],
+) -> bool {
+    let d: Vec<[f64; 2]> = eta.iter().map(|&x| [x, 0.0]).collect();
+    let nf = mesh.n_triangles();
+    let mut pot: Vec<Option<[f64; 3]>> = vec![None; nf];
+    let corner = |f: usize, v: u32| (0..3).find(|&k| mesh.triangles[f][k] == v).unwrap();
+    for seed in 0..nf {
+        if pot[seed].is_some() {
+            continue;
+        }
+        let at = |f: usize, k: usize, p0: f64| {
+            let mut c = [0.0; 3];
+            for (j, cj) in c.iter_mut().enumerate() {
+                *cj = if j == k { p0 } else { p0 + periodic_uv::along2(topo, &d, f, k, j)[0] };
+            }
+            c
+        };
+        pot[seed] = Some(at(seed, 0, 0.0));
+        let mut stack = vec![seed];
+        while let Some(f) = stack.pop() {
+            for &e in &topo.face_edges[f] {
+                if cut[e as usize] {
+                    continue;
+                }
+                for &g in topo.edge_faces(e as usize) {
+                    let g = g as usize;
+                    if pot[g].is_none() {
+                        let v = topo.edges[e as usize][0];
+                        let p = pot[f].unwrap()[corner(f, v)];
+                        pot[g] = Some(at(g, corner(g, v), p));
+                        stack.push(g);
+                    }
+                }
+            }
+        }
+    }
+    (0..topo.n_edges()).filter(|&e| !cut[e]).all(|e| {
+        let fs = topo.edge_faces(e);
+        let (f, g) = (fs[0] as usize, fs[1] as usize);
+        topo.edges[e]
+            .iter()
+            .all(|&v| (pot[f].unwrap()[corner(f, v)] - pot[g].unwrap()[corner(g, v)]).abs() < 1e-9)
+    })
+}
+
+#[test]
+fn shortest_homology_loops_cut_every_period() {
+    use homology_loops::{loop_system, shortest_loop_system};
+    for (mesh, genus) in [(primitives::torus(1.0, 0.35, 24, 10), 1), (genus_two_slab(3), 2)] {
+        let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
+        let roots: Vec<u32> = (0..mesh.n_vertices() as u32).step_by(7).collect();
+        let best = shortest_loop_system(&mesh.positions, &topo, &roots).unwrap();
+        assert_eq!(best.closing_edges.len(), 2 * genus);
+        // Connected, and no period survives: every tree–cotree cocycle integrates to a
+        // single-valued function on the cut-open surface.
+        assert_eq!(cut_open(&mesh, &best.cut).0, 1, "genus {genus}: cut in pieces");
+        let tc = tree_cotree::tree_cotree(&topo);
+        for &g in &tc.generators {
+            let eta = tc.dual_loop_form(&topo, g);
+            assert!(single_valued(&mesh, &topo, &eta, &best.cut), "genus {genus}: a period");
+            assert!(!single_valued(&mesh, &topo, &eta, &vec![false; topo.n_edges()]));
+        }
+        if genus == 1 {
+            // Two crossing loops on a torus: the cut graph opens it into one disk.
+            assert_eq!(cut_open(&mesh, &best.cut), (1, 1));
+        }
+        for &r in &roots {
+            let s = loop_system(&mesh.positions, &topo, r);
+            assert_eq!(s.closing_edges.len(), 2 * genus);
+            assert!(best.length <= s.length, "root {r}: {} < best {}", s.length, best.length);
+        }
+        // Deterministic: the same roots give the same cut.
+        assert_eq!(shortest_loop_system(&mesh.positions, &topo, &roots).unwrap().cut, best.cut);
+    }
+    // On the torus (R = 1, r = 0.35) the shortest system is one meridian and the inner
+    // equator (polygon lengths 2.16 + 4.07); any longitude elsewhere is longer.
+    let torus = primitives::torus(1.0, 0.35, 24, 10);
+    let topo = fieldtex_mesh::Topology::build(torus.n_vertices(), &torus.triangles);
+    let all: Vec<u32> = (0..torus.n_vertices() as u32).collect();
+    let len = shortest_loop_system(&torus.positions, &topo, &all).unwrap().length;
+    assert!((6.0..6.5).contains(&len), "torus cut graph {len}");
+}
+
+#[test]
+fn greedy_homology_basis_is_no_longer_than_the_best_loop_system_and_keeps_charts_injective() {
+    use holomorphic_map::{PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with};
+    use homology_loops::{loop_system, shortest_homology_basis};
+    let mesh = genus_two_slab(3);
+    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
+    let tc = tree_cotree::tree_cotree(&topo);
+    let cocycles: Vec<Vec<f64>> =
+        tc.generators.iter().map(|&g| tc.dual_loop_form(&topo, g)).collect();
+    let roots: Vec<u32> = (0..mesh.n_vertices() as u32).step_by(5).collect();
+    let basis = shortest_homology_basis(&mesh.positions, &topo, &cocycles, &roots).unwrap();
+    assert_eq!(basis.loops.len(), 4);
+    // Greedy over a matroid: the least total loop length among bases of the pool.
+    let sum = |loops: &[(Vec<u32>, f64)]| loops.iter().map(|l| l.1).sum::<f64>();
+    for &r in &roots {
+        let s = loop_system(&mesh.positions, &topo, r);
+        assert!(sum(&basis.loops) <= sum(&s.loops) + 1e-9, "root {r}");
+    }
+    // Every basis loop is closed: each vertex meets an even number of its edges.
+    for (edges, _) in &basis.loops {
+        let mut deg = vec![0usize; mesh.n_vertices()];
+        for &e in edges {
+            for v in topo.edges[e as usize] {
+                deg[v as usize] += 1;
+            }
+        }
+        assert!(deg.iter().all(|d| d % 2 == 0));
+    }
+    // With the loop cut the layout stays injective, and is the same when run twice.
+    let nf = mesh.n_triangles();
+    let run = || holomorphic_map_with(&mesh, 2, nf, TRAJECTORY_LENGTH, PIECE_SIDE, true, true);
+    let (m, again) = (run().unwrap(), run().unwrap());
+    assert!(m.loop_cut.iter().any(|&c| c));
+    for f in 0..nf {
+        assert!(periodic_uv::signed_area(&m.corner[f]) > 0.0, "face {f} flipped");
+        for g in f + 1..nf {
+            assert!(!translation_patches::triangles_overlap(&m.corner[f], &m.corner[g]));
+        }
+    }
+    assert_eq!(m.patch, again.patch);
+    let bits =
+        |c: &[[[f64; 2]; 3]]| c.iter().flatten().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&m.corner), bits(&again.corner));
 }

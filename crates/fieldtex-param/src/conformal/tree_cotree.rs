@@ -32,16 +32,22 @@ pub fn edge_sign_in_face(topology: &Topology, f: usize, e: u32) -> f64 {
         .map_or(0.0, |k| topology.face_edge_signs[f][k] as f64)
 }
 
+/// Per vertex: its incident edges, in increasing edge order.
+pub fn vertex_edges(topology: &Topology) -> Vec<Vec<u32>> {
+    let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); topology.n_vertices];
+    for (e, ed) in topology.edges.iter().enumerate() {
+        vertex_edges[ed[0] as usize].push(e as u32);
+        vertex_edges[ed[1] as usize].push(e as u32);
+    }
+    vertex_edges
+}
+
 /// Builds the decomposition with breadth-first trees rooted at vertex 0 and face 0.
 pub fn tree_cotree(topology: &Topology) -> TreeCotree {
     let nv = topology.n_vertices;
     let ne = topology.n_edges();
     let nf = topology.n_faces();
-    let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); nv];
-    for (e, ed) in topology.edges.iter().enumerate() {
-        vertex_edges[ed[0] as usize].push(e as u32);
-        vertex_edges[ed[1] as usize].push(e as u32);
-    }
+    let vertex_edges = vertex_edges(topology);
     let mut in_tree = vec![false; ne];
     let mut seen = vec![false; nv];
     let mut queue = VecDeque::new();

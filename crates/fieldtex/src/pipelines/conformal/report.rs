@@ -80,6 +80,11 @@ pub(super) fn component_json(
         v["patches"] = json!(c.map.n_patches());
         if c.method == ConformalMethod::CriticalTrajectoryPatches {
             v["critical_trajectories"] = json!(c.map.cut_curves.len());
+            let count = |cut: &[bool]| cut.iter().filter(|&&x| x).count();
+            v["trajectory_cut_edges"] = json!(count(&c.map.trajectory_cut));
+            // Homology-basis cut (Erickson & Whittlesey 2005; off by default), a
+            // substitute for the paper's closed critical trajectories.
+            v["homology_loop_cut_edges"] = json!(count(&c.map.loop_cut));
             v["small_patches_from_overlap_guard"] = json!(c.map.small_patches);
             v["ghost_faces"] = json!(c.map.ghosts.len());
             v["folded_faces_own_chart"] = json!(c.map.folded_faces);
@@ -145,7 +150,10 @@ pub(super) fn add_notes(
         n.push("Genus 0 (the paper is silent): two point slits (vertex stars) at extremal vertices; harmonic u = 0/1 on their rings and its conjugate from the annulus's harmonic 1-form give one cylinder image, periodic across one seam.".into());
     }
     if comps.iter().any(|c| c.method == ConformalMethod::CriticalTrajectoryPatches) {
-        n.push("Genus ≥ 2: the critical horizontal trajectories are traced from every zero point across triangles and snapped to edge paths (cuts lie within one triangle of the exact curves); a trajectory stops at a zero point, at an earlier cut or after √(area) of length, because on a discrete form they spiral instead of closing (the paper picks a form with finite trajectories). Patches grow over faces without crossing cuts and are mapped by integrating the form; a face that would overlap its patch seeds a new patch (overlap guard); then patches whose charts differ by a translation across a shared edge are merged, longest shared seam first, whenever the union stays injective (patch_merges), and folded faces next to zero points join a neighbouring patch as a similar triangle on their shared edge where it fits (the rest: folded_faces_own_chart); single faces then move across a seam to their translate when that shortens the seams around them and overlaps nothing (a greedy local descent). Patches are packed without rotation into one image; faces up to 2 rings across each cut are drawn as ghosts in the margins, linked texel to texel (nearest texel after the translation, ≤ ½ texel misregistration) for boundary consistency.".into());
+        n.push("Genus ≥ 2: the critical horizontal trajectories are traced from every zero point across triangles and snapped to edge paths (cuts lie within one triangle of the exact curves); a trajectory stops at a zero point, at an earlier cut or after 0.15 √(area) of length, because on a discrete form they spiral instead of closing (the paper picks a form with finite trajectories). Patches grow over faces without crossing cuts and are mapped by integrating the form; a face that would overlap its patch seeds a new patch (overlap guard); then patches whose charts differ by a translation across a shared edge are merged, longest shared seam first, whenever the union stays injective (patch_merges), and folded faces next to zero points join a neighbouring patch as a similar triangle on their shared edge where it fits (the rest: folded_faces_own_chart); single faces then move across a seam to their translate when that shortens the seams around them and overlaps nothing (a greedy local descent). Patches are packed without rotation into one image; faces up to 2 rings across each cut are drawn as ghosts in the margins, linked texel to texel (nearest texel after the translation, ≤ ½ texel misregistration) for boundary consistency.".into());
+        if comps.iter().any(|c| c.map.loop_cut.iter().any(|&x| x)) {
+            n.push("Genus ≥ 2: the surface was also cut along a short homology basis (Erickson & Whittlesey 2005: greedy Z₂-independent loops pooled from the shortest-path-tree loop systems of the zero points and 32 sampled base vertices), a substitute for the paper's closed critical trajectories; trajectories stop at these loops (homology_loop_cut_edges).".into());
+        }
         n.push("The genus ≥ 2 holomorphic form minimises the area-weighted CV of |φ|² over all holomorphic forms by a compass search from the best basis form — a substitute for Jin et al. 2004's own solver (both CVs reported).".into());
         if options.quasi_isometric {
             n.push("Mass-spring relaxation is not applied to genus ≥ 2 patch layouts (it would break the translation links across cuts).".into());
