@@ -6,8 +6,8 @@
 //! Why it is sound: a dislocation is a topological point of the stripe phase (its
 //! winding is ±2π on any loop around it), and a 2×2 box mean followed by decimation is
 //! a low-pass filter with no effect on the phase of stripes much longer than 2 pixels
-//! (the box's response at period `T` is `sinc(2/T)`-like, above 0.95 for `T ≥ 10` px in
-//! the original pixels), so the phase field, and with it the windings, survive the
+//! (the 2-tap mean's response at period `T` is `cos(π/T)` per axis, above 0.95 for
+//! `T ≥ 10` px in the original pixels), so the phase field, and with it the windings, survive the
 //! reduction; every length of the method (period, Gabor envelope, smoothing, merge
 //! radius, singular cores) is in periods and halves with the image. The cost of the
 //! count after the period estimate falls about 8× (a quarter of the pixels, half the
@@ -19,8 +19,8 @@
 //! 6.9 px at full resolution, and half the defects). The reduction is used only when
 //! that period is at least [`MIN_COARSE_PERIOD_PX`] reduced pixels (the Gabor bank of
 //! [`phase_defects`] resolves the phase well above that); otherwise the
-//! full-resolution method runs with the period already estimated. Positions, period and pixel counts
-//! are reported in the original image's pixels.
+//! full-resolution method runs with the period already estimated. Positions, period
+//! and pixel counts are reported in the original image's pixels.
 
 use crate::EvalError;
 use crate::image_view::ImageView;
@@ -32,9 +32,10 @@ use crate::phase_defects::{
 /// of the original image).
 pub const MIN_COARSE_PERIOD_PX: f64 = 5.0;
 
-/// Stated bound of the reduced count against the full-resolution one on the test
-/// inputs: `|coarse − exact| ≤ COARSE_ERROR_BOUND.0 + COARSE_ERROR_BOUND.1 · exact`
-/// (defects, share of the exact count).
+/// Stated bound of the reduced count against the full-resolution one on the striped
+/// test inputs (at least half the loops pass the stripe gates):
+/// `|coarse − exact| ≤ COARSE_ERROR_BOUND.0 + COARSE_ERROR_BOUND.1 · exact` (defects,
+/// share of the exact count). Measured values: `docs/perf/orient.md`.
 pub const COARSE_ERROR_BOUND: (f64, f64) = (2.0, 0.15);
 
 /// 2×2 box means of `image` (`⌊w/2⌋ × ⌊h/2⌋`; an odd last row or column is dropped).
