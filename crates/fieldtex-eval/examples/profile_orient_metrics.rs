@@ -110,7 +110,14 @@ fn main() {
         .unwrap()
     });
     let g = stage("guided_coherence", || {
-        let o = GuidedCoherenceOptions { approximate: approximate.clone(), ..Default::default() };
+        // `--guided-stride S` tries another query step.
+        let stride =
+            arg("--guided-stride").map_or(GuidedCoherenceOptions::default().stride, |s| s as usize);
+        let o = GuidedCoherenceOptions {
+            approximate: approximate.clone(),
+            stride,
+            ..Default::default()
+        };
         guided_coherence(&ov, &ev, &fv, &o).unwrap()
     });
     let oe = stage("orientation_error", || {
@@ -121,7 +128,11 @@ fn main() {
         let map = image_orientation(&ov, &OrientationOptions::default()).unwrap();
         singularities(&map, &SingularityOptions::default())
     });
-    let pd = stage("phase_defects", || phase_defects(&ov, &PhaseDefectOptions::default()).unwrap());
+    // The facade's default counts phase defects on the image reduced 2×.
+    let pd = stage("phase_defects", || {
+        let o = PhaseDefectOptions::default();
+        if exact { phase_defects(&ov, &o) } else { coarse_phase_defects(&ov, &o) }.unwrap()
+    });
     println!(
         "STAGE {:28} {:8.1} ms wall {:8.0} ms cpu",
         "total",

@@ -11,7 +11,8 @@
 //! - [`contrast_sharpness()`]: luminance contrast and gradient ratios against the exemplar;
 //! - [`orientation_error`]: structure-tensor feature direction vs a guidance field;
 //! - [`singularities()`]: ±1/2 singularities of an orientation map;
-//! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px;
+//! - [`phase_defects()`]: stripe breaks (dislocations) per 10⁴ px; [`coarse_phase_defects`]
+//!   counts them on the image reduced 2× (the fast reports' default, measured error);
 //! - [`rosy_seam_coherence`]: coherent exemplar coordinates across a 2-RoSy field's
 //!   representation jumps vs image-wide (paper D's seams);
 //! - [`surface_orientation_error`]: orientation error on a textured mesh by
@@ -24,6 +25,7 @@
 //! printing; results are identical for any number of rayon threads.
 
 pub mod approximate_nearest_patch;
+pub mod coarse_phase_defects;
 pub mod coherence;
 pub mod color_sliced_wasserstein;
 pub mod completeness;
@@ -46,6 +48,7 @@ pub mod surface_metrics;
 pub mod transfer_fidelity;
 
 pub use approximate_nearest_patch::ApproximateSearchOptions;
+pub use coarse_phase_defects::coarse_phase_defects;
 pub use coherence::coherence;
 pub use color_sliced_wasserstein::{
     SlicedWassersteinOptions, SlicedWassersteinReport, color_sliced_wasserstein,

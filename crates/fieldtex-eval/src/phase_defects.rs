@@ -100,6 +100,10 @@ pub struct PhaseDefectReport {
     /// Fraction of the evaluated loops that passed the gates (how much of the image
     /// looks like stripes at all).
     pub striped_fraction: f64,
+    /// Reduction of the image the count was made on: 1 = full resolution, 2 = the 2×
+    /// reduction of [`crate::coarse_phase_defects()`] (positions and pixel counts are in
+    /// full-resolution pixels either way).
+    pub reduction: usize,
 }
 
 fn check_image(image: &ImageView, min: usize) -> Result<(), EvalError> {
@@ -389,6 +393,7 @@ pub fn phase_defects(
             period_px: t,
             evaluated_pixels: 0,
             striped_fraction: 0.0,
+            reduction: 1,
         });
     }
     let mid = inner.len() / 2;
@@ -457,6 +462,7 @@ pub fn phase_defects(
         period_px: t,
         evaluated_pixels,
         striped_fraction: if total > 0 { passed as f64 / total as f64 } else { 0.0 },
+        reduction: 1,
     })
 }
 

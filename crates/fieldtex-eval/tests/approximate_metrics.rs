@@ -167,3 +167,84 @@ fn sampled_sliced_wasserstein_stays_within_the_stated_bound() {
         }
     }
 }
+
+/// Stripes of period `period` along x (grey, `size²`) with dislocations of charge ±1 at
+/// `points` (`[x, y, sign]`): the phase is `k·y + Σ sign·atan2(y − y₀, x − x₀)`.
+fn dislocated_stripes(size: usize, period: f64, points: &[[f64; 3]]) -> Vec<f32> {
+    let k = 2.0 * std::f64::consts::PI / period;
+    let mut v = Vec::with_capacity(size * size);
+    for y in 0..size {
+        for x in 0..size {
+            let (xf, yf) = (x as f64 + 0.5, y as f64 + 0.5);
+            let phase: f64 =
+                k * yf + points.iter().map(|p| p[2] * (yf - p[1]).atan2(xf - p[0])).sum::<f64>();
+            v.push((0.5 + 0.4 * phase.cos()) as f32);
+        }
+    }
+    v
+}
+
+/// The phase defects of the fast reports (counted on the image reduced 2×) against the
+/// full-resolution count: within `COARSE_ERROR_BOUND` on the striped ones of the
+/// patchworks of the four test exemplars and of the stripes exemplar enlarged 2× and 3×
+/// (periods of about 12–19 px, as in orient's outputs), and exactly the planted
+/// dislocations of synthetic stripes at periods 12–24 px.
+#[test]
+fn coarse_phase_defects_stay_within_the_stated_bound() {
+    use fieldtex_eval::coarse_phase_defects::COARSE_ERROR_BOUND;
+    let opts = PhaseDefectOptions::default();
+    let check = |what: &str, data: &[f32], size: usize, channels: usize| {
+        let v = ImageView::new(data, size, size, channels).unwrap();
+        let (exact, coarse) =
+            (phase_defects(&v, &opts).unwrap(), coarse_phase_defects(&v, &opts).unwrap());
+        let (e, c) = (exact.count as f64, coarse.count as f64);
+        eprintln!(
+            "{what}: phase defects exact {e} (period {:.2}, striped {:.3}) coarse {c} \
+             (period {:.2}, striped {:.3}, reduction {}; {:+})",
+            exact.period_px,
+            exact.striped_fraction,
+            coarse.period_px,
+            coarse.striped_fraction,
+            coarse.reduction,
+            c - e
+        );
+        // The bound is stated for striped images (half the loops pass the stripe
+        // gates); the ×3 patchwork (16-px blocks of 39-px stripes) is not one.
+        assert!(
+            exact.striped_fraction < 0.5
+                || (c - e).abs() <= COARSE_ERROR_BOUND.0 + COARSE_ERROR_BOUND.1 * e,
+            "{what}: coarse {c} vs exact {e}"
+        );
+        coarse
+    };
+    let size = 384;
+    for name in TEST_EXEMPLARS {
+        let (ex, w, h) = load(name);
+        check(name, &patchwork(&ex, w, h, size, 7), size, 3);
+    }
+    // The stripes exemplar enlarged (nearest neighbour) so its period reaches the
+    // reduced range.
+    let (ex, w, h) = load(TEST_EXEMPLARS[0]);
+    for f in [2usize, 3] {
+        let big: Vec<f32> = (0..w * f * h * f * 3)
+            .map(|i| {
+                let (p, ch) = (i / 3, i % 3);
+                let (x, y) = (p % (w * f) / f, p / (w * f) / f);
+                ex[(y * w + x) * 3 + ch]
+            })
+            .collect();
+        let pw = patchwork(&big, w * f, h * f, size, 7);
+        let r = check(&format!("stripes ×{f} patchwork"), &pw, size, 3);
+        assert_eq!(r.reduction, 2, "the enlarged stripes are counted reduced");
+    }
+    let planted = [[70.3, 90.8, 1.0], [190.0, 150.4, -1.0], [120.6, 200.2, 1.0]];
+    for period in [12.0, 14.0, 18.0, 24.0] {
+        let img = dislocated_stripes(256, period, &planted);
+        let r = check(&format!("planted, period {period}"), &img, 256, 1);
+        assert_eq!(r.reduction, 2);
+        assert_eq!(r.count, 3, "period {period}: {r:?}");
+        for p in &planted {
+            assert_eq!(count_defects_near(&r.defects, &[[p[0], p[1]]], 0.5 * period), 1, "{r:?}");
+        }
+    }
+}

@@ -178,14 +178,19 @@ pub(crate) fn image_metrics(
                  is at most {}% above the exact distances on the test exemplars; \
                  color_sliced_wasserstein uses a \
                  seeded sample of about {} pixels per image, within {} + {}% of the all-pixel \
-                 value on the test exemplars (docs/perf/orient.md); --exact-metrics for the \
-                 exhaustive versions",
+                 value on the test exemplars; phase_defects are counted on the image reduced \
+                 2× where the stripe period is at least {} px (phase_defects.reduction), \
+                 within {} + {}% of the full-resolution count on the test inputs \
+                 (docs/perf/orient.md); --exact-metrics for the exhaustive versions",
                 ev::ApproximateSearchOptions::default().sampled_queries,
                 ev::query_sampling::RUN_LENGTH,
                 ev::approximate_nearest_patch::ERROR_BOUND_PERCENT,
                 ev::color_sliced_wasserstein::SAMPLED_PIXELS,
                 ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_ABS,
                 ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_PERCENT,
+                2.0 * ev::coarse_phase_defects::MIN_COARSE_PERIOD_PX,
+                ev::coarse_phase_defects::COARSE_ERROR_BOUND.0,
+                100.0 * ev::coarse_phase_defects::COARSE_ERROR_BOUND.1,
             );
             search + coverage_note
         },
@@ -256,7 +261,11 @@ fn other_metrics(
         }
     };
     progress.advance(1);
-    let phase_defects = match ev::phase_defects(o, &ev::PhaseDefectOptions::default()) {
+    // Default: counted on the image reduced 2× where the stripes are long enough (the
+    // gap to full resolution is pinned by fieldtex-eval's tests/approximate_metrics.rs).
+    let pdo = ev::PhaseDefectOptions::default();
+    let pd = if exact { ev::phase_defects(o, &pdo) } else { ev::coarse_phase_defects(o, &pdo) };
+    let phase_defects = match pd {
         Ok(r) => Some(r),
         Err(err) => {
             skipped.push(format!("phase_defects: {err}"));

@@ -268,20 +268,17 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     fieldtex_io::write_npy_f32(&stage.join("coords.npy"), &[n, n, 2], &coords)?;
     report.metric("designed_singularities", &designed);
     if options.metrics {
-        let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-        let (mut metrics, _) = texture_metrics(
+        orient_metrics(
             &mut report,
-            synth,
+            &result,
             &exemplar,
             &flat,
-            Some(&coords[..]),
-            &pts,
+            &coords,
+            &designed,
+            per_pixel,
             options,
             progress,
         )?;
-        metrics.rosy_seam =
-            Some(seam_metric(&coords, &flat, &result.flips, n, &exemplar, per_pixel)?);
-        report.metric("texture", &metrics);
     } else {
         report.notes.push("image metrics skipped (--no-metrics)".into());
     }
@@ -312,23 +309,45 @@ pub(crate) fn orient_in_memory(
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     report.metric("designed_singularities", &designed);
     if options.metrics {
-        let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
         let coords: Vec<f32> = result.coords.iter().flat_map(|c| [c[0], c[1]]).collect();
-        let (mut metrics, _) = texture_metrics(
-            report,
-            synth,
-            exemplar,
-            &flat,
-            Some(&coords[..]),
-            &pts,
-            options,
-            progress,
+        orient_metrics(
+            report, &result, exemplar, &flat, &coords, &designed, per_pixel, options, progress,
         )?;
-        metrics.rosy_seam =
-            Some(seam_metric(&coords, &flat, &result.flips, n, exemplar, per_pixel)?);
-        report.metric("texture", &metrics);
     }
     Ok(preview_with_singularities(synth, &designed))
+}
+
+/// The metric stage of both orient pipelines: the texture metrics of the synthesis
+/// `result` (field `flat`, exemplar coordinates `coords`, both `H×W×2`) with the phase
+/// defects near the `designed` singularities, and the seam measure, into
+/// `report`'s `texture` metrics.
+#[allow(clippy::too_many_arguments)]
+fn orient_metrics(
+    report: &mut Report,
+    result: &fieldtex_synth::SynthesisResult,
+    exemplar: &Image,
+    flat: &[f32],
+    coords: &[f32],
+    designed: &[DesignedSingularity],
+    per_pixel: f64,
+    options: &OrientOptions,
+    progress: &dyn Progress,
+) -> Result<()> {
+    let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
+    let (mut metrics, _) = texture_metrics(
+        report,
+        &result.colors,
+        exemplar,
+        flat,
+        Some(coords),
+        &pts,
+        options,
+        progress,
+    )?;
+    let seam = seam_metric(coords, flat, &result.flips, options.size, exemplar, per_pixel)?;
+    metrics.rosy_seam = Some(seam);
+    report.metric("texture", &metrics);
+    Ok(())
 }
 
 /// The seam measure (`fieldtex_eval::rosy_seam`) of an `n × n` synthesis: its exemplar
