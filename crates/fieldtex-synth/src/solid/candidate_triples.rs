@@ -51,14 +51,6 @@ impl CandidateTriples {
         let pixel = wrapped(y, self.height) * self.width + wrapped(x, self.width);
         &self.triples[pixel * self.n_t + k]
     }
-
-    /// Asks the CPU to fetch pixel `(x, y)`'s first candidates ahead of [`Self::get`]
-    /// (no effect on results).
-    #[inline]
-    pub fn prefetch(&self, x: i32, y: i32) {
-        let pixel = wrapped(y, self.height) * self.width + wrapped(x, self.width);
-        crate::prefetch::prefetch_read(&self.triples[pixel * self.n_t]);
-    }
 }
 
 /// The first `k` candidates of every pixel of one [`CandidateTriples`] table, with the
