@@ -51,13 +51,47 @@ impl CandidateTriples {
         let pixel = wrapped(y, self.height) * self.width + wrapped(x, self.width);
         &self.triples[pixel * self.n_t + k]
     }
+}
 
-    /// Asks the CPU to fetch pixel `(x, y)`'s first candidates ahead of [`Self::get`]
-    /// (no effect on results).
+/// The first `k` candidates of every pixel of one [`CandidateTriples`] table, with the
+/// coordinates as `u16`: what the correction reads (it takes `k` of the `N_T`), packed
+/// `k` to a pixel so that a predicted pixel's candidates share one or two cache lines
+/// instead of sitting `N_T` triples apart (12 bytes a triple instead of 24; with the
+/// defaults 24 bytes a pixel instead of 288). The same triples, so the same results.
+#[derive(Clone, Debug)]
+pub(crate) struct CandidateHeads {
+    width: usize,
+    height: usize,
+    k: usize,
+    triples: Vec<[[u16; 2]; 3]>,
+}
+
+impl CandidateHeads {
+    /// The first `k` (at most `N_T`) candidates of every pixel of `table`, whose
+    /// coordinates lie inside their exemplars (below `2¹⁶`, as every table's do).
+    pub(crate) fn new(table: &CandidateTriples, k: usize) -> Self {
+        let k = k.clamp(1, table.n_t);
+        let mut triples = Vec::with_capacity(table.width * table.height * k);
+        for pixel in table.triples.chunks_exact(table.n_t) {
+            triples.extend(pixel[..k].iter().map(|t| t.map(|xy| xy.map(|v| v as u16))));
+        }
+        Self { width: table.width, height: table.height, k, triples }
+    }
+
+    /// The `kk`-th candidate (`kk < k`) of pixel `(x, y)` (wrapped), as
+    /// [`CandidateTriples::get`] gives it.
     #[inline]
-    pub fn prefetch(&self, x: i32, y: i32) {
+    pub(crate) fn get(&self, x: i32, y: i32, kk: usize) -> Triple {
         let pixel = wrapped(y, self.height) * self.width + wrapped(x, self.width);
-        crate::prefetch::prefetch_read(&self.triples[pixel * self.n_t]);
+        self.triples[pixel * self.k + kk].map(|xy| xy.map(i32::from))
+    }
+
+    /// Asks the CPU to fetch pixel `(x, y)`'s candidates ahead of [`Self::get`] (no
+    /// effect on results).
+    #[inline]
+    pub(crate) fn prefetch(&self, x: i32, y: i32) {
+        let pixel = wrapped(y, self.height) * self.width + wrapped(x, self.width);
+        crate::prefetch::prefetch_read(&self.triples[pixel * self.k]);
     }
 }
 
@@ -119,20 +153,46 @@ fn keep(best: &mut Vec<(f32, usize)>, d: f32, q: usize) {
     }
 }
 
+/// The pool pixels' sticks transposed, stick element-major (`len` rows of one value
+/// per pool pixel), so that the pool scan computes the distances of all pool pixels
+/// at once (one vector lane per pixel) while each still sums its squared differences
+/// in stick order, exactly as [`dist2`] does.
+fn pool_sticks(sticks: &[f32], len: usize, pool: &[usize]) -> Vec<f32> {
+    let mut out = vec![0.0f32; len * pool.len()];
+    for (i, &q) in pool.iter().enumerate() {
+        for k in 0..len {
+            out[k * pool.len() + i] = sticks[q * len + k];
+        }
+    }
+    out
+}
+
 /// The `K₁` pixels whose `stick(q)` is nearest `query`: the best of the pool, then the
 /// best of the full-resolution `stride × stride` cells around those (module docs).
+/// `pooled` is [`pool_sticks`] of `sticks` over the pool; `dists` is scratch.
+#[allow(clippy::too_many_arguments)]
 fn nearest(
     query: &[f32],
     sticks: &[f32],
+    pooled: &[f32],
     len: usize,
     pool: &(Vec<usize>, usize),
     w: usize,
     hgt: usize,
+    dists: &mut Vec<f32>,
 ) -> Vec<(f32, usize)> {
     let (pool, stride) = (&pool.0, pool.1);
+    dists.clear();
+    dists.resize(pool.len(), 0.0);
+    for (&a, row) in query.iter().zip(pooled.chunks_exact(pool.len())) {
+        for (d, &b) in dists.iter_mut().zip(row) {
+            let t = a - b;
+            *d += t * t;
+        }
+    }
     let mut coarse: Vec<(f32, usize)> = Vec::with_capacity(K1 + 1);
-    for &q in pool {
-        keep(&mut coarse, dist2(query, &sticks[q * len..(q + 1) * len]), q);
+    for (&d, &q) in dists.iter().zip(pool) {
+        keep(&mut coarse, d, q);
     }
     if stride <= 1 {
         return coarse;
@@ -189,14 +249,16 @@ pub fn candidate_triples(
     let w = options.plane_weights;
     let (wij, wik, wjk) = (w[i] * w[j], w[i] * w[k], w[j] * w[k]);
     let coord = |e: &PlaneExemplar, p: usize| [(p % e.width) as i32, (p / e.width) as i32];
+    let (pooled_j, pooled_k) =
+        (pool_sticks(&st[j].rows, len, &pool_j.0), pool_sticks(&st[k].cols, len, &pool_k.0));
     let mut triples = vec![[[0i32; 2]; 3]; ei.width * ei.height * n_t];
-    triples.par_chunks_mut(n_t).enumerate().for_each(|(p, out)| {
+    triples.par_chunks_mut(n_t).enumerate().for_each_init(Vec::new, |dists, (p, out)| {
         // Column of plane i ↔ row of plane j; row of plane i ↔ column of plane k;
         // column of plane j ↔ row of plane k.
-        let qs =
-            nearest(&st[i].cols[p * len..(p + 1) * len], &st[j].rows, len, &pool_j, dj.0, dj.1);
-        let rs =
-            nearest(&st[i].rows[p * len..(p + 1) * len], &st[k].cols, len, &pool_k, dk.0, dk.1);
+        let (col_i, row_i) =
+            (&st[i].cols[p * len..(p + 1) * len], &st[i].rows[p * len..(p + 1) * len]);
+        let qs = nearest(col_i, &st[j].rows, &pooled_j, len, &pool_j, dj.0, dj.1, dists);
+        let rs = nearest(row_i, &st[k].cols, &pooled_k, len, &pool_k, dk.0, dk.1, dists);
         let mut scored: Vec<(f32, usize, usize)> = Vec::with_capacity(qs.len() * rs.len());
         for &(eq, q) in &qs {
             for &(er, r) in &rs {
@@ -216,4 +278,76 @@ pub fn candidate_triples(
         }
     });
     CandidateTriples { plane, width: ei.width, height: ei.height, n_t, triples }
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::*;
+
+    /// Sticks of a deterministic pseudo-random `w × h` "exemplar" (`len` floats each).
+    fn random_sticks(w: usize, h: usize, len: usize, salt: &str) -> Vec<f32> {
+        (0..w * h * len).map(|i| fieldtex_core::rng::hash_unit(3, salt, i as u64) as f32).collect()
+    }
+
+    #[test]
+    fn the_transposed_pool_scan_gives_the_scalar_scans_partners_and_distances() {
+        let (w, h, len) = (37, 29, 15);
+        let sticks = random_sticks(w, h, len, "sticks");
+        let queries = random_sticks(23, 1, len, "queries");
+        let pool = pool(w, h, 64);
+        assert!(pool.1 > 1);
+        let pooled = pool_sticks(&sticks, len, &pool.0);
+        let mut dists = Vec::new();
+        for query in queries.chunks_exact(len) {
+            let got = nearest(query, &sticks, &pooled, len, &pool, w, h, &mut dists);
+            // The scalar reference: the pool by `dist2`, then the cells around its hits.
+            let mut coarse = Vec::new();
+            for &q in &pool.0 {
+                keep(&mut coarse, dist2(query, &sticks[q * len..(q + 1) * len]), q);
+            }
+            let mut cells = Vec::new();
+            let s = pool.1 as i64;
+            for &(_, q) in &coarse {
+                for dy in -(s / 2)..s - s / 2 {
+                    for dx in -(s / 2)..s - s / 2 {
+                        let x = ((q % w) as i64 + dx).rem_euclid(w as i64) as usize;
+                        let y = ((q / w) as i64 + dy).rem_euclid(h as i64) as usize;
+                        cells.push(y * w + x);
+                    }
+                }
+            }
+            cells.sort_unstable();
+            cells.dedup();
+            let mut want = Vec::new();
+            for q in cells {
+                keep(&mut want, dist2(query, &sticks[q * len..(q + 1) * len]), q);
+            }
+            assert_eq!(got.len(), K1);
+            let bits =
+                |v: &[(f32, usize)]| v.iter().map(|(d, q)| (d.to_bits(), *q)).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want));
+        }
+    }
+
+    #[test]
+    fn candidate_heads_hold_each_pixels_first_k_triples() {
+        let (w, h, n_t) = (11, 7, 5);
+        let triples: Vec<Triple> = (0..w * h * n_t)
+            .map(|i| {
+                let v = |s: &str, m: usize| {
+                    (fieldtex_core::rng::hash_unit(5, s, i as u64) * m as f64) as i32
+                };
+                [[v("a", w), v("b", h)], [v("c", w), v("d", h)], [v("e", w), v("f", h)]]
+            })
+            .collect();
+        let table = CandidateTriples { plane: 0, width: w, height: h, n_t, triples };
+        let heads = CandidateHeads::new(&table, 3);
+        for y in -8..16 {
+            for x in -12..24 {
+                for kk in 0..3 {
+                    assert_eq!(heads.get(x, y, kk), *table.get(x, y, kk), "({x}, {y}) #{kk}");
+                }
+            }
+        }
+    }
 }

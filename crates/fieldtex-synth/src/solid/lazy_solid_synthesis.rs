@@ -45,7 +45,7 @@
 //! and whole-level tabulation replaced by evaluation of a requested subset from its
 //! dependency (block) set.
 
-use super::candidate_triples::{Triple, wrapped};
+use super::candidate_triples::{CandidateHeads, Triple, wrapped};
 use super::solid_exemplar::SolidExemplar;
 use super::voxel_lattice::{
     FrameSource, VoxelLattice, dual_block, dual_origin, floor_div, primary_block, primary_origin,
@@ -139,6 +139,12 @@ pub struct SolidSynthesizer<'a> {
     frames: &'a dyn FrameSource,
     options: SolidSynthesisOptions,
     cache: Vec<LevelCache>,
+    /// Per level and plane, the `k` candidates per pixel the correction reads.
+    heads: Vec<[CandidateHeads; 3]>,
+    /// Per level and plane, the PCA basis transposed (`N² · channels` rows of
+    /// `pca_dims`), so that the correction's projection runs over all dimensions at
+    /// once while each dimension still sums its products in the basis's order.
+    bases: Vec<[Vec<f32>; 3]>,
 }
 
 /// The computed blocks of a [`SolidSynthesizer`], detached from its borrows
@@ -190,12 +196,35 @@ impl<'a> SolidSynthesizer<'a> {
             });
         }
         let levels = exemplar.options.levels;
+        let heads = exemplar
+            .triples
+            .iter()
+            .map(|row| std::array::from_fn(|p| CandidateHeads::new(&row[p], options.k)))
+            .collect();
+        let bases = (0..levels)
+            .map(|c| {
+                std::array::from_fn(|p| {
+                    let lvl = &exemplar.planes[p].levels[c];
+                    let dims = lvl.dims();
+                    let dim = lvl.basis.len() / dims.max(1);
+                    let mut t = vec![0.0f32; lvl.basis.len()];
+                    for j in 0..dims {
+                        for i in 0..dim {
+                            t[i * dims + j] = lvl.basis[j * dim + i];
+                        }
+                    }
+                    t
+                })
+            })
+            .collect();
         Ok(Self {
             exemplar,
             lattice,
             frames,
             options,
             cache: (0..levels).map(|_| LevelCache::default()).collect(),
+            heads,
+            bases,
         })
     }
 

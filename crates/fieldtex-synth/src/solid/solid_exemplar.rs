@@ -334,8 +334,10 @@ fn analyse_plane(
     if w < min || h < min {
         return Err(SynthError::ExemplarTooSmall { width: w, height: h, min });
     }
-    if w > options.max_size || h > options.max_size {
-        return Err(SynthError::ExemplarTooLarge { width: w, height: h, max: options.max_size });
+    // Coordinates are kept as `u16` in the correction's candidate table.
+    let max = options.max_size.min(1 << 16);
+    if w > max || h > max {
+        return Err(SynthError::ExemplarTooLarge { width: w, height: h, max });
     }
     for (index, p) in image.pixels.iter().enumerate() {
         if let Some(&value) = p.iter().take(3).find(|v| !v.is_finite()) {

@@ -178,7 +178,7 @@ impl SolidSynthesizer<'_> {
                     k += 1;
                 }
             }
-            let table = &self.exemplar.triples[c][p];
+            let table = &self.heads[c][p];
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     let pix = if dx == 0 && dy == 0 {
@@ -251,14 +251,20 @@ impl SolidSynthesizer<'_> {
                 }
             }
             let dims = if weights[p] > 0.0 { lvl.dims() } else { 0 };
-            let dim = (n * n) as usize * ch;
-            for j in 0..dims {
-                let row = &lvl.basis[j * dim..(j + 1) * dim];
-                let mut acc = 0.0f32;
-                for (a, b) in row.iter().zip(&scratch.buf[..dim]) {
-                    acc += a * b;
+            if dims > 0 {
+                // proj_j = Σ_i basis[j][i] · buf[i] − bias_j, each sum in the order of
+                // i, all j at once (the transposed basis's rows).
+                let dim = (n * n) as usize * ch;
+                let proj = &mut scratch.proj[p][..dims];
+                proj.fill(0.0);
+                for (row, &b) in self.bases[c][p].chunks_exact(dims).zip(&scratch.buf[..dim]) {
+                    for (acc, &a) in proj.iter_mut().zip(row) {
+                        *acc += a * b;
+                    }
                 }
-                scratch.proj[p][j] = acc - lvl.bias[j];
+                for (acc, &bias) in proj.iter_mut().zip(&lvl.bias) {
+                    *acc -= bias;
+                }
             }
         }
         // The candidates: each predicted pixel's `k` table entries, plane by plane in
@@ -266,14 +272,14 @@ impl SolidSynthesizer<'_> {
         // same triples again, whose costs equal the first ones', so it is skipped (the
         // earliest of equal costs wins either way: same result).
         for p in 0..3 {
-            let table = &self.exemplar.triples[c][p];
+            let table = &self.heads[c][p];
             let pred = &scratch.predicted[p];
             for (j, pix) in pred.iter().enumerate() {
                 if pred[..j].contains(pix) {
                     continue;
                 }
                 for kk in 0..self.options.k {
-                    scratch.candidates.push(*table.get(pix[0], pix[1], kk));
+                    scratch.candidates.push(table.get(pix[0], pix[1], kk));
                 }
             }
         }
