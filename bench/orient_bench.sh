@@ -31,6 +31,10 @@
 #   `--no-metrics`, against Embark `generate` (all write a 512² PNG from the exemplar
 #   file), the ratios, the metrics' share of the default run (target < 10 %), and CPU
 #   time (user+sys) medians. Run on a quiet machine: `uptime` is printed with the numbers.
+# - wrap: whether the metrics read the exemplar toroidally (`exemplar_wrap` of the report:
+#   only when `fieldtex_synth::exemplar_tiling` finds that it tiles, wrap-jump ratios x / y
+#   against the threshold 1.4); the same rule scores every image of an exemplar (orient,
+#   Embark, the rotated-copy floor), since it depends on the exemplar alone.
 # Usage: bench/orient_bench.sh [--size N] [--runs R] [--presets "whorl left-loop"]
 #        [--exemplars "stripes_Fabric071 ..."] [--no-speed] [--keep-embark]
 # --summary-only prints the tables from the outputs of earlier runs (e.g. one run per
@@ -176,7 +180,7 @@ for e in exemplars:
             "seam_ratio": sr, "repaired_seam_ratio": rep, "repaired_local_ratio": loc, "forced_seam_pairs": forced,
             "seam_ratio_nofix": srn, "jump_pairs": s["jump_pairs"],
             "coherent_share": s["coherent_share"], "coherent_share_nofix": sn["coherent_share"]})
-print(f"\n{'exemplar':32} {'const0 coh':>10} {'embark coh':>10} {'':4} {'const0 g':>9} {'embark g':>9} {'':4} {'floor':>8} "
+print(f"\n{'exemplar':32} {'wrap':>15} {'const0 coh':>10} {'embark coh':>10} {'':4} {'const0 g':>9} {'embark g':>9} {'':4} {'floor':>8} "
       + (f"{'default_s':>9} {'nometr_s':>8} {'embark_s':>8} {'ratio':>7} {'ratio_nm':>8} "
          f"{'metr%':>6} {'d_cpu_s':>7} {'o_cpu_s':>7} {'e_cpu_s':>7}" if speed else ""))
 for e in exemplars:
@@ -195,9 +199,28 @@ for e in exemplars:
               for a in (10, 20, 30, 45) if os.path.exists(os.path.join(d, f"ideal-{a}-eval.json"))]
     floor = sum(floors) / len(floors) if floors else float("nan")
     misses += not c <= k
-    line = f"{e:32} {c:10.5f} {k:10.5f} {ok(c <= k):4} {cg:9.6f} {kg:9.6f} {ok(cg <= kg):4} {floor:8.5f}"
+    # The wrap rule the metrics used (absent in reports older than session 13).
+    wr = load(os.path.join(d, "const0", "report.json"))["metrics"]["texture"].get("exemplar_wrap")
+    # Same rule for every image scored against this exemplar (it depends on the exemplar only).
+    seen = set()
+    for q in [os.path.join(d, "embark-eval.json")] + [os.path.join(d, f"ideal-{a}-eval.json") for a in (10, 20, 30, 45)]:
+        if os.path.exists(q):
+            seen.add(str(load(q).get("exemplar_wrap", {}).get("wrapped")))
+    for p in presets:
+        q = os.path.join(d, p, "report.json")
+        if os.path.exists(q):
+            seen.add(str(load(q)["metrics"]["texture"].get("exemplar_wrap", {}).get("wrapped")))
+    if wr is not None:
+        seen.add(str(wr["wrapped"]))
+    if len(seen) > 1:
+        print(f"{e}: WARNING: the images were scored under different wrap rules {sorted(seen)} (rerun them)")
+    wtxt = "n/a" if wr is None else "{} {:.2f}/{:.2f}".format(
+        "yes" if wr["wrapped"] else "no", *wr["tiling"]["jump_ratio"])
+    line = f"{e:32} {wtxt:>15} {c:10.5f} {k:10.5f} {ok(c <= k):4} {cg:9.6f} {kg:9.6f} {ok(cg <= kg):4} {floor:8.5f}"
     entry = {"const0_coherence": c, "embark_coherence": k, "rotated_copy_floor": floor,
-             "const0_guided_coherence": cg, "embark_guided_coherence": kg}
+             "const0_guided_coherence": cg, "embark_guided_coherence": kg,
+             "exemplar_wrap": None if wr is None else {"wrapped": wr["wrapped"],
+                                                       "jump_ratio": wr["tiling"]["jump_ratio"]}}
     if speed and os.path.exists(os.path.join(d, "orient-times.txt")):
         def med(path):
             rows = [list(map(float, l.split())) for l in open(path) if l.strip() and l[0].isdigit()]

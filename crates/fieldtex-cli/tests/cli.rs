@@ -234,7 +234,8 @@ fn pipeline_glbs_pass_the_khronos_validator() {
 }
 
 /// `eval` of an exemplar against itself: zero coherence and colour distance, the
-/// stripes' orientation matches 0°, and a field of the wrong shape is refused (exit 2).
+/// stripes' orientation matches 0°, the crop is not read across its wrap, and a field
+/// of the wrong shape is refused (exit 2).
 #[test]
 fn eval_known_answers_and_bad_field() {
     let ex = shared().join("exemplars/stripes_Fabric071.png");
@@ -244,6 +245,10 @@ fn eval_known_answers_and_bad_field() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
     assert_eq!(v["coherence"]["mean"].as_f64(), Some(0.0));
     assert_eq!(v["color_sliced_wasserstein"]["distance"].as_f64(), Some(0.0));
+    // A crop that does not tile (its y wrap cuts a stripe): its patches are not read
+    // across the wrap, and the report says so.
+    assert_eq!(v["exemplar_wrap"]["wrapped"].as_bool(), Some(false));
+    assert!(v["exemplar_wrap"]["tiling"]["jump_ratio"][1].as_f64().unwrap() > 2.0);
     assert!(v["orientation_error"]["mean_error_deg"].as_f64().unwrap() < 2.0);
     let o = run(&["eval", e, "--exemplar", e, "--angle", "90"], Duration::from_secs(60));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();

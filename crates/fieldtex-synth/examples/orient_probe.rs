@@ -2,7 +2,7 @@
 //! `fieldtex orient` (paper D §4 targets of issue 3).
 //!
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
-//!  [DIR…] [--const DEG…] [--ideal DEG…] [--prerotate DEG… [--residual R] [--copy-scale F]] [--tileable] [--no-wrap-metric] [--both] [--no-rosy-fix] [--free-flips]
+//!  [DIR…] [--const DEG…] [--ideal DEG…] [--prerotate DEG… [--residual R] [--copy-scale F]] [--tileable | --detect-tileable] [--margin-divisor D] [--wrap-metric | --no-wrap-metric] [--both] [--no-rosy-fix] [--free-flips]
 //!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid] [--warp | --no-warp]
 //!  [--passes N] [--finest-passes N] [--coarse-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
 //!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--radius R] [--analysis-k K]
@@ -23,9 +23,12 @@
 //! `ideal-DEG.png` and its field `ideal-DEG.npy`). `--prerotate DEG` scores a constant
 //! design at DEG + `--residual` (default 0) synthesised against the exemplar pre-rotated
 //! by DEG (`fieldtex_synth::synthesize_rotated`, a copy `--copy-scale` × the exemplar's
-//! size); `--tileable` analyses the exemplar as tileable; `--no-wrap-metric` scores
-//! against the exemplar's patches without wrapping (its wrap seams are not exemplar
-//! content then). `--both` runs with and without the 2-RoSy fix. `--png DIR`
+//! size); `--tileable` analyses the exemplar as tileable, `--detect-tileable` does so
+//! when `fieldtex_synth::exemplar_tiling` finds that it tiles; `--margin-divisor D`
+//! caps a non-tileable exemplar's border margin at `min(W, H) / D` (default 8). The guided coherence
+//! searches the exemplar's patches toroidally only when that test finds that it tiles
+//! (the rule of `fieldtex orient` / `eval`); `--wrap-metric` / `--no-wrap-metric`
+//! force wrapping on / off. `--both` runs with and without the 2-RoSy fix. `--png DIR`
 //! writes the texture, the texture with the defects marked (red: within 3 periods of a
 //! designed singularity), 3× crops around the singularities and the flip map.
 
@@ -111,7 +114,8 @@ fn main() {
     let mut prerotate: Vec<f32> = Vec::new();
     let mut residual = 0.0f32;
     let mut copy_scale = 1.0f32;
-    let mut wrap_exemplar = true;
+    let mut wrap_metric: Option<bool> = None;
+    let mut detect_tileable = false;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--both" => both = true,
@@ -129,7 +133,10 @@ fn main() {
             "--residual" => residual = num(args.next(), &a),
             "--copy-scale" => copy_scale = num(args.next(), &a),
             "--tileable" => aopts.tileable = true,
-            "--no-wrap-metric" => wrap_exemplar = false,
+            "--no-wrap-metric" => wrap_metric = Some(false),
+            "--wrap-metric" => wrap_metric = Some(true),
+            "--detect-tileable" => detect_tileable = true,
+            "--margin-divisor" => aopts.margin_divisor = num(args.next(), &a),
             "--no-rosy-fix" => opts.rosy_fix = false,
             "--coarse-passes" => opts.coarse_passes = Some(num(args.next(), &a)),
             "--no-trapezoid" => opts.trapezoid_frames = false,
@@ -149,6 +156,14 @@ fn main() {
         }
     }
     let ex: Image = fieldtex_io::read_image(&exemplar).expect("exemplar");
+    let tiling = fieldtex_synth::exemplar_tiling(&ex);
+    let wrap_exemplar = wrap_metric.unwrap_or(tiling.tiles);
+    aopts.tileable |= detect_tileable && tiling.tiles;
+    println!(
+        "wrap-jump ratio x {:.2} y {:.2} (tiles: {}); metric wraps: {wrap_exemplar}; analysis \
+         tileable: {}",
+        tiling.jump_ratio[0], tiling.jump_ratio[1], tiling.tiles, aopts.tileable
+    );
     let t0 = Instant::now();
     let analysis = ExemplarAnalysis::new(&ex, &aopts, &NoProgress).unwrap();
     println!(

@@ -39,12 +39,24 @@ pub struct AnalysisOptions {
     /// not tile), level `c` keeps synthesised coordinates at least
     /// `min(2^(c+1), min(W, H) / 8)` pixels from the exemplar border
     /// ([`AnalysisLevel::margin`]), so the exemplar's edges never show as seams.
+    /// [`crate::exemplar_tiling`] tells whether an exemplar tiles.
     pub tileable: bool,
+    /// The cap of the border margin of a non-tileable exemplar as a divisor of its
+    /// shorter side: level `c` keeps `min(2^(c+1), min(W, H) / margin_divisor)` pixels
+    /// (at least 1). Default 8. A larger divisor lets the coarse levels use more of a
+    /// small exemplar (on a 124² exemplar the default removes up to 43 % of the
+    /// positions); measured in docs/real-exemplars.md "session 13" (not adopted).
+    #[serde(default = "default_margin_divisor")]
+    pub margin_divisor: usize,
     /// Largest accepted exemplar side; larger exemplars are refused with
     /// [`SynthError::ExemplarTooLarge`]. Default
     /// [`MAX_EXEMPLAR_SIDE`](crate::MAX_EXEMPLAR_SIDE) (pipelines reduce larger ones
     /// first, [`crate::exemplar_policy`]).
     pub max_size: usize,
+}
+
+fn default_margin_divisor() -> usize {
+    8
 }
 
 impl Default for AnalysisOptions {
@@ -54,6 +66,7 @@ impl Default for AnalysisOptions {
             coherence_radius: 3,
             coherence_scan: 256,
             tileable: false,
+            margin_divisor: default_margin_divisor(),
             max_size: crate::MAX_EXEMPLAR_SIDE,
         }
     }
@@ -169,8 +182,8 @@ impl ExemplarAnalysis {
             let spacing = 1usize << c;
             let space = appearance_space(&level_img, width, height, spacing, c)?;
             let radius = options.coherence_radius.max(spacing).min(width.min(height) / 4).max(1);
-            let margin =
-                if options.tileable { 0 } else { (2 * spacing).min(width.min(height) / 8).max(1) };
+            let cap = width.min(height) / options.margin_divisor.max(1);
+            let margin = if options.tileable { 0 } else { (2 * spacing).min(cap).max(1) };
             let coherence = k_coherence(
                 &space.unrotated,
                 width,

@@ -23,6 +23,10 @@
 //!   neighbourhoods, and the 2-RoSy flip indicator of paper D §4
 //!   ([`SynthesisOptions::rosy_fix`]).
 //!
+//! - [`exemplar_tiling`] (`exemplar_tiling.rs`): whether an exemplar tiles (wrap-jump
+//!   ratio), the one test the pipelines and their metrics use before reading an exemplar
+//!   toroidally.
+//!
 //! # Measurements
 //! Quality and speed against the orient targets, and what was tried and dropped:
 //! `docs/perf/orient-synthesis.md`.
@@ -49,6 +53,7 @@ pub mod exemplar_analysis;
 mod exemplar_level;
 pub mod exemplar_policy;
 pub mod exemplar_scales;
+pub mod exemplar_tiling;
 pub mod flip_combing;
 pub mod gaussian_stack;
 pub mod graph_cut;
@@ -72,6 +77,7 @@ pub use domain::{ImageDomain, SynthesisDomain};
 pub use error::SynthError;
 pub use exemplar_analysis::{APPEARANCE_DIMS, AnalysisLevel, AnalysisOptions, ExemplarAnalysis};
 pub use exemplar_policy::{FittedExemplar, MAX_EXEMPLAR_SIDE, fit_exemplar};
+pub use exemplar_tiling::{TILING_JUMP_RATIO, TilingTest, exemplar_tiling};
 pub use image_quilting::{QuiltStats, QuiltTarget, QuiltingOptions, quilt};
 pub use lattice_domain::{Jacobian, LatticeDomain, PlanarDomain};
 pub use parallel_synthesis::{

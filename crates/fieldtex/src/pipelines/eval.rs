@@ -42,12 +42,36 @@ pub struct ImageMetrics {
     /// coordinate map (`orient`, or `eval --coords`) and a field.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rosy_seam: Option<ev::RosySeamReport>,
+    /// Whether the exemplar-patch metrics (coherence, guided coherence, completeness,
+    /// source coverage) read the exemplar toroidally, and the tiling test that decided.
+    pub exemplar_wrap: ExemplarWrap,
     /// Metrics that could not be computed, with the reason.
     pub skipped: Vec<String>,
     /// How the nearest-patch metrics were searched and how far the approximate values
     /// may be from the exact ones.
     pub search: String,
 }
+
+/// The rule deciding whether the metrics read the exemplar toroidally: only when it
+/// tiles (`fieldtex_synth::exemplar_tiling`), so that the wrap seams of a photo crop are
+/// never credited as exemplar content. It depends on the exemplar alone, so every image
+/// scored against one exemplar (`orient`'s texture, Embark's output, the rotated-copy
+/// floor) is scored under the same rule.
+#[derive(Debug, Clone, Serialize)]
+pub struct ExemplarWrap {
+    /// Patches across the exemplar's wrap were searched (the exemplar tiles).
+    pub wrapped: bool,
+    /// Wrap-jump ratios `[x, y]`, the threshold and the verdict.
+    pub tiling: fieldtex_synth::TilingTest,
+    /// The rule in words.
+    pub rule: &'static str,
+}
+
+/// [`ExemplarWrap::rule`].
+const WRAP_RULE: &str = "the exemplar is read toroidally only if it tiles: on both axes the \
+    mean colour jump across its wrap is at most `threshold` times the mean jump between \
+    interior neighbours (fieldtex_synth::exemplar_tiling); otherwise patches crossing its \
+    border are not exemplar patches";
 
 /// Counts and positions of the singularities found in an image.
 #[derive(Debug, Clone, Serialize)]
@@ -102,8 +126,10 @@ pub(crate) fn image_metrics(
     // the exact distances; docs/perf/orient.md gives the measured gap); `exact`: the
     // exhaustive scan.
     let approximate = (!exact).then(|| ev::ApproximateSearchOptions { seed, ..Default::default() });
+    let tiling = fieldtex_synth::exemplar_tiling(exemplar);
+    let wrap = tiling.tiles;
     let popts = ev::PatchDistanceOptions::default()
-        .with_wrap_exemplar(true)
+        .with_wrap_exemplar(wrap)
         .with_approximate(approximate.clone());
     let reference = match (field, angle_deg) {
         (Some(f), _) => Some(ev::OrientationReference::Field(ev::FieldView::new(
@@ -129,7 +155,10 @@ pub(crate) fn image_metrics(
             progress.advance(2);
             r
         },
-        || other_metrics(&o, &e, reference, exemplar_angle_deg, seed, exact, approximate, progress),
+        || {
+            let angle = exemplar_angle_deg;
+            other_metrics(&o, &e, reference, angle, wrap, seed, exact, approximate, progress)
+        },
     );
     let (coherence, completeness) = pair?;
     let (
@@ -142,8 +171,11 @@ pub(crate) fn image_metrics(
     ) = rest?;
     let source_coverage = match &sources {
         Some(s) => {
-            let opts =
-                ev::SourceCoverageOptions { patch_size: popts.patch_size, ..Default::default() };
+            let opts = ev::SourceCoverageOptions {
+                patch_size: popts.patch_size,
+                wrap_exemplar: wrap,
+                ..Default::default()
+            };
             Some(ev::source_coverage(s.coords, [exemplar.width, exemplar.height], &opts)?)
         }
         None => None,
@@ -165,6 +197,7 @@ pub(crate) fn image_metrics(
         singularities,
         phase_defects,
         rosy_seam: None,
+        exemplar_wrap: ExemplarWrap { wrapped: wrap, tiling, rule: WRAP_RULE },
         skipped,
         search: if exact {
             "exact: exhaustive nearest-patch searches".into()
@@ -208,13 +241,15 @@ type OtherMetrics = (
 );
 
 /// Colour, guided coherence, orientation, singularities and phase defects of `o`
-/// against `e` (see [`image_metrics`]), with the list of skipped metrics.
+/// against `e` (see [`image_metrics`]; `wrap`: the exemplar tiles), with the list of
+/// skipped metrics.
 #[allow(clippy::too_many_arguments)]
 fn other_metrics(
     o: &ev::ImageView,
     e: &ev::ImageView,
     reference: Option<ev::OrientationReference>,
     exemplar_angle_deg: f64,
+    wrap: bool,
     seed: u64,
     exact: bool,
     approximate: Option<ev::ApproximateSearchOptions>,
@@ -229,7 +264,11 @@ fn other_metrics(
     let mut skipped = Vec::new();
     let guided_coherence = match &reference {
         Some(ev::OrientationReference::Field(f)) => {
-            let gopts = ev::GuidedCoherenceOptions { approximate, ..Default::default() };
+            let gopts = ev::GuidedCoherenceOptions {
+                approximate,
+                wrap_exemplar: wrap,
+                ..Default::default()
+            };
             Some(ev::guided_coherence(o, e, f, &gopts)?)
         }
         _ => None,
@@ -408,4 +447,82 @@ pub fn eval_files(
             })?;
     metrics.rosy_seam = seam;
     Ok(metrics)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fieldtex_core::NoProgress;
+
+    /// A `w × h` exemplar of `f(x, y)` in the red channel and a shifted copy in green.
+    fn exemplar(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Image {
+        let mut im = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
+        for y in 0..h {
+            for x in 0..w {
+                let (xf, yf) = (x as f64, y as f64);
+                im.pixels[y * w + x] = [f(xf, yf) as f32, f(xf + 5.0, yf + 3.0) as f32, 0.5, 1.0];
+            }
+        }
+        im
+    }
+
+    /// `e` repeated `2 × 2`: its wrap seams copied into the middle of the image.
+    fn tiled(e: &Image) -> Image {
+        let (w, h) = (e.width, e.height);
+        let mut out = Image::new(2 * w, 2 * h, [0.0; 4]);
+        for y in 0..2 * h {
+            for x in 0..2 * w {
+                out.pixels[y * 2 * w + x] = e.pixels[(y % h) * w + x % w];
+            }
+        }
+        out
+    }
+
+    /// Exact metrics of `out` against `e` at a constant 0° field.
+    fn metrics(out: &Image, e: &Image) -> ImageMetrics {
+        let field: Vec<f32> = (0..out.width * out.height).flat_map(|_| [1.0, 0.0]).collect();
+        image_metrics(out, e, Some(&field), None, 0.0, None, 1, true, &NoProgress).unwrap()
+    }
+
+    #[test]
+    fn a_copied_wrap_seam_costs_only_when_the_exemplar_does_not_tile() {
+        use std::f64::consts::TAU;
+        // Periods that do not divide 40: a crop, with a seam at its wrap.
+        let crop = exemplar(40, 40, |x, y| {
+            0.5 + 0.25 * (TAU * (x / 17.3 + y / 29.1)).sin() + 0.2 * (TAU * y / 13.7).cos()
+        });
+        // Whole periods over 40 pixels: it tiles.
+        let tile = exemplar(40, 40, |x, y| {
+            0.5 + 0.25 * (TAU * (x / 20.0 + y / 40.0)).sin() + 0.2 * (TAU * y / 10.0).cos()
+        });
+        let m = metrics(&tiled(&crop), &crop);
+        assert!(!m.exemplar_wrap.wrapped && !m.exemplar_wrap.tiling.tiles);
+        assert!(m.exemplar_wrap.tiling.jump_ratio.iter().any(|&r| r > 1.4));
+        // The old rule (always toroidal) finds every patch of the 2 × 2 repeat in the
+        // exemplar; the honest one charges the patches across the copied seams.
+        let (ob, eb) = (ev::rgb_buffer(&tiled(&crop)), ev::rgb_buffer(&crop));
+        let o = ev::ImageView::new(&ob, 80, 80, 3).unwrap();
+        let e = ev::ImageView::new(&eb, 40, 40, 3).unwrap();
+        let wrapped =
+            ev::coherence(&o, &e, &ev::PatchDistanceOptions::default().with_wrap_exemplar(true))
+                .unwrap();
+        assert!(wrapped.mean < 1e-9, "{}", wrapped.mean);
+        assert!(m.coherence.mean > 1e-4, "{}", m.coherence.mean);
+        let guided = m.guided_coherence.as_ref().unwrap().mean;
+        let fv: Vec<f32> = (0..80 * 80).flat_map(|_| [1.0, 0.0]).collect();
+        let f = ev::FieldView::new(&fv, 80, 80).unwrap();
+        let gw =
+            ev::guided_coherence(&o, &e, &f, &ev::GuidedCoherenceOptions::default()).unwrap().mean;
+        assert!(guided > 1e-4 && guided > 10.0 * gw, "no wrap {guided}, wrap {gw}");
+
+        let m = metrics(&tiled(&tile), &tile);
+        assert!(m.exemplar_wrap.wrapped && m.exemplar_wrap.tiling.tiles, "{:?}", m.exemplar_wrap);
+        assert!(m.coherence.mean < 1e-9, "{}", m.coherence.mean);
+        assert!(m.guided_coherence.unwrap().mean < 1e-9);
+        // Reported in the JSON with the rule.
+        let json = serde_json::to_value(&m.exemplar_wrap).unwrap();
+        assert_eq!(json["wrapped"], true);
+        assert!(json["rule"].as_str().unwrap().contains("exemplar_tiling"));
+        assert_eq!(json["tiling"]["threshold"], fieldtex_synth::TILING_JUMP_RATIO);
+    }
 }

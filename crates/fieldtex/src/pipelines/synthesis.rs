@@ -72,6 +72,9 @@ fn analysis_key(exemplar: &Image, options: &AnalysisOptions) -> u64 {
     eat(options.k as u64);
     eat(options.coherence_radius as u64);
     eat(options.max_size as u64);
+    eat(options.coherence_scan as u64);
+    eat(u64::from(options.tileable));
+    eat(options.margin_divisor as u64);
     h
 }
 
