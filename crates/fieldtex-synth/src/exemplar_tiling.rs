@@ -64,7 +64,7 @@ pub struct TilingTest {
 pub fn exemplar_tiling(exemplar: &Image) -> TilingTest {
     let (w, h) = (exemplar.width, exemplar.height);
     let px = |x: usize, y: usize| exemplar.pixels[y * w + x];
-    let rx = wrap_jump_ratio(w, h, |i, j| px(i, j));
+    let rx = wrap_jump_ratio(w, h, px);
     let ry = wrap_jump_ratio(h, w, |i, j| px(j, i));
     let threshold = TILING_JUMP_RATIO;
     TilingTest { jump_ratio: [rx, ry], threshold, tiles: rx <= threshold && ry <= threshold }
