@@ -17,6 +17,9 @@ for c in met["components"]:
 fs, fn = met["feature_size"], n["metrics"]["feature_size"]
 if fs and fn:
     print(f"   feature-size CV multiscale {fs['cv']:.3f}  no-multiscale {fn['cv']:.3f}  ratio {fs['cv'] / fn['cv']:.2f} (target <= 0.5)")
+    fc, fnc = met.get("feature_size_centre_lambda"), n["metrics"].get("feature_size_centre_lambda")
+    if fc and fnc:
+        print(f"   (centre-triangle λ, the measure of sessions 10-12: {fc['cv']:.3f} / {fnc['cv']:.3f} = {fc['cv'] / fnc['cv']:.2f})")
     fw, fnw = met.get("feature_size_fixed_window"), n["metrics"].get("feature_size_fixed_window")
     if fw and fnw:
         print(f"   (fixed 24-texel window: {fw['cv']:.3f} / {fnw['cv']:.3f} = {fw['cv'] / fnw['cv']:.2f}; adaptive windows saturated {fs.get('saturated')})")

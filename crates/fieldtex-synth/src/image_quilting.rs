@@ -6,6 +6,13 @@
 //! each patch takes its exemplar level from the mean inverse conformal factor `τ` under
 //! it — weighted towards the texels that show the most surface (`patch_tau`).
 //!
+//! Where `τ` changes fast (a patch over a zero point of the conformal map, or over two
+//! neighbouring charts of different scale), one level cannot suit the whole patch: a
+//! patch whose `τ` spans more than `split_spread` (max / min) is placed as 2 × 2
+//! half-size patches in raster order (side `(b + o) / 2`, overlapping by `o`), each with
+//! its own level, candidates and cut — the "smaller patches" refinement of session 13
+//! (our addition; the paper uses one patch size).
+//!
 //! Canvas texels are *unknown*, *synthesised* or *fixed*. Before a patch is placed, every
 //! unknown texel of its region that has an already known partner (a texel showing the
 //! same surface point elsewhere, e.g. across a periodic side of a geometry image) is
@@ -37,12 +44,23 @@ pub struct QuiltingOptions {
     pub candidates: usize,
     /// Relative tolerance over the best overlap error (Efros & Freeman: 0.1).
     pub tolerance: f64,
+    /// A patch whose texels' `τ` spans more than this factor (max / min) is placed as
+    /// 2 × 2 half-size patches, each with its own level ([`f64::INFINITY`] = never).
+    /// Default never.
+    pub split_spread: f64,
     pub seed: u64,
 }
 
 impl Default for QuiltingOptions {
     fn default() -> Self {
-        Self { patch_size: 40, overlap: 8, candidates: 400, tolerance: 0.1, seed: 1 }
+        Self {
+            patch_size: 40,
+            overlap: 8,
+            candidates: 400,
+            tolerance: 0.1,
+            split_spread: f64::INFINITY,
+            seed: 1,
+        }
     }
 }
 
@@ -73,6 +91,8 @@ pub struct QuiltStats {
     pub seam_cost: f64,
     /// Texels on a seam (cut) between patches.
     pub seam_texels: usize,
+    /// Patches placed as 2 × 2 half-size patches (`split_spread`).
+    pub split_patches: usize,
 }
 
 const SCALE: f64 = 4096.0;
@@ -89,155 +109,201 @@ pub fn quilt(
     let b = options.patch_size.max(4);
     let o = options.overlap.min(b / 2).max(1);
     let step = b - o;
-    let mut pix = vec![[0.0f32; 3]; w * h];
-    let mut state = vec![0u8; w * h]; // 0 unknown, 1 synthesised, 2 fixed
-    let mut stats = QuiltStats { level_histogram: vec![0; levels.len()], ..Default::default() };
+    let pix = vec![[0.0f32; 3]; w * h];
+    let state = vec![0u8; w * h]; // 0 unknown, 1 synthesised, 2 fixed
+    let stats = QuiltStats { level_histogram: vec![0; levels.len()], ..Default::default() };
     let xs: Vec<usize> = positions(w, b, step);
     let ys: Vec<usize> = positions(h, b, step);
     progress.stage("quilting", (xs.len() * ys.len()) as u64);
-    let mut buf = Vec::new();
+    let mut canvas = Canvas { w, pix, state, stats, buf: Vec::new() };
+    // Sub-patches of a split patch: side `(b + o) / 2`, so two of them overlap by `o`.
+    let bs = (b + o) / 2;
+    let halves = |lo: usize, hi: usize| -> Vec<(usize, usize)> {
+        if hi - lo <= bs { vec![(lo, hi)] } else { vec![(lo, lo + bs), (hi - bs, hi)] }
+    };
     let mut patch_index = 0u64;
     for &y0 in &ys {
         for &x0 in &xs {
             patch_index += 1;
             progress.advance(1);
             let (x1, y1) = ((x0 + b).min(w), (y0 + b).min(h));
-            let (rw, rh) = (x1 - x0, y1 - y0);
-            // Boundary consistency: copy known partners into unknown texels.
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let i = y * w + x;
-                    if state[i] != 0 {
-                        continue;
-                    }
-                    buf.clear();
-                    (target.partners)(x, y, &mut buf);
-                    if let Some(&(px, py)) = buf.iter().find(|&&(px, py)| state[py * w + px] != 0) {
-                        pix[i] = pix[py * w + px];
-                        state[i] = 2;
-                        state[py * w + px] = 2; // both copies are locked from now on
-                        stats.fixed_texels += 1;
+            if bs > o && tau_spread(target.tau, w, x0..x1, y0..y1) > options.split_spread {
+                canvas.stats.split_patches += 1;
+                let mut k = 0u64;
+                for &(sy0, sy1) in &halves(y0, y1) {
+                    for &(sx0, sx1) in &halves(x0, x1) {
+                        let rng = stream(options.seed, "quilt-split", 4 * patch_index + k);
+                        k += 1;
+                        canvas.place(levels, target, options, sx0..sx1, sy0..sy1, rng);
                     }
                 }
-            }
-            let mut unknown = 0;
-            let mut known: Vec<(usize, usize, [f32; 3])> = Vec::new();
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let i = y * w + x;
-                    if state[i] == 0 {
-                        unknown += 1;
-                    } else {
-                        known.push((x - x0, y - y0, pix[i]));
-                    }
-                }
-            }
-            if unknown == 0 {
-                continue;
-            }
-            let level =
-                (target.level_for)(patch_tau(target.tau, w, x0..x1, y0..y1)).min(levels.len() - 1);
-            let ex = &levels[level];
-            stats.patches += 1;
-            stats.level_histogram[level] += 1;
-            let mut rng = stream(options.seed, "quilt", patch_index);
-            let (mx, my) = (ex.width.saturating_sub(rw) + 1, ex.height.saturating_sub(rh) + 1);
-            let cands: Vec<(usize, usize)> = (0..options.candidates.max(1))
-                .map(|_| (rng.random_range(0..mx), rng.random_range(0..my)))
-                .collect();
-            let errors: Vec<f64> = cands
-                .par_iter()
-                .map(|&(cx, cy)| {
-                    let mut e = 0.0f64;
-                    for &(dx, dy, a) in &known {
-                        let p = ex.get((cx + dx).min(ex.width - 1), (cy + dy).min(ex.height - 1));
-                        for c in 0..3 {
-                            let d = (p[c] - a[c]) as f64;
-                            e += d * d;
-                        }
-                    }
-                    e
-                })
-                .collect();
-            let best = errors.iter().cloned().fold(f64::INFINITY, f64::min);
-            let ok: Vec<usize> = (0..cands.len())
-                .filter(|&k| errors[k] <= best * (1.0 + options.tolerance) + 1e-12)
-                .collect();
-            let pick = if ok.is_empty() { 0 } else { ok[rng.random_range(0..ok.len())] };
-            let (cx, cy) = cands[pick];
-            let patch = |dx: usize, dy: usize| {
-                let p = ex.get((cx + dx).min(ex.width - 1), (cy + dy).min(ex.height - 1));
-                [p[0], p[1], p[2]]
-            };
-            if known.is_empty() {
-                for y in y0..y1 {
-                    for x in x0..x1 {
-                        pix[y * w + x] = patch(x - x0, y - y0);
-                        state[y * w + x] = 1;
-                    }
-                }
-                continue;
-            }
-            // Minimum-cost seam over the region.
-            let node = |x: usize, y: usize| (y - y0) * rw + (x - x0);
-            let diff = |x: usize, y: usize| -> f64 {
-                let i = y * w + x;
-                if state[i] == 0 {
-                    return 0.0;
-                }
-                let p = patch(x - x0, y - y0);
-                (0..3).map(|c| (p[c] - pix[i][c]).abs() as f64).sum()
-            };
-            let mut g = MaxFlow::new(rw * rh);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let i = y * w + x;
-                    let n = node(x, y);
-                    let ring = x == x0 || y == y0 || x + 1 == x1 || y + 1 == y1;
-                    match state[i] {
-                        0 => g.add_terminal(n, 0, INF),
-                        2 => g.add_terminal(n, INF, 0),
-                        _ if ring => g.add_terminal(n, INF, 0),
-                        _ => {}
-                    }
-                    if x + 1 < x1 {
-                        let c = ((diff(x, y) + diff(x + 1, y)) * SCALE) as i64 + 1;
-                        g.add_edge(n, node(x + 1, y), c, c);
-                    }
-                    if y + 1 < y1 {
-                        let c = ((diff(x, y) + diff(x, y + 1)) * SCALE) as i64 + 1;
-                        g.add_edge(n, node(x, y + 1), c, c);
-                    }
-                }
-            }
-            let flow = g.solve();
-            stats.seam_cost += flow as f64 / SCALE;
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let i = y * w + x;
-                    let n = node(x, y);
-                    if !g.source_side(n) {
-                        if state[i] != 0 {
-                            // Was known and is replaced: count seam texels at the cut.
-                            if x > x0 && g.source_side(node(x - 1, y))
-                                || y > y0 && g.source_side(node(x, y - 1))
-                            {
-                                stats.seam_texels += 1;
-                            }
-                        }
-                        pix[i] = patch(x - x0, y - y0);
-                        state[i] = 1;
-                    }
-                }
+            } else {
+                let rng = stream(options.seed, "quilt", patch_index);
+                canvas.place(levels, target, options, x0..x1, y0..y1, rng);
             }
         }
     }
     progress.finish_stage();
     let mut out = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-    for (i, p) in pix.iter().enumerate() {
+    for (i, p) in canvas.pix.iter().enumerate() {
         out.pixels[i] = [p[0], p[1], p[2], 1.0];
     }
-    (out, stats)
+    (out, canvas.stats)
+}
+
+/// The canvas being quilted: colours, texel states, statistics.
+struct Canvas {
+    w: usize,
+    pix: Vec<[f32; 3]>,
+    state: Vec<u8>,
+    stats: QuiltStats,
+    buf: Vec<(usize, usize)>,
+}
+
+impl Canvas {
+    /// Places one patch over the region `xs × ys`: partner copies, level choice,
+    /// candidate search, minimum-cut seam (see the module docs).
+    fn place(
+        &mut self,
+        levels: &[Image],
+        target: &QuiltTarget,
+        options: &QuiltingOptions,
+        xs: std::ops::Range<usize>,
+        ys: std::ops::Range<usize>,
+        mut rng: impl rand::Rng,
+    ) {
+        let w = self.w;
+        let (x0, x1, y0, y1) = (xs.start, xs.end, ys.start, ys.end);
+        let (rw, rh) = (x1 - x0, y1 - y0);
+        let (pix, state, stats, buf) =
+            (&mut self.pix, &mut self.state, &mut self.stats, &mut self.buf);
+        // Boundary consistency: copy known partners into unknown texels.
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let i = y * w + x;
+                if state[i] != 0 {
+                    continue;
+                }
+                buf.clear();
+                (target.partners)(x, y, buf);
+                if let Some(&(px, py)) = buf.iter().find(|&&(px, py)| state[py * w + px] != 0) {
+                    pix[i] = pix[py * w + px];
+                    state[i] = 2;
+                    state[py * w + px] = 2; // both copies are locked from now on
+                    stats.fixed_texels += 1;
+                }
+            }
+        }
+        let mut unknown = 0;
+        let mut known: Vec<(usize, usize, [f32; 3])> = Vec::new();
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let i = y * w + x;
+                if state[i] == 0 {
+                    unknown += 1;
+                } else {
+                    known.push((x - x0, y - y0, pix[i]));
+                }
+            }
+        }
+        if unknown == 0 {
+            return;
+        }
+        let level =
+            (target.level_for)(patch_tau(target.tau, w, x0..x1, y0..y1)).min(levels.len() - 1);
+        let ex = &levels[level];
+        stats.patches += 1;
+        stats.level_histogram[level] += 1;
+        let (mx, my) = (ex.width.saturating_sub(rw) + 1, ex.height.saturating_sub(rh) + 1);
+        let cands: Vec<(usize, usize)> = (0..options.candidates.max(1))
+            .map(|_| (rng.random_range(0..mx), rng.random_range(0..my)))
+            .collect();
+        let errors: Vec<f64> = cands
+            .par_iter()
+            .map(|&(cx, cy)| {
+                let mut e = 0.0f64;
+                for &(dx, dy, a) in &known {
+                    let p = ex.get((cx + dx).min(ex.width - 1), (cy + dy).min(ex.height - 1));
+                    for c in 0..3 {
+                        let d = (p[c] - a[c]) as f64;
+                        e += d * d;
+                    }
+                }
+                e
+            })
+            .collect();
+        let best = errors.iter().cloned().fold(f64::INFINITY, f64::min);
+        let ok: Vec<usize> = (0..cands.len())
+            .filter(|&k| errors[k] <= best * (1.0 + options.tolerance) + 1e-12)
+            .collect();
+        let pick = if ok.is_empty() { 0 } else { ok[rng.random_range(0..ok.len())] };
+        let (cx, cy) = cands[pick];
+        let patch = |dx: usize, dy: usize| {
+            let p = ex.get((cx + dx).min(ex.width - 1), (cy + dy).min(ex.height - 1));
+            [p[0], p[1], p[2]]
+        };
+        if known.is_empty() {
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    pix[y * w + x] = patch(x - x0, y - y0);
+                    state[y * w + x] = 1;
+                }
+            }
+            return;
+        }
+        // Minimum-cost seam over the region.
+        let node = |x: usize, y: usize| (y - y0) * rw + (x - x0);
+        let diff = |x: usize, y: usize| -> f64 {
+            let i = y * w + x;
+            if state[i] == 0 {
+                return 0.0;
+            }
+            let p = patch(x - x0, y - y0);
+            (0..3).map(|c| (p[c] - pix[i][c]).abs() as f64).sum()
+        };
+        let mut g = MaxFlow::new(rw * rh);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let i = y * w + x;
+                let n = node(x, y);
+                let ring = x == x0 || y == y0 || x + 1 == x1 || y + 1 == y1;
+                match state[i] {
+                    0 => g.add_terminal(n, 0, INF),
+                    2 => g.add_terminal(n, INF, 0),
+                    _ if ring => g.add_terminal(n, INF, 0),
+                    _ => {}
+                }
+                if x + 1 < x1 {
+                    let c = ((diff(x, y) + diff(x + 1, y)) * SCALE) as i64 + 1;
+                    g.add_edge(n, node(x + 1, y), c, c);
+                }
+                if y + 1 < y1 {
+                    let c = ((diff(x, y) + diff(x, y + 1)) * SCALE) as i64 + 1;
+                    g.add_edge(n, node(x, y + 1), c, c);
+                }
+            }
+        }
+        let flow = g.solve();
+        stats.seam_cost += flow as f64 / SCALE;
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let i = y * w + x;
+                let n = node(x, y);
+                if !g.source_side(n) {
+                    if state[i] != 0 {
+                        // Was known and is replaced: count seam texels at the cut.
+                        if x > x0 && g.source_side(node(x - 1, y))
+                            || y > y0 && g.source_side(node(x, y - 1))
+                        {
+                            stats.seam_texels += 1;
+                        }
+                    }
+                    pix[i] = patch(x - x0, y - y0);
+                    state[i] = 1;
+                }
+            }
+        }
+    }
 }
 
 /// The `τ` a patch takes its level from: the mean of `τ` over the patch weighted by
@@ -269,6 +335,25 @@ fn patch_tau(
         }
     }
     if den > 0.0 && num.is_finite() { num / den } else { f64::NAN }
+}
+
+/// `max τ / min τ` over the texels of the region that have a `τ` (1 without any).
+fn tau_spread(
+    tau: &[f32],
+    width: usize,
+    xs: std::ops::Range<usize>,
+    ys: std::ops::Range<usize>,
+) -> f64 {
+    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+    for y in ys {
+        for &t in &tau[y * width + xs.start..y * width + xs.end] {
+            if t.is_finite() && t > 0.0 {
+                lo = lo.min(t);
+                hi = hi.max(t);
+            }
+        }
+    }
+    if hi > 0.0 { (hi / lo) as f64 } else { 1.0 }
 }
 
 /// Power `p` of the `τ^-p` weights of a patch's level choice (`patch_tau`).
@@ -346,6 +431,45 @@ mod tests {
         assert!(patch_tau(&[f32::NAN; 4], 2, 0..2, 0..2).is_nan());
     }
 
+    /// A 40 × 40 canvas whose 16 left columns have `τ` 1 and the others 4 (level 0 below
+    /// 2, level 1 above): one whole patch takes one level (the `τ⁻⁴` weights favour the
+    /// compressed side); with `split_spread` 2 it is placed as four 24-px patches, and
+    /// the right two (columns 16–39, all `τ` 4) take level 1. A uniform canvas is never
+    /// split.
+    #[test]
+    fn patches_over_a_fast_tau_change_are_split() {
+        let (w, h) = (40, 40);
+        let tau: Vec<f32> = (0..w * h).map(|i| if i % w < 16 { 1.0 } else { 4.0 }).collect();
+        let level_for = |t: f64| if t < 2.0 { 0 } else { 1 };
+        let partners = |_: usize, _: usize, _: &mut Vec<(usize, usize)>| {};
+        let levels = [exemplar(), crate::exemplar_scales::resample(&exemplar(), 3.0)];
+        let run = |tau: &[f32], split: f64| {
+            let target = QuiltTarget {
+                width: w,
+                height: h,
+                tau,
+                level_for: &level_for,
+                partners: &partners,
+            };
+            let opts = QuiltingOptions {
+                patch_size: 40,
+                overlap: 8,
+                candidates: 32,
+                split_spread: split,
+                ..Default::default()
+            };
+            quilt(&levels, &target, &opts, &NoProgress).1
+        };
+        let whole = run(&tau, f64::INFINITY);
+        assert_eq!((whole.patches, whole.split_patches), (1, 0));
+        assert_eq!(whole.level_histogram, vec![1, 0]);
+        let split = run(&tau, 2.0);
+        assert_eq!((split.patches, split.split_patches), (4, 1));
+        assert_eq!(split.level_histogram, vec![2, 2]);
+        let uniform = run(&vec![4.0; w * h], 2.0);
+        assert_eq!((uniform.patches, uniform.split_patches), (1, 0));
+    }
+
     #[test]
     fn same_output_for_one_and_two_threads() {
         let (w, h) = (70, 60);
@@ -366,7 +490,12 @@ mod tests {
                 quilt(
                     &levels,
                     &target,
-                    &QuiltingOptions { patch_size: 20, overlap: 5, ..Default::default() },
+                    &QuiltingOptions {
+                        patch_size: 20,
+                        overlap: 5,
+                        split_spread: 1.2,
+                        ..Default::default()
+                    },
                     &NoProgress,
                 )
             })
@@ -376,5 +505,6 @@ mod tests {
         assert_eq!(a, b);
         assert_eq!(sa, sb);
         assert!(sa.level_histogram[0] > 0 && sa.level_histogram[1] > 0);
+        assert!(sa.split_patches > 0);
     }
 }

@@ -29,6 +29,12 @@ use report::{add_notes, component_json, texel_density, weighted_quantile};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
+/// A quilting patch whose texels' `τ` spans more than this factor is placed as four
+/// half-size patches with a level each (`QuiltingOptions::split_spread`). Session 13,
+/// fertility, three seeds: 2 gave feature-size CV ratios 0.42–0.45 against 0.49–0.50
+/// with whole patches; 1.25, 1.5 and 3 were no better (docs/conformal.md).
+pub const PATCH_SPLIT_SPREAD: f64 = 2.0;
+
 /// Options of [`conformal`].
 #[derive(Debug, Clone, Serialize)]
 pub struct ConformalOptions {
@@ -234,6 +240,10 @@ pub fn conformal(
     let qbase = QuiltingOptions {
         patch_size: options.patch_size,
         overlap: (options.patch_size / 5).max(2),
+        // A 40-px patch over a fast τ change (near zero points, across neighbouring
+        // charts) is placed as four half-size patches, each with its own level; the
+        // ablation keeps whole patches (one level, nothing to choose).
+        split_spread: if options.multiscale { PATCH_SPLIT_SPREAD } else { f64::INFINITY },
         seed: options.seed,
         ..Default::default()
     };
@@ -312,7 +322,7 @@ pub fn conformal(
     let comp_json: Vec<serde_json::Value> =
         comps.iter().zip(&images).map(|(c, img)| component_json(c, img.as_ref())).collect();
     report.metric("components", comp_json);
-    report.metric("exemplar_levels", json!({"scales": level_names, "tau_reference": tau_ref, "tau_q05": q05, "tau_q95": q95, "multiscale": options.multiscale}));
+    report.metric("exemplar_levels", json!({"scales": level_names, "tau_reference": tau_ref, "tau_q05": q05, "tau_q95": q95, "multiscale": options.multiscale, "patch_split_spread": qbase.split_spread}));
     report.metric("quilting", quilt_stats);
     if options.quasi_isometric {
         report.metric("mass_spring", relax_stats);
@@ -322,11 +332,15 @@ pub fn conformal(
     });
     report.metric("seams", seams);
     let feature = report.stage(progress, "eval-feature-size", || {
-        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, true)
+        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, true, true)
     });
     report.metric("feature_size", feature);
+    let feature_centre = report.stage(progress, "eval-feature-size-centre", || {
+        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, true, false)
+    });
+    report.metric("feature_size_centre_lambda", feature_centre);
     let feature24 = report.stage(progress, "eval-feature-size-fixed", || {
-        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, false)
+        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, false, false)
     });
     report.metric("feature_size_fixed_window", feature24);
     // Whole-mesh distortion in texel units (the texture is not square).
