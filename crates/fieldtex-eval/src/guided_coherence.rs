@@ -8,7 +8,8 @@
 //! the perpendicular `(−dy, dx)`. The plain metric compares axis-aligned output patches
 //! and so penalises every rotated region, even an exact rotated copy of the exemplar.
 //!
-//! Method, per query pixel `p` on a regular grid with step [`stride`]:
+//! Method, per query pixel `p` on a regular grid with step [`stride`] (or, with
+//! [`sampled_queries`], at seeded random pixels: see below):
 //! 1. **Output patch** (`N×N`, `N` = [`patch_size`], default 7 like the plain metric):
 //!    samples at `p + (½, ½) + u_i·d + u_j·d⊥`, `u = i − (N−1)/2`, read with bilinear
 //!    interpolation. Queries whose samples leave the output, or where the field is zero
@@ -42,6 +43,15 @@
 //! stride 16 takes ≈ 2 s. Stride 1 evaluates every pixel (64× the default). TODO: a
 //! faster exact search (e.g. the displacement scan of `nearest_patch` per angle bin).
 //!
+//! **Sampled queries** ([`sampled_queries`] > 0; the pipelines' default reports use
+//! [`SAMPLED_QUERIES`]): the query pixels are drawn uniformly with replacement (a seeded
+//! hash) from the pixels at least `⌈(N−1)/√2⌉ + 1` from every edge, where the rotated
+//! patch stays inside at any angle, and the report carries the standard error of the
+//! sample mean (`sd / √queries`, simple random sampling). A substitute for the grid
+//! whose measured gap to the exact grid mean is pinned by `tests/approximate_metrics.rs`
+//! (`docs/first-hour.md`): half the queries of the default stride-8 grid at 512², and
+//! no aliasing with a texture's period.
+//!
 //! Not implemented: anisotropic scale (the field is taken as unit length: its
 //! magnitude is ignored), mirror frames, and per-sample frames (one frame per patch,
 //! taken from the field at `p`).
@@ -50,6 +60,7 @@
 //! [`patch_size`]: GuidedCoherenceOptions::patch_size
 //! [`wrap_exemplar`]: GuidedCoherenceOptions::wrap_exemplar
 //! [`sign_free`]: GuidedCoherenceOptions::sign_free
+//! [`sampled_queries`]: GuidedCoherenceOptions::sampled_queries
 
 use crate::EvalError;
 use crate::image_view::{FieldView, ImageView};

@@ -111,17 +111,28 @@ fn bit_identical_for_any_thread_count() {
             [a.cos(), a.sin()]
         })
         .collect();
-    let run = |threads: usize| {
+    let run = |threads: usize, opts: &GuidedCoherenceOptions| {
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
             let o = ImageView::new(&out, size, size, 3).unwrap();
             let f = FieldView::new(&field, size, size).unwrap();
-            let opts = GuidedCoherenceOptions { stride: 3, ..Default::default() };
-            guided_coherence(&o, &exemplar_view(&ex, ew, eh), &f, &opts).unwrap()
+            guided_coherence(&o, &exemplar_view(&ex, ew, eh), &f, opts).unwrap()
         })
     };
-    let (a, b) = (run(1), run(3));
+    let grid = GuidedCoherenceOptions { stride: 3, ..Default::default() };
+    let (a, b) = (run(1, &grid), run(3, &grid));
     assert_eq!(a, b);
     assert!(a.queries > 100 && a.mean > 0.0, "{a:?}");
+    // The pipelines' default: the approximate search on a seeded sample of pixels.
+    let sampled = GuidedCoherenceOptions {
+        approximate: Some(fieldtex_eval::ApproximateSearchOptions::default()),
+        sampled_queries: 300,
+        seed: 4,
+        ..Default::default()
+    };
+    let (a, b) = (run(1, &sampled), run(3, &sampled));
+    assert_eq!(a, b);
+    assert_eq!((a.queries, a.sampled_queries, a.skipped_border), (300, 300, 0), "{a:?}");
+    assert!(a.standard_error.is_some_and(|se| se > 0.0), "{a:?}");
 }
 
 #[test]
