@@ -5,7 +5,7 @@
 # Per exemplar × preset (512², seed 1, the metrics of `fieldtex orient`'s report.json):
 # - err: orientation error of the texture against the field turned by the exemplar's own
 #   dominant direction; limit max(10°, the exemplar's own error against that direction + 3°).
-# - gcoh: guided coherence (approximate search, stride 8, as in the report); limit 1.3× the
+# - gcoh: guided coherence (approximate search on 2 048 seeded query pixels, as in the report since session 13; stride 8 before); limit 1.3× the
 #   rotated-copy floor: the exemplar itself rotated exactly to constant fields at 10°, 20°,
 #   30° and 45° (`orient_probe --ideal`, the synthesis's own colour lookup), scored by
 #   `fieldtex eval` with the same search, mean over the four angles.

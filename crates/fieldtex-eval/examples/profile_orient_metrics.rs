@@ -113,21 +113,27 @@ fn main() {
         // `--guided-stride S` tries another query step.
         let stride =
             arg("--guided-stride").map_or(GuidedCoherenceOptions::default().stride, |s| s as usize);
+        // The facade's default samples query pixels (`--guided-samples N`, 0 = the grid).
+        let default_samples = if exact { 0 } else { guided_coherence::SAMPLED_QUERIES };
+        let sampled_queries = arg("--guided-samples").map_or(default_samples, |s| s as usize);
         let o = GuidedCoherenceOptions {
             approximate: approximate.clone(),
             stride,
+            sampled_queries,
+            seed: 1,
             ..Default::default()
         };
         guided_coherence(&ov, &ev, &fv, &o).unwrap()
     });
+    // The facade computes one orientation map for both (same σ).
+    let map = stage("orientation_map", || {
+        image_orientation(&ov, &OrientationOptions::default()).unwrap()
+    });
     let oe = stage("orientation_error", || {
         let o = OrientationErrorOptions { exemplar_angle_deg: angle, ..Default::default() };
-        orientation_error(&ov, &OrientationReference::Field(fv), &o).unwrap()
+        orientation_error_of_map(&map, &OrientationReference::Field(fv), &o).unwrap()
     });
-    let s = stage("singularities", || {
-        let map = image_orientation(&ov, &OrientationOptions::default()).unwrap();
-        singularities(&map, &SingularityOptions::default())
-    });
+    let s = stage("singularities", || singularities(&map, &SingularityOptions::default()));
     // The facade's default counts phase defects on the image reduced 2×.
     let pd = stage("phase_defects", || {
         let o = PhaseDefectOptions::default();

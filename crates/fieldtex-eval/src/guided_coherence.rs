@@ -8,7 +8,8 @@
 //! the perpendicular `(−dy, dx)`. The plain metric compares axis-aligned output patches
 //! and so penalises every rotated region, even an exact rotated copy of the exemplar.
 //!
-//! Method, per query pixel `p` on a regular grid with step [`stride`]:
+//! Method, per query pixel `p` on a regular grid with step [`stride`] (or, with
+//! [`sampled_queries`], at seeded random pixels: see below):
 //! 1. **Output patch** (`N×N`, `N` = [`patch_size`], default 7 like the plain metric):
 //!    samples at `p + (½, ½) + u_i·d + u_j·d⊥`, `u = i − (N−1)/2`, read with bilinear
 //!    interpolation. Queries whose samples leave the output, or where the field is zero
@@ -42,6 +43,15 @@
 //! stride 16 takes ≈ 2 s. Stride 1 evaluates every pixel (64× the default). TODO: a
 //! faster exact search (e.g. the displacement scan of `nearest_patch` per angle bin).
 //!
+//! **Sampled queries** ([`sampled_queries`] > 0; the pipelines' default reports use
+//! [`SAMPLED_QUERIES`]): the query pixels are drawn uniformly with replacement (a seeded
+//! hash) from the pixels at least `⌈(N−1)/√2⌉ + 1` from every edge, where the rotated
+//! patch stays inside at any angle, and the report carries the standard error of the
+//! sample mean (`sd / √queries`, simple random sampling). A substitute for the grid
+//! whose measured gap to the exact grid mean is pinned by `tests/approximate_metrics.rs`
+//! (`docs/first-hour.md`): half the queries of the default stride-8 grid at 512², and
+//! no aliasing with a texture's period.
+//!
 //! Not implemented: anisotropic scale (the field is taken as unit length: its
 //! magnitude is ignored), mirror frames, and per-sample frames (one frame per patch,
 //! taken from the field at `p`).
@@ -50,6 +60,7 @@
 //! [`patch_size`]: GuidedCoherenceOptions::patch_size
 //! [`wrap_exemplar`]: GuidedCoherenceOptions::wrap_exemplar
 //! [`sign_free`]: GuidedCoherenceOptions::sign_free
+//! [`sampled_queries`]: GuidedCoherenceOptions::sampled_queries
 
 use crate::EvalError;
 use crate::image_view::{FieldView, ImageView};
@@ -71,14 +82,35 @@ pub struct GuidedCoherenceOptions {
     /// where `d` and `−d` are the same direction). Default true.
     pub sign_free: bool,
     /// `Some`: approximate nearest search (PCA + kd-tree, an upper bound of the exact
-    /// distances, [`crate::approximate_nearest_patch`]; its `query_stride` is not used,
-    /// [`stride`] is); `None`: the exact search. Default `None`.
+    /// distances, [`crate::approximate_nearest_patch`]; its `query_stride` and
+    /// `sampled_queries` are not used: `stride` and `sampled_queries` here are); `None`:
+    /// the exact search. Default `None`.
     pub approximate: Option<crate::ApproximateSearchOptions>,
+    /// `> 0`: the mean is estimated from this many query pixels drawn uniformly (with
+    /// replacement, a seeded hash of `seed`) from the pixels whose rotated patch stays
+    /// inside the output at any angle, instead of the `stride` grid, and the report
+    /// carries its standard error (a substitute for the grid with a measured error:
+    /// `tests/approximate_metrics.rs`). 0: the grid. Default 0; the pipelines'
+    /// default reports use [`SAMPLED_QUERIES`].
+    pub sampled_queries: usize,
+    /// Seed of the query sample. Default 1.
+    pub seed: u64,
 }
+
+/// Query pixels of the pipelines' default (sampled) guided coherence.
+pub const SAMPLED_QUERIES: usize = 2_048;
 
 impl Default for GuidedCoherenceOptions {
     fn default() -> Self {
-        Self { patch_size: 7, stride: 8, wrap_exemplar: true, sign_free: true, approximate: None }
+        Self {
+            patch_size: 7,
+            stride: 8,
+            wrap_exemplar: true,
+            sign_free: true,
+            approximate: None,
+            sampled_queries: 0,
+            seed: 1,
+        }
     }
 }
 
@@ -126,6 +158,14 @@ pub struct GuidedCoherenceReport {
     pub sign_free: bool,
     /// `"exact"` or `"approximate"`.
     pub search: String,
+    /// Query pixels drawn at random ([`GuidedCoherenceOptions::sampled_queries`]); 0
+    /// when the `stride` grid was used.
+    pub sampled_queries: usize,
+    /// For a sampled mean: its standard error (sample standard deviation / √queries;
+    /// the estimate is within ±1.96 of the mean over every eligible pixel with about
+    /// 95 % probability); absent for the grid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standard_error: Option<f64>,
 }
 
 /// Bilinear sample of all channels at `(x, y)` (pixel centres at integers), with
@@ -314,19 +354,30 @@ pub fn guided_coherence(
         None => None,
     };
     let s = options.stride;
-    let xs: Vec<usize> = (s / 2..output.width).step_by(s).collect();
-    let ys: Vec<usize> = (s / 2..output.height).step_by(s).collect();
-    // Per query row: (distances, border skips, no-direction skips), in row order.
-    let per_row: Vec<(Vec<f32>, usize, usize)> = ys
+    let sampled = sampled_positions(output.width, output.height, n, options);
+    let rows: Vec<Vec<(usize, usize)>> = match &sampled {
+        // Fixed chunks of the sample: the result does not depend on the thread count.
+        Some(p) => p.chunks(64).map(|c| c.to_vec()).collect(),
+        None => {
+            let xs: Vec<usize> = (s / 2..output.width).step_by(s).collect();
+            (s / 2..output.height)
+                .step_by(s)
+                .map(|py| xs.iter().map(|&px| (px, py)).collect())
+                .collect()
+        }
+    };
+    // Per query row (or chunk of the sample): (distances, border skips, no-direction
+    // skips), in order.
+    let per_row: Vec<(Vec<f32>, usize, usize)> = rows
         .par_iter()
-        .map(|&py| {
+        .map(|row| {
             let mut q = vec![0f32; dim];
             let mut q_flip = vec![0f32; dim];
             let mut scratch = crate::approximate_nearest_patch::SearchScratch::default();
-            let mut dists = Vec::with_capacity(xs.len());
+            let mut dists = Vec::with_capacity(row.len());
             let (mut border, mut no_dir) = (0, 0);
             let mut hint = 0usize;
-            for &px in &xs {
+            for &(px, py) in row {
                 match sample_query(output, field, px, py, n, &mut q, &mut q_flip) {
                     Query::Border => border += 1,
                     Query::NoDirection => no_dir += 1,
@@ -365,6 +416,14 @@ pub fn guided_coherence(
     let norm = 1.0 / dim as f64;
     let mut v: Vec<f64> = all.iter().map(|&d| d.max(0.0) as f64 * norm).collect();
     let mean = if v.is_empty() { f64::NAN } else { v.iter().sum::<f64>() / v.len() as f64 };
+    let standard_error = sampled.as_ref().map(|_| {
+        let m = v.len();
+        if m < 2 {
+            return 0.0;
+        }
+        let var = v.iter().map(|d| (d - mean) * (d - mean)).sum::<f64>() / (m - 1) as f64;
+        (var / m as f64).sqrt()
+    });
     v.sort_by(|a, b| a.total_cmp(b));
     let pick = |f: f64| {
         v.get(((v.len() as f64 * f) as usize).min(v.len().saturating_sub(1)))
@@ -384,7 +443,34 @@ pub fn guided_coherence(
         stride: s,
         sign_free: options.sign_free,
         search: if options.approximate.is_some() { "approximate" } else { "exact" }.into(),
+        sampled_queries: sampled.as_ref().map_or(0, |p| p.len()),
+        standard_error,
     })
+}
+
+/// The query pixels of a sampled estimate ([`GuidedCoherenceOptions::sampled_queries`]):
+/// drawn uniformly with replacement from the pixels at least `⌈(N−1)/√2⌉ + 1` from
+/// every edge, where an `N×N` patch in any frame stays inside the output; `None` for
+/// the grid (no sample asked for, or an output too small for that margin).
+fn sampled_positions(
+    width: usize,
+    height: usize,
+    n: usize,
+    options: &GuidedCoherenceOptions,
+) -> Option<Vec<(usize, usize)>> {
+    let count = options.sampled_queries;
+    // Half the patch diagonal, (N−1)/2·√2, rounded up, plus one pixel for the
+    // half-pixel centre and the bilinear footprint.
+    let margin = ((n as f64 - 1.0) / std::f64::consts::SQRT_2).ceil() as usize + 1;
+    if count == 0 || width <= 2 * margin || height <= 2 * margin {
+        return None;
+    }
+    let (span_x, span_y) = (width - 2 * margin, height - 2 * margin);
+    let pick = |i: u64, span: usize| {
+        let u = fieldtex_core::rng::hash_unit(options.seed, "guided-queries", i);
+        margin + ((u * span as f64) as usize).min(span - 1)
+    };
+    Some((0..count as u64).map(|i| (pick(2 * i, span_x), pick(2 * i + 1, span_y))).collect())
 }
 
 /// Smallest SSD of `q` (and `q_flip` when given) to any patch of `db`, and the index

@@ -66,7 +66,7 @@ pub use nearest_patch_metrics::{
 pub use orientation::{
     OrientationErrorOptions, OrientationErrorReport, OrientationMap, OrientationOptions,
     OrientationReference, dominant_orientation, image_orientation, luminance_orientation,
-    orientation_error,
+    orientation_error, orientation_error_of_map,
 };
 pub use phase_defects::{
     PhaseDefect, PhaseDefectOptions, PhaseDefectReport, count_defects_near, estimate_stripe_period,

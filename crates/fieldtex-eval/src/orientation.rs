@@ -257,13 +257,25 @@ pub fn orientation_error(
     reference: &OrientationReference,
     options: &OrientationErrorOptions,
 ) -> Result<OrientationErrorReport, EvalError> {
+    check_error_inputs(image.width, image.height, reference, options)?;
+    let map = image_orientation(image, &options.structure)?;
+    orientation_error_of_map(&map, reference, options)
+}
+
+/// The size and angle checks of [`orientation_error`].
+fn check_error_inputs(
+    width: usize,
+    height: usize,
+    reference: &OrientationReference,
+    options: &OrientationErrorOptions,
+) -> Result<(), EvalError> {
     if let OrientationReference::Field(f) = reference
-        && (f.width, f.height) != (image.width, image.height)
+        && (f.width, f.height) != (width, height)
     {
         return Err(EvalError::SizeMismatch {
             what: "orientation field vs image",
-            expected_width: image.width,
-            expected_height: image.height,
+            expected_width: width,
+            expected_height: height,
             found_width: f.width,
             found_height: f.height,
         });
@@ -275,10 +287,22 @@ pub fn orientation_error(
             reason: "must be finite",
         });
     }
-    let map = image_orientation(image, &options.structure)?;
+    Ok(())
+}
+
+/// [`orientation_error`] of an image whose structure-tensor orientation `map` is already
+/// computed (with `options.structure`; `options.structure.sigma` is reported as given),
+/// so that one map serves this and [`crate::singularities()`]. The same values as
+/// [`orientation_error`] on the image the map came from.
+pub fn orientation_error_of_map(
+    map: &OrientationMap,
+    reference: &OrientationReference,
+    options: &OrientationErrorOptions,
+) -> Result<OrientationErrorReport, EvalError> {
+    check_error_inputs(map.width, map.height, reference, options)?;
     let border = options.border.unwrap_or_else(|| options.structure.default_border());
     let offset = options.exemplar_angle_deg.to_radians();
-    let (w, h) = (image.width, image.height);
+    let (w, h) = (map.width, map.height);
     // Per-row partial sums, reduced in row order for determinism.
     let rows: Vec<[f64; 6]> = (0..h)
         .into_par_iter()

@@ -153,12 +153,15 @@ fn mean_gabor_amplitude(l0: &[f32], w: usize, h: usize, normal: &[f32], t: f64) 
                     .collect()
             };
             let (hx, hy) = (taps(kx), taps(ky));
+            // The mirrored columns of the window, once per point (the same indices, so
+            // the same sums, as mirroring every tap).
+            let cols: Vec<usize> = (-r..=r).map(|dx| mirror(x as isize + dx, w)).collect();
             let (mut re, mut im) = (0f64, 0f64);
             for (dy, &(yr, yi)) in (-r..=r).zip(&hy) {
-                let row = mirror(y as isize + dy, h) * w;
+                let row = &l0[mirror(y as isize + dy, h) * w..][..w];
                 let (mut sr, mut si) = (0f64, 0f64);
-                for (dx, &(xr, xi)) in (-r..=r).zip(&hx) {
-                    let v = l0[row + mirror(x as isize + dx, w)] as f64;
+                for (&c, &(xr, xi)) in cols.iter().zip(&hx) {
+                    let v = row[c] as f64;
                     sr += xr * v;
                     si += xi * v;
                 }
@@ -266,6 +269,11 @@ pub fn phase_defects(
     let r = (g.len() / 2) as isize;
     let mut re = vec![0f32; w * h];
     let mut im = vec![0f32; w * h];
+    // Start offsets of the (mirrored) rows within the column kernel's reach of each row.
+    let taps = g.len();
+    let reach_rows: Vec<usize> = (0..h)
+        .flat_map(|y| (0..taps).map(move |j| mirror(y as isize + j as isize - r, h) * w))
+        .collect();
     for b in 0..m {
         let beta = b as f64 * bin_width;
         let (kx, ky) = (k * beta.cos(), k * beta.sin());
@@ -296,10 +304,11 @@ pub fn phase_defects(
         // kernel's reach of row y'.
         let mut needed = vec![false; w * h];
         for y in 0..h {
+            let reach = &reach_rows[y * taps..(y + 1) * taps];
             for x in 0..w {
                 if bins[y * w + x] as usize == b {
-                    for j in 0..hy.len() {
-                        needed[mirror(y as isize + j as isize - r, h) * w + x] = true;
+                    for &row in reach {
+                        needed[row + x] = true;
                     }
                 }
             }
@@ -337,14 +346,13 @@ pub fn phase_defects(
         });
         // Column pass at the pixels of this bin: R = Σ hy(d) T(x, y + d).
         re.par_chunks_mut(w).zip(im.par_chunks_mut(w)).enumerate().for_each(|(y, (rr, ri))| {
-            let src_rows: Vec<usize> =
-                (0..hy.len()).map(|j| mirror(y as isize + j as isize - r, h) * w).collect();
+            let src_rows = &reach_rows[y * taps..(y + 1) * taps];
             for x in 0..w {
                 if bins[y * w + x] as usize != b {
                     continue;
                 }
                 let (mut a, mut c) = (0f32, 0f32);
-                for (&(hr, hi), &row) in hy.iter().zip(&src_rows) {
+                for (&(hr, hi), &row) in hy.iter().zip(src_rows) {
                     let (vr, vi) = (tre[row + x], tim[row + x]);
                     a += hr * vr - hi * vi;
                     c += hr * vi + hi * vr;

@@ -9,7 +9,7 @@
 use fieldtex_eval::*;
 
 mod common;
-use common::{TEST_EXEMPLARS, load, patchwork};
+use common::{TEST_EXEMPLARS, constant_field, load, patchwork, rotated_copy};
 
 /// Relative gap of the approximate means over the exact ones, on four exemplars: the
 /// search alone (every query) within the stated bound and never below the exact
@@ -108,6 +108,98 @@ fn sampled_means_scatter_as_their_standard_error_says() {
         eprintln!("{what}: rms deviation {rms:.3e}, mean standard error {:.3e}", se[j]);
         assert!(se[j] > 0.0 && rms <= 2.0 * se[j], "{what}: rms {rms} vs standard error {}", se[j]);
     }
+}
+
+/// Guided coherence as the pipelines report it by default (the approximate search on a
+/// seeded sample of [`guided_coherence::SAMPLED_QUERIES`] query pixels) against the
+/// exact search on the stride-4 grid, on patchworks of 24-pixel blocks of each test
+/// exemplar laid out along a constant 30° field (seams like a synthesis output): the
+/// search alone (same grid) within the stated bound of the nearest-patch search and
+/// never below the exact values; the sampled mean within that bound plus three of its
+/// standard errors; the standard error at most 5 % of the mean.
+#[test]
+fn sampled_guided_coherence_stays_within_the_stated_bound() {
+    let size = 160;
+    let deg = 30.0;
+    let bound = fieldtex_eval::approximate_nearest_patch::ERROR_BOUND_PERCENT / 100.0;
+    let field = constant_field(size, deg);
+    let f = FieldView::new(&field, size, size).unwrap();
+    for name in TEST_EXEMPLARS {
+        let (ex, w, h) = load(name);
+        let out = rotated_copy(&ex, w, h, size, deg, true);
+        let o = ImageView::new(&out, size, size, 3).unwrap();
+        let e = ImageView::new(&ex, w, h, 3).unwrap();
+        let grid = GuidedCoherenceOptions { stride: 4, ..Default::default() };
+        let exact = guided_coherence(&o, &e, &f, &grid).unwrap();
+        let approximate = Some(ApproximateSearchOptions::default());
+        let search_opts = GuidedCoherenceOptions { approximate: approximate.clone(), ..grid };
+        let search = guided_coherence(&o, &e, &f, &search_opts).unwrap();
+        let sampled_opts = GuidedCoherenceOptions {
+            approximate,
+            sampled_queries: guided_coherence::SAMPLED_QUERIES,
+            ..Default::default()
+        };
+        let sampled = guided_coherence(&o, &e, &f, &sampled_opts).unwrap();
+        let x = exact.mean;
+        let gap = (search.mean - x) / x.max(1e-12);
+        let se = sampled.standard_error.expect("a sampled mean has a standard error");
+        eprintln!(
+            "{name}: guided coherence exact {x:.6} ({} queries), search {:+.2} %, sampled \
+             {:+.2} % (se {:.2} %, {} queries)",
+            exact.queries,
+            100.0 * gap,
+            100.0 * (sampled.mean - x) / x,
+            100.0 * se / x,
+            sampled.queries
+        );
+        assert_eq!((exact.standard_error, search.standard_error), (None, None));
+        assert_eq!(sampled.queries, guided_coherence::SAMPLED_QUERIES, "{name}");
+        assert!(gap >= -1e-4, "{name}: search below the exact minimum");
+        assert!(gap <= bound, "{name}: search {:.2} % above exact", 100.0 * gap);
+        assert!(
+            (sampled.mean - x).abs() <= bound * x + 3.0 * se,
+            "{name}: sampled {} vs exact {x} (se {se})",
+            sampled.mean
+        );
+        assert!(se <= 0.05 * x, "{name}: standard error {se} of {x}");
+    }
+}
+
+/// The standard error of the sampled guided coherence describes its spread: over eight
+/// seeds the estimates scatter around the mean over every pixel (stride 1, the same
+/// search) by at most twice the mean reported standard error.
+#[test]
+fn sampled_guided_coherence_scatters_as_its_standard_error_says() {
+    let (ex, w, h) = load("pebbles_Rocks002.png");
+    let (size, deg) = (160, 20.0);
+    let out = rotated_copy(&ex, w, h, size, deg, true);
+    let field = constant_field(size, deg);
+    let (o, e) =
+        (ImageView::new(&out, size, size, 3).unwrap(), ImageView::new(&ex, w, h, 3).unwrap());
+    let f = FieldView::new(&field, size, size).unwrap();
+    let approximate = Some(ApproximateSearchOptions::default());
+    let every = GuidedCoherenceOptions {
+        approximate: approximate.clone(),
+        stride: 1,
+        ..Default::default()
+    };
+    let full = guided_coherence(&o, &e, &f, &every).unwrap().mean;
+    let seeds = 8;
+    let (mut dev, mut se) = (0f64, 0f64);
+    for seed in 0..seeds {
+        let opts = GuidedCoherenceOptions {
+            approximate: approximate.clone(),
+            sampled_queries: 512,
+            seed,
+            ..Default::default()
+        };
+        let r = guided_coherence(&o, &e, &f, &opts).unwrap();
+        dev += (r.mean - full) * (r.mean - full) / seeds as f64;
+        se += r.standard_error.unwrap() / seeds as f64;
+    }
+    let rms = dev.sqrt();
+    eprintln!("guided coherence: rms deviation {rms:.3e}, mean standard error {se:.3e}");
+    assert!(se > 0.0 && rms <= 2.0 * se, "rms {rms} vs standard error {se}");
 }
 
 /// The approximate search gives bit-identical reports on 1 and 2 threads.

@@ -5,6 +5,9 @@ use fieldtex_eval::{
 };
 use std::path::Path;
 
+mod common;
+use common::{constant_field, rotated_copy};
+
 /// An RGB exemplar from the shared test data as `(data, width, height)`.
 fn exemplar(name: &str) -> (Vec<f32>, usize, usize) {
     let path =
@@ -12,40 +15,6 @@ fn exemplar(name: &str) -> (Vec<f32>, usize, usize) {
     let img = image::open(&path).expect("test exemplar").to_rgb8();
     let (w, h) = (img.width() as usize, img.height() as usize);
     (img.as_raw().iter().map(|&v| v as f32 / 255.0).collect(), w, h)
-}
-
-/// A `size²` image whose exemplar x axis follows the constant direction `deg`:
-/// output pixel `P` copies exemplar pixel `round(Rᵀ (P − centre))` (toroidal), the way
-/// a pixel-copying synthesis lays the exemplar out along a field. With `blocks`, the
-/// exemplar-space plane is a patchwork of 24×24 blocks each shifted by a random
-/// offset (seams like a synthesis output), the same patchwork for every angle.
-fn rotated_copy(ex: &[f32], ew: usize, eh: usize, size: usize, deg: f64, blocks: bool) -> Vec<f32> {
-    let (s, c) = deg.to_radians().sin_cos();
-    let o = size as f64 / 2.0;
-    let mut out = vec![0f32; size * size * 3];
-    for y in 0..size {
-        for x in 0..size {
-            let (px, py) = (x as f64 - o, y as f64 - o);
-            let mut ex_x = (c * px + s * py).round() as i64;
-            let mut ex_y = (-s * px + c * py).round() as i64;
-            if blocks {
-                let b = (ex_x.div_euclid(24) * 1000 + ex_y.div_euclid(24)) as u64;
-                ex_x += (fieldtex_core::rng::hash_unit(3, "blocks", 2 * b) * 1000.0) as i64;
-                ex_y += (fieldtex_core::rng::hash_unit(3, "blocks", 2 * b + 1) * 1000.0) as i64;
-            }
-            let (ix, iy) =
-                (ex_x.rem_euclid(ew as i64) as usize, ex_y.rem_euclid(eh as i64) as usize);
-            for ch in 0..3 {
-                out[(y * size + x) * 3 + ch] = ex[(iy * ew + ix) * 3 + ch];
-            }
-        }
-    }
-    out
-}
-
-fn constant_field(size: usize, deg: f64) -> Vec<f32> {
-    let (s, c) = deg.to_radians().sin_cos();
-    (0..size * size).flat_map(|_| [c as f32, s as f32]).collect()
 }
 
 fn guided(out: &[f32], size: usize, ex: &[f32], ew: usize, eh: usize, field: &[f32]) -> f64 {
@@ -142,17 +111,28 @@ fn bit_identical_for_any_thread_count() {
             [a.cos(), a.sin()]
         })
         .collect();
-    let run = |threads: usize| {
+    let run = |threads: usize, opts: &GuidedCoherenceOptions| {
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
             let o = ImageView::new(&out, size, size, 3).unwrap();
             let f = FieldView::new(&field, size, size).unwrap();
-            let opts = GuidedCoherenceOptions { stride: 3, ..Default::default() };
-            guided_coherence(&o, &exemplar_view(&ex, ew, eh), &f, &opts).unwrap()
+            guided_coherence(&o, &exemplar_view(&ex, ew, eh), &f, opts).unwrap()
         })
     };
-    let (a, b) = (run(1), run(3));
+    let grid = GuidedCoherenceOptions { stride: 3, ..Default::default() };
+    let (a, b) = (run(1, &grid), run(3, &grid));
     assert_eq!(a, b);
     assert!(a.queries > 100 && a.mean > 0.0, "{a:?}");
+    // The pipelines' default: the approximate search on a seeded sample of pixels.
+    let sampled = GuidedCoherenceOptions {
+        approximate: Some(fieldtex_eval::ApproximateSearchOptions::default()),
+        sampled_queries: 300,
+        seed: 4,
+        ..Default::default()
+    };
+    let (a, b) = (run(1, &sampled), run(3, &sampled));
+    assert_eq!(a, b);
+    assert_eq!((a.queries, a.sampled_queries, a.skipped_border), (300, 300, 0), "{a:?}");
+    assert!(a.standard_error.is_some_and(|se| se > 0.0), "{a:?}");
 }
 
 #[test]

@@ -140,35 +140,54 @@ pub(crate) fn image_metrics(
         (None, Some(a)) => Some(ev::OrientationReference::ConstantDeg(a)),
         _ => None,
     };
-    // The nearest-patch pair beside the other metrics: both sides are parallel loops
-    // with serial parts (tree building, period estimate, merging), which overlap on
-    // few cores. Each metric is deterministic on its own; the results are assembled
-    // in a fixed order.
+    // Four independent groups side by side (a join tree, so on two cores the serial
+    // parts of one group — tree building, PCA eigen-solves, period estimate, merging —
+    // overlap the parallel loops of another): the nearest-patch pair, guided
+    // coherence, colour + orientation + singularities, phase defects. Each metric is
+    // deterministic on its own; the results are assembled in a fixed order.
     let search_completeness = sources.as_ref().is_none_or(|s| s.search_too);
-    let (pair, rest) = rayon::join(
+    let ((pair, guided), (oriented, phase)) = rayon::join(
         || {
-            let r = if search_completeness {
-                ev::coherence_and_completeness(&o, &e, &popts).map(|(c, p)| (c, Some(p)))
-            } else {
-                ev::coherence(&o, &e, &popts).map(|c| (c, None))
-            };
-            progress.advance(2);
-            r
+            rayon::join(
+                || {
+                    let r = if search_completeness {
+                        ev::coherence_and_completeness(&o, &e, &popts).map(|(c, p)| (c, Some(p)))
+                    } else {
+                        ev::coherence(&o, &e, &popts).map(|c| (c, None))
+                    };
+                    progress.advance(2);
+                    r
+                },
+                || guided_metric(&o, &e, reference.as_ref(), wrap, approximate.clone(), seed),
+            )
         },
         || {
-            let angle = exemplar_angle_deg;
-            other_metrics(&o, &e, reference, angle, wrap, seed, exact, approximate, progress)
+            rayon::join(
+                || {
+                    colour_and_orientation(
+                        &o,
+                        &e,
+                        reference,
+                        exemplar_angle_deg,
+                        seed,
+                        exact,
+                        progress,
+                    )
+                },
+                || phase_metric(&o, exact, progress),
+            )
         },
     );
     let (coherence, completeness) = pair?;
-    let (
-        color_sliced_wasserstein,
-        guided_coherence,
-        orientation_error,
-        singularities,
-        phase_defects,
-        skipped,
-    ) = rest?;
+    let guided_coherence = guided?;
+    let (color_sliced_wasserstein, orientation_error, singularities, mut skipped) = oriented?;
+    let phase_defects = match phase {
+        Ok(r) => Some(r),
+        Err(err) => {
+            skipped.push(format!("phase_defects: {err}"));
+            None
+        }
+    };
     let source_coverage = match &sources {
         Some(s) => {
             let opts = ev::SourceCoverageOptions {
@@ -207,7 +226,9 @@ pub(crate) fn image_metrics(
                  nearest-patch search (one PCA basis for both images, k-d trees searched \
                  with a bounded budget, coherent candidates); coherence and completeness \
                  average a seeded sample of at most {} query patches each (runs of {}), \
-                 with the standard error of the sample mean in standard_error; the search \
+                 with the standard error of the sample mean in standard_error; \
+                 guided_coherence averages {} query pixels drawn at random (its \
+                 standard_error likewise); the search \
                  is at most {}% above the exact distances on the test exemplars; \
                  color_sliced_wasserstein uses a \
                  seeded sample of about {} pixels per image, within {} + {}% of the all-pixel \
@@ -217,6 +238,7 @@ pub(crate) fn image_metrics(
                  (docs/perf/orient.md); --exact-metrics for the exhaustive versions",
                 ev::ApproximateSearchOptions::default().sampled_queries,
                 ev::query_sampling::RUN_LENGTH,
+                ev::guided_coherence::SAMPLED_QUERIES,
                 ev::approximate_nearest_patch::ERROR_BOUND_PERCENT,
                 ev::color_sliced_wasserstein::SAMPLED_PIXELS,
                 ev::color_sliced_wasserstein::SAMPLED_ERROR_BOUND_ABS,
@@ -230,31 +252,58 @@ pub(crate) fn image_metrics(
     })
 }
 
-/// The metrics of [`image_metrics`] other than coherence and completeness.
-type OtherMetrics = (
+/// Colour, orientation error and singularities of [`image_metrics`], with the list of
+/// skipped metrics.
+type OrientedMetrics = (
     ev::SlicedWassersteinReport,
-    Option<ev::GuidedCoherenceReport>,
     Option<ev::OrientationErrorReport>,
     Option<SingularitySummary>,
-    Option<ev::PhaseDefectReport>,
     Vec<String>,
 );
 
-/// Colour, guided coherence, orientation, singularities and phase defects of `o`
-/// against `e` (see [`image_metrics`]; `wrap`: the exemplar tiles), with the list of
-/// skipped metrics.
-#[allow(clippy::too_many_arguments)]
-fn other_metrics(
+/// Guided coherence of `o` against `e` in the frame of a field `reference` (none for a
+/// constant angle or no reference), its queries drawn with `seed`; `wrap`: the exemplar
+/// tiles, so its patches are read toroidally.
+fn guided_metric(
+    o: &ev::ImageView,
+    e: &ev::ImageView,
+    reference: Option<&ev::OrientationReference>,
+    wrap: bool,
+    approximate: Option<ev::ApproximateSearchOptions>,
+    seed: u64,
+) -> std::result::Result<Option<ev::GuidedCoherenceReport>, ev::EvalError> {
+    match reference {
+        Some(ev::OrientationReference::Field(f)) => {
+            // Default: the approximate search on a seeded sample of query pixels (the
+            // gap to the exact search on the stride grid is pinned by fieldtex-eval's
+            // tests/approximate_metrics.rs); exact: the exhaustive search on the grid.
+            let sampled_queries =
+                if approximate.is_some() { ev::guided_coherence::SAMPLED_QUERIES } else { 0 };
+            let gopts = ev::GuidedCoherenceOptions {
+                approximate,
+                sampled_queries,
+                seed,
+                wrap_exemplar: wrap,
+                ..Default::default()
+            };
+            Ok(Some(ev::guided_coherence(o, e, f, &gopts)?))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// Colour sliced Wasserstein, orientation error and singularities of `o` against `e`
+/// (see [`image_metrics`]); the last two share one structure-tensor orientation map
+/// (the default σ of both, so the values are those of computing it twice).
+fn colour_and_orientation(
     o: &ev::ImageView,
     e: &ev::ImageView,
     reference: Option<ev::OrientationReference>,
     exemplar_angle_deg: f64,
-    wrap: bool,
     seed: u64,
     exact: bool,
-    approximate: Option<ev::ApproximateSearchOptions>,
     progress: &dyn Progress,
-) -> std::result::Result<OtherMetrics, ev::EvalError> {
+) -> std::result::Result<OrientedMetrics, ev::EvalError> {
     // Default: a seeded sample of the pixels of a large image (the gap to all pixels
     // is pinned by fieldtex-eval's tests/approximate_metrics.rs).
     let max_pixels = (!exact).then_some(ev::color_sliced_wasserstein::SAMPLED_PIXELS);
@@ -262,29 +311,21 @@ fn other_metrics(
     let color_sliced_wasserstein = ev::color_sliced_wasserstein(o, e, &swo)?;
     progress.advance(1);
     let mut skipped = Vec::new();
-    let guided_coherence = match &reference {
-        Some(ev::OrientationReference::Field(f)) => {
-            let gopts = ev::GuidedCoherenceOptions {
-                approximate,
-                wrap_exemplar: wrap,
-                ..Default::default()
-            };
-            Some(ev::guided_coherence(o, e, f, &gopts)?)
-        }
-        _ => None,
-    };
+    let opts = ev::OrientationErrorOptions { exemplar_angle_deg, ..Default::default() };
+    let map = ev::image_orientation(o, &opts.structure);
     let orientation_error = match reference {
-        Some(r) => {
-            let opts = ev::OrientationErrorOptions { exemplar_angle_deg, ..Default::default() };
-            Some(ev::orientation_error(o, &r, &opts)?)
-        }
+        Some(r) => match &map {
+            Ok(m) => Some(ev::orientation_error_of_map(m, &r, &opts)?),
+            // The error `orientation_error` itself returns (same map, same checks).
+            Err(_) => Some(ev::orientation_error(o, &r, &opts)?),
+        },
         None => {
             skipped.push("orientation_error: no guidance field or angle given".to_string());
             None
         }
     };
     progress.advance(1);
-    let singularities = match ev::image_orientation(o, &ev::OrientationOptions::default()) {
+    let singularities = match map {
         Ok(map) => {
             let r = ev::singularities(&map, &ev::SingularityOptions::default());
             Some(SingularitySummary {
@@ -300,26 +341,21 @@ fn other_metrics(
         }
     };
     progress.advance(1);
-    // Default: counted on the image reduced 2× where the stripes are long enough (the
-    // gap to full resolution is pinned by fieldtex-eval's tests/approximate_metrics.rs).
+    Ok((color_sliced_wasserstein, orientation_error, singularities, skipped))
+}
+
+/// Phase defects of `o` (default: counted on the image reduced 2× where the stripes are
+/// long enough; the gap to full resolution is pinned by fieldtex-eval's
+/// tests/approximate_metrics.rs).
+fn phase_metric(
+    o: &ev::ImageView,
+    exact: bool,
+    progress: &dyn Progress,
+) -> std::result::Result<ev::PhaseDefectReport, ev::EvalError> {
     let pdo = ev::PhaseDefectOptions::default();
     let pd = if exact { ev::phase_defects(o, &pdo) } else { ev::coarse_phase_defects(o, &pdo) };
-    let phase_defects = match pd {
-        Ok(r) => Some(r),
-        Err(err) => {
-            skipped.push(format!("phase_defects: {err}"));
-            None
-        }
-    };
     progress.advance(1);
-    Ok((
-        color_sliced_wasserstein,
-        guided_coherence,
-        orientation_error,
-        singularities,
-        phase_defects,
-        skipped,
-    ))
+    pd
 }
 
 /// The exemplar-coordinate map of a synthesised image, for the seam measure of
