@@ -88,6 +88,14 @@ pub struct SolidSynthesisOptions {
     /// along the field (module docs); sampled trilinearly on the `trilinear_levels`
     /// coarsest, at the nearest voxel below. Default 2.
     pub integrate_levels: usize,
+    /// The correction predicts a neighbour's pixel from the neighbour's actual lattice
+    /// offset `D` projected into the voxel's frame (`T_P(v + D) − [h P_P(Rᵀ D)]`, paper E
+    /// §4.3's `P_xy(d)`), not from the in-plane integer offset `D` was rounded from.
+    /// The two agree for axis-aligned frames; for turned ones the rounded offset is up to
+    /// half a voxel (`h/2` exemplar pixels per axis) off. Default false (the earlier
+    /// bits): on the bent stripes box (docs/solid.md, session 13) it was neutral within
+    /// the seed-to-seed spread, so it stays opt-in.
+    pub projected_predictions: bool,
     pub seed: u64,
 }
 
@@ -103,6 +111,7 @@ impl Default for SolidSynthesisOptions {
             subpart: 64,
             trilinear_levels: 3,
             integrate_levels: 2,
+            projected_predictions: false,
             seed: 1,
         }
     }

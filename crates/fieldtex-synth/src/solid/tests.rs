@@ -103,6 +103,37 @@ fn per_level_passes_keep_the_on_demand_equality() {
     assert_eq!(t, [more[3], more[500], more[999]]);
 }
 
+/// A constant field: the identity frame everywhere.
+struct Axes;
+
+impl FrameSource for Axes {
+    fn frame(&self, _p: [f64; 3]) -> [f64; 9] {
+        [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+    }
+}
+
+/// Predictions from the neighbours' projected lattice offsets
+/// (`SolidSynthesisOptions::projected_predictions`) equal the in-plane integer offsets
+/// for axis-aligned frames (same triples), are used for turned ones (the triples
+/// differ), and keep the on-demand equality.
+#[test]
+fn projected_predictions_change_only_turned_frames() {
+    let img = exemplar();
+    let (ao, so) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let voxels = all_voxels(10);
+    let run = |projected: bool, frames: &dyn FrameSource, voxels: &[[i32; 3]]| {
+        let o = SolidSynthesisOptions { projected_predictions: projected, ..so.clone() };
+        SolidSynthesizer::new(&ex, lattice, frames, o).unwrap().triples(voxels, &NoProgress).0
+    };
+    assert_eq!(run(true, &Axes, &voxels), run(false, &Axes, &voxels));
+    let turned = run(true, &Bent, &voxels);
+    assert_ne!(turned, run(false, &Bent, &voxels), "the projected offsets changed nothing");
+    let few = [voxels[7], voxels[432], voxels[998]];
+    assert_eq!(run(true, &Bent, &few), [turned[7], turned[432], turned[998]]);
+}
+
 #[test]
 fn one_and_two_threads_give_the_same_voxels() {
     let img = exemplar();

@@ -154,6 +154,7 @@ impl SolidSynthesizer<'_> {
         let weights = self.exemplar.options.plane_weights;
         let trilinear = c + self.options.trilinear_levels >= self.cache.len();
         let integrate = c + self.options.integrate_levels >= self.cache.len();
+        let projected = self.options.projected_predictions;
         // Integrated samples stay where trilinear interpolation has both corners.
         let reach = self.halo() as f32;
         let nn = (n * n) as usize;
@@ -175,6 +176,9 @@ impl SolidSynthesizer<'_> {
                     let (sf, tf) = (ss as f32, t as f32);
                     let d: [i32; 3] = std::array::from_fn(|a| round_i32(sf * u[a] + tf * w[a]));
                     offsets[k] = base + ((d[2] * s + d[1]) * s + d[0]) as isize;
+                    if (-1..=1).contains(&ss) && (-1..=1).contains(&t) {
+                        scratch.near[p][((t + 1) * 3 + ss + 1) as usize] = d;
+                    }
                     k += 1;
                 }
             }
@@ -186,7 +190,17 @@ impl SolidSynthesizer<'_> {
                     } else {
                         let o = offsets[((dy + half) * n + dx + half) as usize] as usize;
                         let nb = region[o][p];
-                        [nb[0] - h * dx, nb[1] - h * dy]
+                        if projected {
+                            // The neighbour's lattice offset in the frame's plane axes.
+                            let d = scratch.near[p][((dy + 1) * 3 + dx + 1) as usize];
+                            let df = d.map(|x| x as f32);
+                            let l1 = u[0] * df[0] + u[1] * df[1] + u[2] * df[2];
+                            let l2 = w[0] * df[0] + w[1] * df[1] + w[2] * df[2];
+                            let hf = h as f32;
+                            [nb[0] - round_i32(hf * l1), nb[1] - round_i32(hf * l2)]
+                        } else {
+                            [nb[0] - h * dx, nb[1] - h * dy]
+                        }
                     };
                     scratch.predicted[p][((dy + 1) * 3 + dx + 1) as usize] = pix;
                     table.prefetch(pix[0], pix[1]);
@@ -325,6 +339,8 @@ struct Scratch {
     offsets: Vec<isize>,
     /// Per plane, the pixels predicted by the 3 × 3 in-plane offsets (row-major).
     predicted: [[[i32; 2]; 9]; 3],
+    /// Per plane, the lattice offsets of the 3 × 3 in-plane neighbours (row-major).
+    near: [[[i32; 3]; 9]; 3],
     proj: [[f32; 32]; 3],
     candidates: Vec<Triple>,
     /// Integrated sample offsets (`N × N`) and the first axis's path (`N`).
@@ -339,6 +355,7 @@ impl Scratch {
             buf: vec![0.0; n * n * e.channels()],
             offsets: vec![0; 3 * n * n],
             predicted: [[[0; 2]; 9]; 3],
+            near: [[[0; 3]; 9]; 3],
             proj: [[0.0; 32]; 3],
             candidates: Vec::with_capacity(64),
             path: vec![[0.0; 3]; n * n],
