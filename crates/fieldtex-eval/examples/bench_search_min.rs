@@ -3,26 +3,19 @@
 //! `bench_search_min OUT_DIR EXEMPLAR.png [REPS]` with `OUT_DIR` an orient output
 //! (`texture.png`, `field.npy`). Used for `docs/perf/orient.md`.
 
+#[path = "common/mod.rs"]
+mod common;
+use common::*;
+
 use fieldtex_eval::*;
 use std::time::Instant;
-
-fn rgb(path: &str) -> (Vec<f32>, usize, usize) {
-    let img = image::open(path).unwrap_or_else(|e| panic!("{path}: {e}")).to_rgb8();
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    (img.as_raw().iter().map(|&v| v as f32 / 255.0).collect(), w, h)
-}
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let reps: usize = a.get(3).map_or(15, |s| s.parse().unwrap());
     let (o, ow, oh) = rgb(&format!("{}/texture.png", a[1]));
     let (e, ew, eh) = rgb(&a[2]);
-    let bytes = std::fs::read(format!("{}/field.npy", a[1])).unwrap();
-    let hl = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let f: Vec<f32> = bytes[10 + hl..]
-        .chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+    let f = npy(&format!("{}/field.npy", a[1]));
     let ov = ImageView::new(&o, ow, oh, 3).unwrap();
     let ev = ImageView::new(&e, ew, eh, 3).unwrap();
     let fv = FieldView::new(&f, ow, oh).unwrap();

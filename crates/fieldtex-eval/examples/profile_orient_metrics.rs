@@ -5,20 +5,12 @@
 //! (`crates/fieldtex/src/pipelines/eval.rs::image_metrics`, plus the exemplar's own
 //! orientation of `orient.rs`). Used for `docs/perf/orient.md`.
 
+#[path = "common/mod.rs"]
+mod common;
+use common::*;
+
 use fieldtex_eval::*;
 use std::time::Instant;
-
-fn rgb(path: &str) -> (Vec<f32>, usize, usize) {
-    let img = image::open(path).unwrap_or_else(|e| panic!("{path}: {e}")).to_rgb8();
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    (img.as_raw().iter().map(|&v| v as f32 / 255.0).collect(), w, h)
-}
-
-fn npy(path: &str) -> Vec<f32> {
-    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let hl = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    bytes[10 + hl..].chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
-}
 
 /// CPU seconds (user + system) of this process so far (`/proc/self/stat`, 100 Hz).
 fn cpu_s() -> f64 {

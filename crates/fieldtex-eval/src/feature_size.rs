@@ -30,7 +30,7 @@
 //! over the window both forms agree.
 
 use fieldtex_core::{Image, vec3};
-use fieldtex_mesh::TriMesh;
+use fieldtex_mesh::{CornerUvs, TriMesh};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -175,6 +175,27 @@ pub struct TriangleFeature {
     pub saturated: bool,
 }
 
+/// Triangle `f` of a mesh with UVs on a `w × h` texture: its corners in texels (row 0 at
+/// `v = 1`), its surface area, and its surface length per texel `λ = √(A_surface /
+/// A_texels)` (NaN for a triangle degenerate on either side); `uvs` are the mesh's.
+pub fn triangle_texel_scale(
+    mesh: &TriMesh,
+    uvs: &CornerUvs,
+    f: usize,
+    w: usize,
+    h: usize,
+) -> ([[f64; 2]; 3], f64, f64) {
+    let c = uvs.indices[f].map(|i| uvs.values[i as usize]);
+    let t = c.map(|p| [p[0] * w as f64, (1.0 - p[1]) * h as f64]);
+    let at = 0.5
+        * ((t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]))
+            .abs();
+    let p = mesh.triangle_positions(f);
+    let a3 = 0.5 * vec3::norm(vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0])));
+    let lambda = if at > 0.0 && a3 > 0.0 { (a3 / at).sqrt() } else { f64::NAN };
+    (t, a3, lambda)
+}
+
 /// Per-triangle measurements of `mesh` (per-corner UVs; `None` without) textured by
 /// `tex`; a triangle without UV area, outside the texture or whose window has no
 /// contrast gives `None`. `window` is the smallest window side in texels; with
@@ -197,18 +218,7 @@ pub fn feature_size_per_triangle(
     // Per triangle: corners in texels, surface area, surface length per texel.
     let geo: Vec<([[f64; 2]; 3], f64, f64)> = (0..mesh.n_triangles())
         .into_par_iter()
-        .map(|f| {
-            let c = uvs.indices[f].map(|i| uvs.values[i as usize]);
-            let t = c.map(|p| [p[0] * w as f64, (1.0 - p[1]) * h as f64]);
-            let at = 0.5
-                * ((t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
-                    - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]))
-                    .abs();
-            let p = mesh.triangle_positions(f);
-            let a3 = 0.5 * vec3::norm(vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0])));
-            let lambda = if at > 0.0 && a3 > 0.0 { (a3 / at).sqrt() } else { f64::NAN };
-            (t, a3, lambda)
-        })
+        .map(|f| triangle_texel_scale(mesh, uvs, f, w, h))
         .collect();
     let lum = tex.luminance();
     let sums = if per_texel {

@@ -20,7 +20,7 @@
 //!
 //! Assumes the texture holds one geometry image at its top (one component).
 
-use fieldtex_eval::feature_size::feature_size_per_triangle;
+use fieldtex_eval::feature_size::{feature_size_per_triangle, triangle_texel_scale};
 use std::path::PathBuf;
 
 /// `--response EXEMPLAR PATCH`: for each scale, the period in texels the measure reads
@@ -116,23 +116,7 @@ fn main() {
     let per_texel = std::env::args().nth(2).as_deref() != Some("centre");
     let rows = feature_size_per_triangle(&mesh, &tex, 24, true, per_texel).unwrap();
     // Per-face λ from the rows' computation (recomputed for faces without a row).
-    let lam: Vec<f64> = (0..nf)
-        .map(|f| {
-            let c = uvs.indices[f].map(|i| uvs.values[i as usize]);
-            let t = c.map(|p| [p[0] * w as f64, (1.0 - p[1]) * h as f64]);
-            let at = 0.5
-                * ((t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
-                    - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]))
-                    .abs();
-            let p = mesh.triangle_positions(f);
-            let a3 = 0.5
-                * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
-                    fieldtex_core::vec3::sub(p[1], p[0]),
-                    fieldtex_core::vec3::sub(p[2], p[0]),
-                ));
-            if at > 0.0 { (a3 / at).sqrt() } else { f64::NAN }
-        })
-        .collect();
+    let lam: Vec<f64> = (0..nf).map(|f| triangle_texel_scale(&mesh, uvs, f, w, h).2).collect();
     let tau: Vec<f64> =
         owner.iter().map(|&o| if o >= 0 { 1.0 / lam[o as usize] } else { f64::NAN }).collect();
     // Quilting patches as `quilt` places them.
