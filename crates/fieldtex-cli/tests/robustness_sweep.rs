@@ -197,3 +197,33 @@ fn eval_mesh_samples_0_scored_15_points_and_1e8_hung() {
         assert_input_error(&o, "--samples");
     }
 }
+
+#[test]
+fn solid_small_exemplar_was_not_named() {
+    // "exemplar: exemplar is 8×64 pixels; synthesis needs at least 10 …" named no file;
+    // with per-plane exemplars the user could not tell which one.
+    let d = tmp("solid_small_exemplar");
+    let good = exemplar(&d, "good.png", 32, 32);
+    let thin = exemplar(&d, "thin.png", 8, 64);
+    let torus = shared().join("meshes/torus.obj");
+    let out = d.join("out");
+    let (t, g, th, o) = (s(&torus), s(&good), s(&thin), s(&out));
+    let single = ["solid", "--mesh", t, "--exemplar", th, "--out", o, "--resolution", "32"];
+    assert_input_error(&run(&single), "thin.png");
+    let planes = [
+        "solid",
+        "--mesh",
+        t,
+        "--exemplar-xy",
+        g,
+        "--exemplar-yz",
+        th,
+        "--exemplar-zx",
+        g,
+        "--out",
+        o,
+        "--resolution",
+        "32",
+    ];
+    assert_input_error(&run(&planes), "thin.png");
+}
