@@ -50,7 +50,8 @@ pub struct TransferArgs {
     /// Surface samples at the finest level on each mesh.
     #[arg(long, default_value_t = 512_000)]
     samples: usize,
-    /// Samples on which the ray-cast descriptors are computed (then interpolated).
+    /// Samples on which the ray-cast descriptors are computed (then interpolated), 256 to
+    /// 8000000.
     #[arg(long, default_value_t = 32_768)]
     descriptor_samples: usize,
     /// k-means clusters of the parametric engine.
@@ -76,6 +77,14 @@ fn check_ranges(a: &TransferArgs) -> Result<(), Error> {
     let bad = |m: String| Err(Error::bad_input(None, m));
     if !(256..=8_000_000).contains(&a.samples) {
         return bad(format!("--samples must be in 256..=8000000, got {}", a.samples));
+    }
+    // Fewer descriptor samples ran (0 and 1 exited 0) with every ray-cast descriptor
+    // interpolated from a handful of points.
+    if !(256..=8_000_000).contains(&a.descriptor_samples) {
+        return bad(format!(
+            "--descriptor-samples must be in 256..=8000000, got {}",
+            a.descriptor_samples
+        ));
     }
     if a.clusters == 0 {
         return bad("--clusters must be at least 1".into());

@@ -162,7 +162,8 @@ fn conformal_scale_1e_30_hung() {
 
 #[test]
 fn transfer_option_errors_named_library_fields_or_passed_silently() {
-    // `--coherence NaN` and `--neighbourhood 4` were accepted with the default engine;
+    // `--coherence NaN` and `--neighbourhood 4` were accepted with the default engine,
+    // `--descriptor-samples 0` with any;
     // `--samples 0` said "invalid option samples", `--clusters 0` "invalid option
     // parametric engine: clusters ≥ 1, iterations ≤ 100, quantiles ≥ 2"; a negative
     // `--coherence` was taken for a flag by the argument parser.
@@ -170,8 +171,9 @@ fn transfer_option_errors_named_library_fields_or_passed_silently() {
     let torus = shared().join("meshes/torus.obj");
     let out = d.join("out");
     let base = ["transfer", "--source", s(&torus), "--target", s(&torus), "--out", s(&out)];
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["--coherence", "NaN"], "--coherence"),
+        (&["--descriptor-samples", "0"], "--descriptor-samples"),
         (&["--coherence", "-1"], "--coherence"),
         (&["--neighbourhood", "4"], "--neighbourhood"),
         (&["--samples", "0"], "--samples"),
