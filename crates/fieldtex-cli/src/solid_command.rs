@@ -121,7 +121,9 @@ fn check_ranges(a: &SolidArgs) -> Result<(), Error> {
     if let Some(d) = a.interior_depth
         && !(d.is_finite() && d > 0.0)
     {
-        return bad(format!("--interior-depth must be a positive distance in mesh units, got {d}"));
+        return bad(format!(
+            "--interior-depth must be a positive distance in mesh units, got {d:?}"
+        ));
     }
     if !(8..=16384).contains(&a.atlas_size) {
         return bad(format!("--atlas-size must be in 8..=16384 texels, got {}", a.atlas_size));
@@ -134,7 +136,7 @@ fn check_ranges(a: &SolidArgs) -> Result<(), Error> {
     }
     let fw = a.feature_weight;
     if !(fw.is_finite() && (0.0..=1000.0).contains(&fw)) {
-        return bad(format!("--feature-weight must be in [0, 1000], got {fw}"));
+        return bad(format!("--feature-weight must be in [0, 1000], got {fw:?}"));
     }
     if !(4..=64).contains(&a.block) {
         return bad(format!("--block must be in 4..=64, got {}", a.block));

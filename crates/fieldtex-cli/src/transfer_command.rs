@@ -90,7 +90,7 @@ fn check_ranges(a: &TransferArgs) -> Result<(), Error> {
         return bad("--clusters must be at least 1".into());
     }
     if !(a.coherence.is_finite() && a.coherence >= 0.0) {
-        return bad(format!("--coherence must be finite and ≥ 0, got {}", a.coherence));
+        return bad(format!("--coherence must be finite and ≥ 0, got {:?}", a.coherence));
     }
     if a.neighbourhood.is_multiple_of(2) || !(1..=9).contains(&a.neighbourhood) {
         return bad(format!("--neighbourhood must be odd, 1 to 9, got {}", a.neighbourhood));

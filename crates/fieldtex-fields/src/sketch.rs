@@ -123,7 +123,7 @@ impl Sketch {
             }
             if !(curve.weight > 0.0 && curve.weight <= MAX_CURVE_WEIGHT) {
                 return Err(sketch_error(format!(
-                    "curve {c} has weight {}; use a weight in (0, {MAX_CURVE_WEIGHT:e}]",
+                    "curve {c} has weight {:?}; use a weight in (0, {MAX_CURVE_WEIGHT:e}]",
                     curve.weight
                 )));
             }

@@ -104,7 +104,7 @@ pub fn conformal(
     if !(options.scale >= 1.0 / 64.0 && options.scale <= 16.0) {
         return Err(Error::bad_input(
             None,
-            format!("--scale must be in [0.015625, 16], got {}", options.scale),
+            format!("--scale must be in [0.015625, 16], got {:?}", options.scale),
         ));
     }
     if options.levels == 0 || options.levels > 16 {
