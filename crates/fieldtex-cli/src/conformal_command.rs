@@ -29,8 +29,8 @@ pub struct ConformalArgs {
     /// Number of exemplar scale levels.
     #[arg(long, default_value_t = 6)]
     levels: usize,
-    /// Exemplar pixels per texture texel at the reference conformal factor.
-    #[arg(long, default_value_t = 1.0)]
+    /// Exemplar pixels per texture texel at the reference conformal factor, 1/64 to 16.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     scale: f64,
     /// Quilting patch side in texels (paper: 30–50).
     #[arg(long, default_value_t = 40)]

@@ -69,7 +69,7 @@ enum Command {
         out: PathBuf,
         /// Weld vertices closer than this fraction of the bounding-box diagonal
         /// (0 = only identical positions).
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         weld_epsilon: f64,
         /// Print the repair report as JSON.
         #[arg(long)]
@@ -270,7 +270,7 @@ enum Command {
         /// The reference texturing of the same surface (with --mesh).
         #[arg(long, requires = "mesh")]
         reference: Option<PathBuf>,
-        /// Surface samples for --mesh/--reference.
+        /// Surface samples for --mesh/--reference, 256 to 8000000.
         #[arg(long, default_value_t = 100_000)]
         samples: usize,
         /// Guidance field as .npy (H×W×2 float32 unit (dx, dy), x right, y down).

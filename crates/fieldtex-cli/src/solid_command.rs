@@ -34,7 +34,7 @@ pub struct SolidArgs {
     #[arg(long)]
     feature_mask: Option<PathBuf>,
     /// Weight of the feature mask against the colour channels.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     feature_weight: f32,
     /// Output directory.
     #[arg(long)]
@@ -110,20 +110,53 @@ fn parse_cut(s: &str) -> Result<[f64; 6], String> {
     Ok([v[0], v[1], v[2], v[3], v[4], v[5]])
 }
 
+/// Refuses out-of-range flags before any input is read, naming the flag (the library's
+/// own checks name its option fields and some run only after the frame field is
+/// solved). The ranges are the synthesiser's (`SolidAnalysisOptions`,
+/// `SolidSynthesisOptions`) and the atlas's; `--feature-weight` is also bounded above
+/// (1000: the mask alone decides far below it; larger squared distances lose the
+/// colour channels' precision in `f32`).
+fn check_ranges(a: &SolidArgs) -> Result<(), Error> {
+    let bad = |m: String| Err(Error::bad_input(None, m));
+    if let Some(d) = a.interior_depth
+        && !(d.is_finite() && d > 0.0)
+    {
+        return bad(format!(
+            "--interior-depth must be a positive distance in mesh units, got {d:?}"
+        ));
+    }
+    if !(8..=16384).contains(&a.atlas_size) {
+        return bad(format!("--atlas-size must be in 8..=16384 texels, got {}", a.atlas_size));
+    }
+    if !(1..=8).contains(&a.levels) {
+        return bad(format!("--levels must be in 1..=8, got {}", a.levels));
+    }
+    if !(3..=15).contains(&a.neighbourhood) || a.neighbourhood.is_multiple_of(2) {
+        return bad(format!("--neighbourhood must be odd, 3 to 15, got {}", a.neighbourhood));
+    }
+    let fw = a.feature_weight;
+    if !(fw.is_finite() && (0.0..=1000.0).contains(&fw)) {
+        return bad(format!("--feature-weight must be in [0, 1000], got {fw:?}"));
+    }
+    if !(4..=64).contains(&a.block) {
+        return bad(format!("--block must be in 4..=64, got {}", a.block));
+    }
+    if a.passes > 16 {
+        return bad(format!("--passes must be at most 16, got {}", a.passes));
+    }
+    if let Some(p) = a.level_passes.iter().find(|&&p| p > 32) {
+        return bad(format!("--level-passes must be at most 32 per level, got {p}"));
+    }
+    Ok(())
+}
+
 /// Runs the command; returns the output directory for the summary line.
 pub fn run_solid(
     a: SolidArgs,
     seed: u64,
     progress: &dyn fieldtex::Progress,
 ) -> Result<fieldtex::Report, Error> {
-    if let Some(d) = a.interior_depth
-        && !(d.is_finite() && d > 0.0)
-    {
-        return Err(Error::bad_input(
-            None,
-            format!("--interior-depth must be a positive distance in mesh units, got {d}"),
-        ));
-    }
+    check_ranges(&a)?;
     let mut opts = fieldtex::SolidOptions {
         mesh: a.mesh,
         sketch: a.sketch,

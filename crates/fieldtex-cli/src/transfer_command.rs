@@ -42,7 +42,7 @@ pub struct TransferArgs {
     #[arg(long, default_value = "parametric")]
     engine: String,
     /// Non-parametric engine: Ashikhmin coherence parameter κ (0 = best match only).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     coherence: f64,
     /// Non-parametric engine: side of the tangent-plane neighbourhood (odd).
     #[arg(long, default_value_t = 5)]
@@ -50,7 +50,8 @@ pub struct TransferArgs {
     /// Surface samples at the finest level on each mesh.
     #[arg(long, default_value_t = 512_000)]
     samples: usize,
-    /// Samples on which the ray-cast descriptors are computed (then interpolated).
+    /// Samples on which the ray-cast descriptors are computed (then interpolated), 256 to
+    /// 8000000.
     #[arg(long, default_value_t = 32_768)]
     descriptor_samples: usize,
     /// k-means clusters of the parametric engine.
@@ -69,11 +70,40 @@ fn bad(flag: &str, value: &str, allowed: &str) -> Error {
 }
 
 /// Runs the command.
+/// Refuses out-of-range numbers naming the flag, whatever the engine (the library checks
+/// the same ranges but names its option fields, and the non-parametric engine's only when
+/// that engine runs, so `--coherence NaN` passed silently with the default engine).
+fn check_ranges(a: &TransferArgs) -> Result<(), Error> {
+    let bad = |m: String| Err(Error::bad_input(None, m));
+    if !(256..=8_000_000).contains(&a.samples) {
+        return bad(format!("--samples must be in 256..=8000000, got {}", a.samples));
+    }
+    // Fewer descriptor samples ran (0 and 1 exited 0) with every ray-cast descriptor
+    // interpolated from a handful of points.
+    if !(256..=8_000_000).contains(&a.descriptor_samples) {
+        return bad(format!(
+            "--descriptor-samples must be in 256..=8000000, got {}",
+            a.descriptor_samples
+        ));
+    }
+    if a.clusters == 0 {
+        return bad("--clusters must be at least 1".into());
+    }
+    if !(a.coherence.is_finite() && a.coherence >= 0.0) {
+        return bad(format!("--coherence must be finite and ≥ 0, got {:?}", a.coherence));
+    }
+    if a.neighbourhood.is_multiple_of(2) || !(1..=9).contains(&a.neighbourhood) {
+        return bad(format!("--neighbourhood must be odd, 1 to 9, got {}", a.neighbourhood));
+    }
+    Ok(())
+}
+
 pub fn run(
     args: TransferArgs,
     g: &GlobalArgs,
     progress: &dyn fieldtex::Progress,
 ) -> Result<(), Error> {
+    check_ranges(&args)?;
     let mut opts = fieldtex::TransferCommandOptions {
         source: args.source,
         source_texture: args.source_texture,

@@ -58,6 +58,12 @@ impl SketchAxis {
     }
 }
 
+/// Largest accepted curve weight. The weight multiplies w = 100 in a least-squares system
+/// whose rows are squared: at 10⁶ the factorisation (and its rank-1 edits) loses
+/// positive definiteness on a 2.5K-triangle torus, at 10⁴ it still holds; 10³ keeps a
+/// margin (and a curve at 10³ already overrides every other constraint it meets).
+pub const MAX_CURVE_WEIGHT: f64 = 1e3;
+
 fn one() -> f64 {
     1.0
 }
@@ -115,9 +121,9 @@ impl Sketch {
                     "curve {c}: all its points coincide; draw a curve with length"
                 )));
             }
-            if !(curve.weight.is_finite() && curve.weight > 0.0) {
+            if !(curve.weight > 0.0 && curve.weight <= MAX_CURVE_WEIGHT) {
                 return Err(sketch_error(format!(
-                    "curve {c} has weight {}; use a finite weight > 0",
+                    "curve {c} has weight {:?}; use a weight in (0, {MAX_CURVE_WEIGHT:e}]",
                     curve.weight
                 )));
             }

@@ -46,8 +46,9 @@ pub fn read_image_bytes(bytes: &[u8], name: &str) -> Result<Image, IoError> {
             detail: "not a PNG, JPEG, TGA, BMP, TIFF or PNM image".into(),
         });
     }
-    let decoder =
-        r.into_decoder().map_err(|e| img_err(format!("corrupt or unsupported image: {e}")))?;
+    let decoder = r
+        .into_decoder()
+        .map_err(|e| img_err(format!("corrupt or unsupported image: {}", decoder_words(&e))))?;
     let (w, h) = decoder.dimensions();
     check_dimensions(name, w as u64, h as u64)?;
     let mut limits = image::Limits::default();
@@ -56,8 +57,30 @@ pub fn read_image_bytes(bytes: &[u8], name: &str) -> Result<Image, IoError> {
     limits.max_alloc = Some(MAX_IMAGE_PIXELS * 16);
     let mut r = reader()?;
     r.limits(limits);
-    let dynimg = r.decode().map_err(|e| img_err(format!("corrupt image data: {e}")))?;
+    let dynimg =
+        r.decode().map_err(|e| img_err(format!("corrupt image data: {}", decoder_words(&e))))?;
     Ok(dynamic_to_image(dynimg))
+}
+
+/// The decoder's explanation when it is plain words; a generic one when it carries
+/// the decoder's internal structures (the PNG decoder prints chunk types as Rust debug
+/// text, e.g. `ChunkType { type: … }`).
+fn decoder_words(e: &image::ImageError) -> String {
+    let text = e.to_string();
+    let debug_like = text.contains(['{', '}']) || text.contains("Some(") || text.contains("Err(");
+    if !debug_like {
+        return text;
+    }
+    match e {
+        image::ImageError::Decoding(d) => match d.format_hint() {
+            image::error::ImageFormatHint::Exact(f) => {
+                let name = f.extensions_str().first().map_or("image".into(), |x| x.to_uppercase());
+                format!("the {name} data is malformed (a broken chunk or a truncated file)")
+            }
+            _ => "the data is malformed (a broken chunk or a truncated file)".into(),
+        },
+        _ => "the decoder could not read it".into(),
+    }
 }
 
 fn check_dimensions(name: &str, w: u64, h: u64) -> Result<(), IoError> {

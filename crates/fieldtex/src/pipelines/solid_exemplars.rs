@@ -52,8 +52,9 @@ pub(crate) fn analyse_exemplars(
 ) -> Result<SolidExemplar> {
     let planes = [&exemplars[0], &exemplars[1], &exemplars[2]];
     let Some(path) = &options.feature_mask else {
-        return SolidExemplar::new(planes, analysis, progress)
-            .map_err(|e| Error::classify(&e, None, "exemplar"));
+        return SolidExemplar::new(planes, analysis, progress).map_err(|e| {
+            Error::classify(&e, exemplar_at_fault(options, exemplars, &e), "exemplar")
+        });
     };
     let mask = fieldtex_io::read_image(path)?;
     let turned = if single { transpose(&mask) } else { mask.clone() };
@@ -64,6 +65,25 @@ pub(crate) fn analyse_exemplars(
         progress,
     )
     .map_err(|e| Error::classify(&e, Some(path), "feature mask"))
+}
+
+/// The file of the plane exemplar an analysis error is about (its size matches the one
+/// the error names), so the message names the input rather than "exemplar".
+fn exemplar_at_fault<'a>(
+    options: &'a SolidOptions,
+    exemplars: &[Image; 3],
+    e: &fieldtex_synth::SynthError,
+) -> Option<&'a Path> {
+    let (w, h) = match e {
+        fieldtex_synth::SynthError::ExemplarTooSmall { width, height, .. }
+        | fieldtex_synth::SynthError::ExemplarTooLarge { width, height, .. } => (*width, *height),
+        _ => return None,
+    };
+    let own = [&options.exemplar_xy, &options.exemplar_yz, &options.exemplar_zx];
+    (0..3)
+        .find(|&p| (exemplars[p].width, exemplars[p].height) == (w, h))
+        .and_then(|p| own[p].as_ref().or(options.exemplar.as_ref()))
+        .map(|p| p.as_path())
 }
 
 /// The analysis of the `--interior` exemplar at `path` (paper E Fig. 15): xy, its

@@ -31,17 +31,20 @@ pub fn transfer_fidelity_files(
     samples: usize,
     seed: u64,
 ) -> Result<TransferFidelity> {
+    // transfer's own range: below it the correlation rests on a handful of points (0 was
+    // silently 15), above it the closest-point queries ran for minutes (10⁸ did not
+    // finish in a minute).
+    if !(256..=8_000_000).contains(&samples) {
+        return Err(Error::bad_input(
+            None,
+            format!("--samples must be in 256..=8000000, got {samples}"),
+        ));
+    }
     let (a, ta) = textured(mesh)?;
     let (b, tb) = textured(reference)?;
     let mut warnings = Vec::new();
-    let s = fieldtex_transfer::sample_surface(
-        &a.mesh,
-        samples.max(16),
-        seed,
-        "evaluated",
-        &mut warnings,
-    )
-    .map_err(|e| Error::classify(&e, Some(mesh), ""))?;
+    let s = fieldtex_transfer::sample_surface(&a.mesh, samples, seed, "evaluated", &mut warnings)
+        .map_err(|e| Error::classify(&e, Some(mesh), ""))?;
     let bvh =
         fieldtex_mesh::Bvh::build(&b.mesh).map_err(|e| Error::classify(&e, Some(reference), ""))?;
     let closest = bvh.closest_points(&s.positions);

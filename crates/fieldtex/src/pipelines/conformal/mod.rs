@@ -105,9 +105,19 @@ pub fn conformal(
             ),
         ));
     }
-    if !(options.scale > 0.0 && options.scale <= 16.0) || options.levels == 0 || options.levels > 16
-    {
-        return Err(Error::bad_input(None, "--scale must be in (0, 16] and --levels in 1..=16"));
+    // Below 1/64 (orient's bound too) the run time grows without bound: 10⁻⁴ took 3×
+    // the default's time, 10⁻⁶ and 10⁻³⁰ did not finish in a minute.
+    if !(options.scale >= 1.0 / 64.0 && options.scale <= 16.0) {
+        return Err(Error::bad_input(
+            None,
+            format!("--scale must be in [0.015625, 16], got {:?}", options.scale),
+        ));
+    }
+    if options.levels == 0 || options.levels > 16 {
+        return Err(Error::bad_input(
+            None,
+            format!("--levels must be in 1..=16, got {}", options.levels),
+        ));
     }
     let mut report =
         Report::new("conformal", options.seed, serde_json::to_value(options).unwrap_or_default());
@@ -211,7 +221,9 @@ pub fn conformal(
     let q95 = weighted_quantile(&mut tau_w.clone(), 0.95).unwrap_or(1.0);
     let q99 = weighted_quantile(&mut tau_w.clone(), 0.99).unwrap_or(1.0);
     let ex_side = exemplar.width.min(exemplar.height) as f64;
-    let min_scale = ((options.patch_size as f64 + 8.0) / ex_side).max(0.25);
+    // Never above 1: an exemplar whose short side is under patch + 8 px (accepted: one
+    // patch fits) gets no minified level instead of an empty range.
+    let min_scale = ((options.patch_size as f64 + 8.0) / ex_side).clamp(0.25, 1.0);
     // Largest enlargement: 12×, and no level over 2048 px on its short side.
     let max_scale = (2048.0 / (ex_side * options.scale)).clamp(1.0, 12.0);
     let (scales, level_names) = if options.multiscale {
