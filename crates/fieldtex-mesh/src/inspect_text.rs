@@ -21,6 +21,16 @@ pub const LISTED_ITEMS: usize = 10;
 
 /// The first [`LISTED_ITEMS`] of `items` joined by commas, then "… and K more" when
 /// `total` (the full count) is larger than what is shown.
+/// A coordinate with six decimals, or in scientific notation when that would print a
+/// long run of digits or zeros (|x| ≥ 10⁹ or 0 < |x| < 10⁻⁴).
+fn coordinate(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&x.abs()) {
+        format!("{x:.6}")
+    } else {
+        format!("{x:.6e}")
+    }
+}
+
 fn bounded(mut items: Vec<String>, total: usize) -> String {
     items.truncate(LISTED_ITEMS);
     let shown = items.len();
@@ -163,8 +173,14 @@ impl InspectReport {
             vec![format!("vertices: {}, triangles: {}", self.n_vertices, self.n_triangles)];
         match &self.bounding_box {
             Some(b) => out.push(format!(
-                "bounding box: [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}], diagonal {:.6}",
-                b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2], self.diagonal
+                "bounding box: [{}, {}, {}] – [{}, {}, {}], diagonal {}",
+                coordinate(b.min[0]),
+                coordinate(b.min[1]),
+                coordinate(b.min[2]),
+                coordinate(b.max[0]),
+                coordinate(b.max[1]),
+                coordinate(b.max[2]),
+                coordinate(self.diagonal)
             )),
             None => out.push("bounding box: none (no finite vertex)".into()),
         }
@@ -220,5 +236,21 @@ impl InspectReport {
             out.push(format!("problem {p}"));
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coordinate;
+
+    #[test]
+    fn coordinates_stay_short_at_any_magnitude() {
+        assert_eq!(coordinate(0.0), "0.000000");
+        assert_eq!(coordinate(-12.5), "-12.500000");
+        assert_eq!(coordinate(1e38), "1.000000e38");
+        assert_eq!(coordinate(-3e-30), "-3.000000e-30");
+        for x in [1e300, 1.41e38, 2.5e-9, 123456.0, 0.001] {
+            assert!(coordinate(x).len() <= 16, "{x}: {}", coordinate(x));
+        }
     }
 }
