@@ -130,23 +130,46 @@ where
     /// float operations without FMA contraction: bit-identical to the baseline build).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn correct_avx2(&self, p: usize, s: &[[f32; 2]], fl: &[bool]) -> ([f32; 2], bool) {
-        self.correct_impl(p, s, fl)
+    fn correct_avx2<const WARP: bool>(
+        &self,
+        p: usize,
+        s: &[[f32; 2]],
+        fl: &[bool],
+    ) -> ([f32; 2], bool) {
+        self.correct_impl::<WARP>(p, s, fl)
     }
 
     /// New `(S, I)` of sample `p` from the current state.
     #[inline]
     fn correct(&self, p: usize, s: &[[f32; 2]], fl: &[bool]) -> ([f32; 2], bool) {
+        // The warped corner reads are compiled as a separate instance so that the
+        // default path keeps the plain loop (no per-neighbour corner maps).
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is true only when the CPU reports AVX2 support.
-            return unsafe { self.correct_avx2(p, s, fl) };
+            return unsafe {
+                if self.warp.is_some() {
+                    self.correct_avx2::<true>(p, s, fl)
+                } else {
+                    self.correct_avx2::<false>(p, s, fl)
+                }
+            };
         }
-        self.correct_impl(p, s, fl)
+        if self.warp.is_some() {
+            self.correct_impl::<true>(p, s, fl)
+        } else {
+            self.correct_impl::<false>(p, s, fl)
+        }
     }
 
+    /// `WARP`: [`Self::warp`] is set (the warped corner reads).
     #[inline(always)]
-    fn correct_impl(&self, p: usize, s: &[[f32; 2]], fl: &[bool]) -> ([f32; 2], bool) {
+    fn correct_impl<const WARP: bool>(
+        &self,
+        p: usize,
+        s: &[[f32; 2]],
+        fl: &[bool],
+    ) -> ([f32; 2], bool) {
         let ex = &self.ex;
         let h = self.spacing;
         let jp = self.t.jac[p];
@@ -156,7 +179,7 @@ where
         let mut pred = [([0.0f32; 2], false, [0.0f32; 2]); S];
         let mut valid = [false; S];
         // Corner maps of the warped reads (warped_neighbourhood.rs), per neighbour.
-        let jinv = self.warp.and_then(|_| inverse_frame(&jp));
+        let jinv = if WARP { self.warp.and_then(|_| inverse_frame(&jp)) } else { None };
         let mut corner_maps = [None; S];
         for k in 0..S {
             let q = nb[k];
@@ -181,7 +204,7 @@ where
                 let fpa = if alpha { negated(&jp) } else { jp };
                 fq = mean(&fq, &fpa);
             }
-            if let Some(ji) = &jinv {
+            if WARP && let Some(ji) = &jinv {
                 let fpa = if alpha { negated(&jp) } else { jp };
                 corner_maps[k] = corner_map(&fq, &fpa, ji, h);
             }
@@ -206,8 +229,8 @@ where
                     continue;
                 }
                 let (u, a, _) = pred[t];
-                let v = match (&corner_maps[t], self.warp) {
-                    (Some(m), Some(app)) => &warped_corner(ex, app[a as usize], u, m, ci)[..],
+                let v = match (WARP, &corner_maps[t], self.warp) {
+                    (true, Some(m), Some(app)) => &warped_corner(ex, app[a as usize], u, m, ci)[..],
                     _ => &ex.nv[a as usize][ex.pixel(u)].0[lanes.clone()],
                 };
                 for (o, &x) in tc.iter_mut().zip(v) {
