@@ -5,16 +5,12 @@
 mod common;
 use common::*;
 
-use fieldtex_eval::{FieldView, GuidedCoherenceOptions, ImageView, guided_coherence};
+use fieldtex_eval::{GuidedCoherenceOptions, guided_coherence};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let (o, ow, oh) = rgb(&a[1]);
-    let (e, ew, eh) = rgb(&a[2]);
-    let f = npy(&a[3]);
-    let ov = ImageView::new(&o, ow, oh, 3).unwrap();
-    let ev = ImageView::new(&e, ew, eh, 3).unwrap();
-    let fv = FieldView::new(&f, ow, oh).unwrap();
+    let run = OrientRun::read_files(&a[1], &a[2], &a[3]);
+    let (ov, ev, fv) = run.views();
     let t = std::time::Instant::now();
     let r = guided_coherence(&ov, &ev, &fv, &GuidedCoherenceOptions::default()).unwrap();
     println!("{:.2} s wall: {r:?}", t.elapsed().as_secs_f64());

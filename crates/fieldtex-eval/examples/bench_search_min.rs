@@ -13,12 +13,8 @@ use std::time::Instant;
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let reps: usize = a.get(3).map_or(15, |s| s.parse().unwrap());
-    let (o, ow, oh) = rgb(&format!("{}/texture.png", a[1]));
-    let (e, ew, eh) = rgb(&a[2]);
-    let f = npy(&format!("{}/field.npy", a[1]));
-    let ov = ImageView::new(&o, ow, oh, 3).unwrap();
-    let ev = ImageView::new(&e, ew, eh, 3).unwrap();
-    let fv = FieldView::new(&f, ow, oh).unwrap();
+    let run = OrientRun::read(&a[1], &a[2]);
+    let (ov, ev, fv) = run.views();
     let approximate = Some(ApproximateSearchOptions::default());
     let popts = PatchDistanceOptions::default()
         .with_wrap_exemplar(true)

@@ -34,12 +34,8 @@ fn stage<T>(name: &str, f: impl FnOnce() -> T) -> T {
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let exact = a.iter().any(|s| s == "--exact");
-    let (o, ow, oh) = rgb(&format!("{}/texture.png", a[1]));
-    let (e, ew, eh) = rgb(&a[2]);
-    let f = npy(&format!("{}/field.npy", a[1]));
-    let ov = ImageView::new(&o, ow, oh, 3).unwrap();
-    let ev = ImageView::new(&e, ew, eh, 3).unwrap();
-    let fv = FieldView::new(&f, ow, oh).unwrap();
+    let run = OrientRun::read(&a[1], &a[2]);
+    let (ov, ev, fv) = run.views();
     // `--search DIMS,RERANK,CHECKS` tries other approximate-search options.
     let search = a.iter().position(|s| s == "--search").map(|i| {
         let v: Vec<usize> = a[i + 1].split(',').map(|x| x.parse().unwrap()).collect();
@@ -82,7 +78,8 @@ fn main() {
     if std::path::Path::new(&coords_path).exists() {
         let coords = npy(&coords_path);
         let r = stage("source_coverage", || {
-            source_coverage(&coords, [ew, eh], &SourceCoverageOptions::default()).unwrap()
+            source_coverage(&coords, [ev.width, ev.height], &SourceCoverageOptions::default())
+                .unwrap()
         });
         println!(
             "source coverage {:.4} (copied {:.4}, mean distance {:.2} px, max {:.1} px)",

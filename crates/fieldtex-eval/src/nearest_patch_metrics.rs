@@ -246,19 +246,9 @@ pub(crate) fn summarize(
     }
 }
 
-fn approximate_report(
-    dists: &[f32],
-    dim: usize,
-    candidates: usize,
-    n: usize,
-    stride: usize,
-    options: &ApproximateSearchOptions,
-) -> PatchDistanceReport {
-    approximate_sampled_report(dists, dim, candidates, n, stride, options, None)
-}
-
-/// [`approximate_report`] of a query sample: `Some(whole_grid)` when the queries came
-/// from [`sampled_runs`] (adds the standard error, 0 when the sample was the whole grid).
+/// The report of an approximate search; `sampled` is `Some(whole_grid)` when the queries
+/// came from [`sampled_runs`] (adds the standard error, 0 when the sample was the whole
+/// grid), `None` for a strided grid of queries.
 fn approximate_sampled_report(
     dists: &[f32],
     dim: usize,
@@ -335,36 +325,28 @@ pub(crate) fn coherence_distances(
 ) -> Result<(PatchDistanceReport, Vec<f32>, usize, usize), EvalError> {
     let (out, ex) = grids(output, exemplar, options, "coherence")?;
     if let Some(a) = &options.approximate {
-        let (qs, sampled, stride) = coherence_queries(&out, a);
-        if !map {
-            let (to_ex, _) = approximate_ssd(&out, &qs, &ex, a, None)?;
-            let report = approximate_sampled_report(
-                &to_ex,
-                out.dim(),
-                ex.count(),
-                options.patch_size,
-                stride,
-                a,
-                sampled,
-            );
-            return Ok((report, to_ex, 0, 0));
-        }
-        let qs = strided(&out, a.query_stride);
+        // A map needs the strided grid of queries; a mean takes the seeded sample.
+        let (qs, sampled, stride) = if map {
+            (strided(&out, a.query_stride), None, a.query_stride)
+        } else {
+            coherence_queries(&out, a)
+        };
         let (to_ex, _) = approximate_ssd(&out, &qs, &ex, a, None)?;
-        let report = approximate_report(
+        let report = approximate_sampled_report(
             &to_ex,
             out.dim(),
             ex.count(),
             options.patch_size,
-            a.query_stride,
+            stride,
             a,
+            sampled,
         );
-        return Ok((
-            report,
-            to_ex,
-            out.cols.div_ceil(a.query_stride.max(1)),
-            out.rows.div_ceil(a.query_stride.max(1)),
-        ));
+        let (cols, rows) = if map {
+            (out.cols.div_ceil(stride.max(1)), out.rows.div_ceil(stride.max(1)))
+        } else {
+            (0, 0)
+        };
+        return Ok((report, to_ex, cols, rows));
     }
     let (to_ex, _) = nearest_patch_ssd(&out, &ex, true, false);
     let report = summarize(&to_ex, out.dim(), ex.count(), options.patch_size);

@@ -476,48 +476,18 @@ pub fn phase_defects(
 
 /// Single-linkage merge of raw loop windings (`raw` sorted by y) within `radius`.
 fn merge_defects(raw: &[(f64, f64, i32)], radius: f64) -> Vec<PhaseDefect> {
-    let n = raw.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
+    let points: Vec<[f64; 2]> = raw.iter().map(|d| [d.0, d.1]).collect();
+    let (labels, count) = crate::singularities::single_linkage_labels(&points, radius);
+    let mut acc: Vec<(f64, f64, i32, usize)> = vec![(0.0, 0.0, 0, 0); count];
+    for (d, &l) in raw.iter().zip(&labels) {
+        acc[l].0 += d.0;
+        acc[l].1 += d.1;
+        acc[l].2 += d.2;
+        acc[l].3 += 1;
     }
-    for i in 0..n {
-        for j in i + 1..n {
-            if raw[j].1 - raw[i].1 > radius {
-                break;
-            }
-            let (dx, dy) = (raw[j].0 - raw[i].0, raw[j].1 - raw[i].1);
-            if dx * dx + dy * dy <= radius * radius {
-                let (a, b) = (find(&mut parent, i), find(&mut parent, j));
-                if a != b {
-                    parent[a.max(b)] = a.min(b);
-                }
-            }
-        }
-    }
-    let mut acc: Vec<(f64, f64, i32, usize)> = vec![(0.0, 0.0, 0, 0); n];
-    let mut order = Vec::new();
-    for (i, d) in raw.iter().enumerate() {
-        let r = find(&mut parent, i);
-        if acc[r].3 == 0 {
-            order.push(r);
-        }
-        acc[r].0 += d.0;
-        acc[r].1 += d.1;
-        acc[r].2 += d.2;
-        acc[r].3 += 1;
-    }
-    order
-        .into_iter()
-        .filter(|&r| acc[r].2 != 0)
-        .map(|r| {
-            let (sx, sy, c, cnt) = acc[r];
-            PhaseDefect { x: sx / cnt as f64, y: sy / cnt as f64, charge: c }
-        })
+    acc.into_iter()
+        .filter(|a| a.2 != 0)
+        .map(|(sx, sy, c, cnt)| PhaseDefect { x: sx / cnt as f64, y: sy / cnt as f64, charge: c })
         .collect()
 }
 

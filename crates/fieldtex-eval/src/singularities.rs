@@ -21,6 +21,7 @@
 
 use crate::orientation::OrientationMap;
 use fieldtex_fields::singularity_index::loop_turns;
+use fieldtex_mesh::UnionFind;
 use serde::Serialize;
 
 /// Options of [`singularities`].
@@ -144,48 +145,53 @@ pub fn singularities(map: &OrientationMap, options: &SingularityOptions) -> Sing
     summarize(raw, merge)
 }
 
-/// Single-linkage clustering within `merge` pixels, then the report.
-fn summarize(raw: Vec<Singularity>, merge: f64) -> SingularityReport {
-    let n = raw.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
-    // Raw points are in scan order (sorted by y), so only a window needs checking.
+/// Single-linkage clusters of points sorted by `y` (scan order), linking points at most
+/// `radius` apart: each point's cluster label, labels numbered by first appearance, and
+/// the number of clusters. Shared by singularity merging and phase-defect merging.
+pub(crate) fn single_linkage_labels(points: &[[f64; 2]], radius: f64) -> (Vec<usize>, usize) {
+    let n = points.len();
+    let mut sets = UnionFind::new(n);
+    // Points are sorted by y, so only a window needs checking.
     for i in 0..n {
         for j in i + 1..n {
-            if raw[j].y - raw[i].y > merge {
+            let (dx, dy) = (points[j][0] - points[i][0], points[j][1] - points[i][1]);
+            if dy > radius {
                 break;
             }
-            let (dx, dy) = (raw[j].x - raw[i].x, raw[j].y - raw[i].y);
-            if dx * dx + dy * dy <= merge * merge {
-                let (a, b) = (find(&mut parent, i), find(&mut parent, j));
-                if a != b {
-                    parent[a.max(b)] = a.min(b);
-                }
+            if dx * dx + dy * dy <= radius * radius {
+                sets.union(i, j);
             }
         }
     }
-    let mut order: Vec<usize> = Vec::new();
-    let mut acc: Vec<(f64, f64, f64, usize)> = vec![(0.0, 0.0, 0.0, 0); n];
-    for (i, s) in raw.iter().enumerate() {
-        let r = find(&mut parent, i);
-        if acc[r].3 == 0 {
-            order.push(r);
-        }
-        acc[r].0 += s.x;
-        acc[r].1 += s.y;
-        acc[r].2 += s.index;
-        acc[r].3 += 1;
+    let mut label_of_root = vec![usize::MAX; n];
+    let mut count = 0;
+    let labels = (0..n)
+        .map(|i| {
+            let r = sets.find(i);
+            if label_of_root[r] == usize::MAX {
+                label_of_root[r] = count;
+                count += 1;
+            }
+            label_of_root[r]
+        })
+        .collect();
+    (labels, count)
+}
+
+/// Single-linkage clustering within `merge` pixels, then the report.
+fn summarize(raw: Vec<Singularity>, merge: f64) -> SingularityReport {
+    let points: Vec<[f64; 2]> = raw.iter().map(|s| [s.x, s.y]).collect();
+    let (labels, count) = single_linkage_labels(&points, merge);
+    let mut acc: Vec<(f64, f64, f64, usize)> = vec![(0.0, 0.0, 0.0, 0); count];
+    for (s, &l) in raw.iter().zip(&labels) {
+        acc[l].0 += s.x;
+        acc[l].1 += s.y;
+        acc[l].2 += s.index;
+        acc[l].3 += 1;
     }
     let mut merged = Vec::new();
     let mut cancelled = 0;
-    for r in order {
-        let (sx, sy, idx, c) = acc[r];
+    for (sx, sy, idx, c) in acc {
         if idx.abs() < 0.25 {
             cancelled += 1;
             continue;

@@ -32,6 +32,7 @@ use fieldtex_core::{Image, Progress, stream};
 use rand::RngExt;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::ops::Range;
 
 /// Options of [`quilt`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -317,43 +318,36 @@ impl Canvas {
 /// surface-area-weighted variance around the target `1/τ_ref`-scaled period is
 /// `s ∝ Σ τ⁻³ / Σ τ⁻⁴`, the mean of `τ` weighted by `τ⁻⁴` (`p = 4`); `p = 2` is the
 /// surface-area-weighted mean, `p = 0` the plain texel mean.
-fn patch_tau(
-    tau: &[f32],
-    width: usize,
-    xs: std::ops::Range<usize>,
-    ys: std::ops::Range<usize>,
-) -> f64 {
+fn patch_tau(tau: &[f32], width: usize, xs: Range<usize>, ys: Range<usize>) -> f64 {
     let (mut num, mut den) = (0.0f64, 0.0f64);
-    for y in ys {
-        for x in xs.clone() {
-            let t = tau[y * width + x] as f64;
-            if t.is_finite() && t > 0.0 {
-                let wgt = t.powf(-TAU_WEIGHT_POWER);
-                num += wgt * t;
-                den += wgt;
-            }
-        }
+    for t in region_taus(tau, width, xs, ys) {
+        let t = t as f64;
+        let wgt = t.powf(-TAU_WEIGHT_POWER);
+        num += wgt * t;
+        den += wgt;
     }
     if den > 0.0 && num.is_finite() { num / den } else { f64::NAN }
 }
 
 /// `max τ / min τ` over the texels of the region that have a `τ` (1 without any).
-fn tau_spread(
-    tau: &[f32],
-    width: usize,
-    xs: std::ops::Range<usize>,
-    ys: std::ops::Range<usize>,
-) -> f64 {
+fn tau_spread(tau: &[f32], width: usize, xs: Range<usize>, ys: Range<usize>) -> f64 {
     let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
-    for y in ys {
-        for &t in &tau[y * width + xs.start..y * width + xs.end] {
-            if t.is_finite() && t > 0.0 {
-                lo = lo.min(t);
-                hi = hi.max(t);
-            }
-        }
+    for t in region_taus(tau, width, xs, ys) {
+        lo = lo.min(t);
+        hi = hi.max(t);
     }
     if hi > 0.0 { (hi / lo) as f64 } else { 1.0 }
+}
+
+/// The finite positive `τ` of the texels in `xs × ys`, row by row.
+fn region_taus(
+    tau: &[f32],
+    width: usize,
+    xs: Range<usize>,
+    ys: Range<usize>,
+) -> impl Iterator<Item = f32> + '_ {
+    ys.flat_map(move |y| tau[y * width + xs.start..y * width + xs.end].iter().copied())
+        .filter(|t| t.is_finite() && *t > 0.0)
 }
 
 /// Power `p` of the `τ^-p` weights of a patch's level choice (`patch_tau`).

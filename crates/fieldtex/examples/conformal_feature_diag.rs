@@ -90,14 +90,7 @@ fn main() {
     let uvs = mesh.uvs.as_ref().unwrap();
     // Charts: faces sharing a UV index.
     let nf = mesh.n_triangles();
-    let mut parent: Vec<usize> = (0..nf).collect();
-    fn find(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
+    let mut sets = fieldtex_mesh::UnionFind::new(nf);
     let mut first = vec![usize::MAX; uvs.values.len()];
     for f in 0..nf {
         for &u in &uvs.indices[f] {
@@ -105,12 +98,11 @@ fn main() {
             if first[u] == usize::MAX {
                 first[u] = f;
             } else {
-                let (a, b) = (find(&mut parent, f), find(&mut parent, first[u]));
-                parent[a] = b;
+                sets.union(f, first[u]);
             }
         }
     }
-    let chart: Vec<usize> = (0..nf).map(|f| find(&mut parent, f)).collect();
+    let chart: Vec<usize> = (0..nf).map(|f| sets.find(f)).collect();
     let map = fieldtex_param::build_texel_map(&mesh, w, h, 0).unwrap();
     let owner: Vec<i64> = map.entries.iter().map(|e| e.map_or(-1, |e| e.triangle as i64)).collect();
     let per_texel = std::env::args().nth(2).as_deref() != Some("centre");

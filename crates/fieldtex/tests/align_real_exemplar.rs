@@ -15,31 +15,10 @@ fn tmp(name: &str) -> PathBuf {
     common::tmp_in("fieldtex-align-real", name)
 }
 
-fn hash(mut x: u64) -> f32 {
-    x ^= x >> 33;
-    x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
-    x ^= x >> 33;
-    (x >> 40) as f32 / (1u64 << 24) as f32
-}
-
-/// Bricks 100 × 42 px, 6-px mortar, a shade per brick, per-pixel grain.
-fn bricks(size: usize) -> Image {
-    let mut img = Image::new(size, size, [0.0, 0.0, 0.0, 1.0]);
-    for y in 0..size {
-        for x in 0..size {
-            let course = y / 42;
-            let xs = x + course % 2 * 50;
-            let grain = 0.08 * (hash((y * size + x) as u64 + 11) - 0.5);
-            let v = if y % 42 < 6 || xs % 100 < 6 {
-                0.78
-            } else {
-                0.25 + 0.2 * hash((course * 64 + xs / 100) as u64)
-            };
-            img.set(x, y, [v + 0.1 + grain, v + grain, v - 0.05 + grain, 1.0]);
-        }
-    }
-    img
-}
+// The brick exemplar of texopt's structured-exemplar test.
+#[path = "../../fieldtex-texopt/tests/common/bricks.rs"]
+mod bricks;
+use bricks::bricks;
 
 #[test]
 fn structured_512_exemplar_on_a_flat_mesh() {

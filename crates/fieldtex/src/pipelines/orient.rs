@@ -74,6 +74,20 @@ impl OrientOptions {
         1.0 / (self.scale * reduction.max(1) as f64)
     }
 
+    /// The `read` stage: the exemplar read and fitted to the exemplar policy's size limit
+    /// (a warning in `report` when reduced), with its exemplar pixels per output pixel.
+    pub(crate) fn read_exemplar(
+        &self,
+        report: &mut Report,
+        progress: &dyn Progress,
+    ) -> Result<(fieldtex_synth::FittedExemplar, f64)> {
+        let image = report.stage(progress, "read", || fieldtex_io::read_image(&self.exemplar))?;
+        let fitted = fieldtex_synth::fit_exemplar(image, fieldtex_synth::MAX_EXEMPLAR_SIDE);
+        report.warnings.extend(fitted.warning.clone());
+        let per_pixel = self.exemplar_pixels_per_output_pixel(fitted.factor);
+        Ok((fitted, per_pixel))
+    }
+
     pub fn new(source: FieldSource, exemplar: PathBuf) -> Self {
         Self {
             source,
@@ -116,22 +130,7 @@ fn build_field(
 ) -> Result<(Vec<[f32; 2]>, Vec<DesignedSingularity>)> {
     let n = options.size;
     let design = match &options.source {
-        FieldSource::Field(p) => {
-            let (shape, data) = fieldtex_io::read_npy_f32(p)?;
-            if shape != [n, n, 2] {
-                return Err(Error::bad_input(
-                    Some(p),
-                    format!(
-                        "the field has shape {shape:?}; --size {n} needs [{n}, {n}, 2] (H×W×2 float32)"
-                    ),
-                ));
-            }
-            let field: Vec<[f32; 2]> = data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-            if let Some(i) = field.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
-                return Err(Error::bad_input(Some(p), format!("non-finite vector at pixel {i}")));
-            }
-            return Ok((field, Vec::new()));
-        }
+        FieldSource::Field(p) => return Ok((read_field_npy(p, n, "", "pixel")?, Vec::new())),
         FieldSource::Design(p) => {
             let text = read_design_text(p)?;
             DesignFile::from_toml_str(&text).map_err(|e| Error::classify(&e, Some(p), ""))?
@@ -175,6 +174,25 @@ fn build_field(
     Ok((pixels, designed))
 }
 
+/// A `--field` file: an `n`×`n`×2 float32 `.npy` of finite vectors. `extra` adds to
+/// the expected-shape message, `unit` names a cell (pixel or texel) in errors.
+pub(super) fn read_field_npy(p: &Path, n: usize, extra: &str, unit: &str) -> Result<Vec<[f32; 2]>> {
+    let (shape, data) = fieldtex_io::read_npy_f32(p)?;
+    if shape != [n, n, 2] {
+        return Err(Error::bad_input(
+            Some(p),
+            format!(
+                "the field has shape {shape:?}; --size {n} needs [{n}, {n}, 2] (H×W×2 float32{extra})"
+            ),
+        ));
+    }
+    let field: Vec<[f32; 2]> = data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+    if let Some(i) = field.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
+        return Err(Error::bad_input(Some(p), format!("non-finite vector at {unit} {i}")));
+    }
+    Ok(field)
+}
+
 /// Reads a design file (UTF-8 TOML) through the bounded reader.
 pub(crate) fn read_design_text(p: &Path) -> Result<String> {
     let bytes =
@@ -211,10 +229,7 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
     }
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let fitted = report.stage(progress, "read", || fieldtex_io::read_image(&options.exemplar))?;
-    let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
-    report.warnings.extend(fitted.warning.clone());
-    let per_pixel = options.exemplar_pixels_per_output_pixel(fitted.factor);
+    let (fitted, per_pixel) = options.read_exemplar(&mut report, progress)?;
     let exemplar = fitted.image;
     report.input = serde_json::json!({
         "exemplar": options.exemplar.display().to_string(),

@@ -91,10 +91,7 @@ pub(crate) fn orient_patch(
     let n = options.size;
     let mut report =
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
-    let fitted = report.stage(progress, "read", || fieldtex_io::read_image(&options.exemplar))?;
-    let fitted = fieldtex_synth::fit_exemplar(fitted, fieldtex_synth::MAX_EXEMPLAR_SIDE);
-    report.warnings.extend(fitted.warning.clone());
-    let per_texel = options.exemplar_pixels_per_output_pixel(fitted.factor);
+    let (fitted, per_texel) = options.read_exemplar(&mut report, progress)?;
     let exemplar = fitted.image;
     let loaded = report.stage(progress, "read_mesh", || fieldtex_io::read_mesh(mesh_path))?;
     report.warnings.extend(loaded.warnings.iter().cloned());
@@ -217,21 +214,8 @@ fn texel_field(
     let n = options.size;
     let (file, src) = match &options.source {
         FieldSource::Field(p) => {
-            let (shape, data) = fieldtex_io::read_npy_f32(p)?;
-            if shape != [n, n, 2] {
-                return Err(Error::bad_input(
-                    Some(p),
-                    format!(
-                        "the field has shape {shape:?}; --size {n} needs [{n}, {n}, 2] (H×W×2 \
-                         float32, the texel field in the patch's parameter space)"
-                    ),
-                ));
-            }
-            let field: Vec<[f32; 2]> = data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-            if let Some(i) = field.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
-                return Err(Error::bad_input(Some(p), format!("non-finite vector at texel {i}")));
-            }
-            return Ok((field, Vec::new()));
+            let extra = ", the texel field in the patch's parameter space";
+            return Ok((super::orient::read_field_npy(p, n, extra, "texel")?, Vec::new()));
         }
         FieldSource::Design(p) => {
             let text = super::orient::read_design_text(p)?;
