@@ -23,13 +23,10 @@ fn run(args: &[&str]) -> Output {
 
 /// A `w`×`h` exemplar with a deterministic colour pattern, written as `dir/name`.
 fn exemplar(dir: &Path, name: &str, w: usize, h: usize) -> PathBuf {
-    let mut im = fieldtex::Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-    for y in 0..h {
-        for x in 0..w {
-            let v = ((x * 37 + y * 91) % 256) as f32 / 255.0;
-            im.pixels[y * w + x] = [v, 1.0 - v, ((x ^ y) % 7) as f32 / 6.0, 1.0];
-        }
-    }
+    let im = fieldtex::Image::from_fn(w, h, |x, y| {
+        let v = ((x * 37 + y * 91) % 256) as f32 / 255.0;
+        [v, 1.0 - v, ((x ^ y) % 7) as f32 / 6.0, 1.0]
+    });
     let p = dir.join(name);
     fieldtex::crates::io::write_png(&p, &im).unwrap();
     p

@@ -20,6 +20,12 @@ impl Image {
         Self { width, height, pixels: vec![color; width * height] }
     }
 
+    /// A `width × height` image whose pixel `(x, y)` is `f(x, y)` (row-major, `y` down).
+    pub fn from_fn(width: usize, height: usize, f: impl Fn(usize, usize) -> [f32; 4]) -> Self {
+        let pixels = (0..width * height).map(|i| f(i % width, i / width)).collect();
+        Self { width, height, pixels }
+    }
+
     #[inline]
     pub fn get(&self, x: usize, y: usize) -> [f32; 4] {
         self.pixels[y * self.width + x]

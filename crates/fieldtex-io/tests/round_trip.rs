@@ -26,13 +26,7 @@ fn uv_grid() -> TriMesh {
 }
 
 fn gradient(w: usize, h: usize) -> Image {
-    let mut im = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-    for y in 0..h {
-        for x in 0..w {
-            im.set(x, y, [x as f32 / (w - 1) as f32, y as f32 / (h - 1) as f32, 0.5, 1.0]);
-        }
-    }
-    im
+    Image::from_fn(w, h, |x, y| [x as f32 / (w - 1) as f32, y as f32 / (h - 1) as f32, 0.5, 1.0])
 }
 
 #[test]

@@ -152,14 +152,10 @@ mod tests {
     use super::*;
 
     fn image(w: usize, h: usize, f: impl Fn(usize, usize) -> f32) -> Image {
-        let mut img = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-        for y in 0..h {
-            for x in 0..w {
-                let v = f(x, y);
-                img.set(x, y, [v, v, v, 1.0]);
-            }
-        }
-        img
+        Image::from_fn(w, h, |x, y| {
+            let v = f(x, y);
+            [v, v, v, 1.0]
+        })
     }
 
     #[test]

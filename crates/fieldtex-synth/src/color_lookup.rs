@@ -109,12 +109,9 @@ mod tests {
     #[test]
     fn cubic_is_exact_at_pixel_centres_and_between_neighbours_elsewhere() {
         let (w, h) = (12, 10);
-        let mut ex = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-        for y in 0..h {
-            for x in 0..w {
-                ex.set(x, y, [x as f32 / 11.0, y as f32 / 9.0, ((x * y) % 3) as f32 / 2.0, 1.0]);
-            }
-        }
+        let ex = Image::from_fn(w, h, |x, y| {
+            [x as f32 / 11.0, y as f32 / 9.0, ((x * y) % 3) as f32 / 2.0, 1.0]
+        });
         let an = ExemplarAnalysis::new(&ex, &AnalysisOptions::default(), &NoProgress).unwrap();
         for (x, y) in [(0usize, 0usize), (5, 3), (11, 9)] {
             let u = [x as f32 + 0.5, y as f32 + 0.5];

@@ -99,14 +99,10 @@ mod tests {
 
     /// A `w × h` image of `f(x, y)` (grey).
     fn grey(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Image {
-        let mut im = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-        for y in 0..h {
-            for x in 0..w {
-                let v = f(x as f64, y as f64) as f32;
-                im.pixels[y * w + x] = [v, v, v, 1.0];
-            }
-        }
-        im
+        Image::from_fn(w, h, |x, y| {
+            let v = f(x as f64, y as f64) as f32;
+            [v, v, v, 1.0]
+        })
     }
 
     /// Random periodic noise: a sum of sinusoids with integer frequencies over the image

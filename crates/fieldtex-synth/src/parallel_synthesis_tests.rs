@@ -39,15 +39,11 @@ fn coord_bits(c: &[[f32; 2]]) -> Vec<[u32; 2]> {
 
 fn test_exemplar() -> Image {
     let (w, h) = (40, 36);
-    let mut ex = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-    for y in 0..h {
-        for x in 0..w {
-            let (fx, fy) = (x as f32, y as f32);
-            let v = 0.5 + 0.45 * (fy * 0.8 + (fx * 0.3).sin()).sin();
-            ex.set(x, y, [v, ((x * 7 + y * 3) % 5) as f32 / 5.0, 1.0 - v, 1.0]);
-        }
-    }
-    ex
+    Image::from_fn(w, h, |x, y| {
+        let (fx, fy) = (x as f32, y as f32);
+        let v = 0.5 + 0.45 * (fy * 0.8 + (fx * 0.3).sin()).sin();
+        [v, ((x * 7 + y * 3) % 5) as f32 / 5.0, 1.0 - v, 1.0]
+    })
 }
 
 /// A wedge-like field: representatives flip by 180° across one ray (2-RoSy path).

@@ -13,23 +13,15 @@ use fieldtex_synth::{
 
 /// A small non-square, non-power-of-two, non-periodic exemplar.
 fn blotches(w: usize, h: usize) -> Image {
-    let mut im = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-    for y in 0..h {
-        for x in 0..w {
-            let (fx, fy) = (x as f32, y as f32);
-            im.set(
-                x,
-                y,
-                [
-                    0.5 + 0.5 * (fx * 0.9 + (fy * 0.4).sin() * 2.0).sin(),
-                    0.5 + 0.5 * (fy * 0.7 - fx * 0.2).cos(),
-                    ((x * 7 + y * 13) % 11) as f32 / 11.0,
-                    1.0,
-                ],
-            );
-        }
-    }
-    im
+    Image::from_fn(w, h, |x, y| {
+        let (fx, fy) = (x as f32, y as f32);
+        [
+            0.5 + 0.5 * (fx * 0.9 + (fy * 0.4).sin() * 2.0).sin(),
+            0.5 + 0.5 * (fy * 0.7 - fx * 0.2).cos(),
+            ((x * 7 + y * 13) % 11) as f32 / 11.0,
+            1.0,
+        ]
+    })
 }
 
 /// Analysis treating the procedural exemplar as tileable.

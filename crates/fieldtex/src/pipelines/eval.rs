@@ -492,14 +492,10 @@ mod tests {
 
     /// A `w × h` exemplar of `f(x, y)` in the red channel and a shifted copy in green.
     fn exemplar(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Image {
-        let mut im = Image::new(w, h, [0.0, 0.0, 0.0, 1.0]);
-        for y in 0..h {
-            for x in 0..w {
-                let (xf, yf) = (x as f64, y as f64);
-                im.pixels[y * w + x] = [f(xf, yf) as f32, f(xf + 5.0, yf + 3.0) as f32, 0.5, 1.0];
-            }
-        }
-        im
+        Image::from_fn(w, h, |x, y| {
+            let (xf, yf) = (x as f64, y as f64);
+            [f(xf, yf) as f32, f(xf + 5.0, yf + 3.0) as f32, 0.5, 1.0]
+        })
     }
 
     /// `e` repeated `2 × 2`: its wrap seams copied into the middle of the image.
