@@ -19,13 +19,13 @@ use fieldtex_core::vec3;
 use fieldtex_linalg::SparseMatrix;
 use fieldtex_mesh::primitives::{self, subdivide_midpoint, torus};
 use fieldtex_mesh::{
-    Bvh, CotanOptions, PoissonDiskOptions, Ray, TriMesh, VertexAreaKind, cotan_laplacian_and_mass,
-    poisson_disk_sampling, total_area,
+    Bvh, CornerUvs, CotanOptions, PoissonDiskOptions, Ray, TriMesh, VertexAreaKind,
+    cotan_laplacian_and_mass, poisson_disk_sampling, total_area,
 };
 use std::time::Instant;
 
-// The crate's test-support OBJ reader (`v`/`f` lines, polygons fanned); it names
-// `crate::TriMesh` and `crate::primitives`, which the imports above provide.
+// The crate's test-support OBJ reader; it names `crate::TriMesh`, `crate::CornerUvs` and
+// `crate::primitives`, which the imports above provide.
 #[path = "../src/test_meshes.rs"]
 #[allow(dead_code)]
 mod test_meshes;

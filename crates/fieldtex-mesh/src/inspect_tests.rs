@@ -3,7 +3,7 @@
 
 use crate::inspect::{InspectOptions, InspectReport, inspect};
 use crate::primitives::{grid, icosphere};
-use crate::test_fixtures::load;
+use crate::test_meshes::load;
 use crate::{CornerUvs, TriMesh};
 
 fn run(rel: &str) -> InspectReport {

@@ -73,8 +73,6 @@ pub use repair::{RepairChange, RepairOptions, RepairResult, repair};
 mod inspect_tests;
 #[cfg(test)]
 mod repair_tests;
-#[cfg(test)]
-mod test_fixtures;
 pub use bvh::{Bvh, ClosestPoint, Hit, Ray};
 pub use dart_throwing::{DartThrower, dart_throwing, nested_dart_throwing};
 pub use directional_occlusion::{DirectionalOcclusionOptions, directional_occlusion_sh};

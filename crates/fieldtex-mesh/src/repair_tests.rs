@@ -4,7 +4,7 @@
 use crate::inspect::{InspectOptions, InspectReport, inspect};
 use crate::primitives::{grid, icosphere, torus};
 use crate::repair::{RepairOptions, RepairResult, repair};
-use crate::test_fixtures::load;
+use crate::test_meshes::load;
 use crate::triangle_quality::signed_volume6;
 use crate::{CornerUvs, TriMesh};
 

@@ -15,47 +15,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
+/// The mesh's geometry (positions and triangles) through `fieldtex-io`'s reader.
 fn load_obj(path: &Path) -> Result<TriMesh, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it
-                    .take(3)
-                    .map(|s| s.parse::<f64>())
-                    .collect::<Result<_, _>>()
-                    .map_err(|e| format!("line {}: {e}", ln + 1))?;
-                if c.len() != 3 {
-                    return Err(format!("line {}: a vertex needs 3 coordinates", ln + 1));
-                }
-                positions.push([c[0], c[1], c[2]]);
-            }
-            Some("f") => {
-                let mut idx = Vec::new();
-                for tok in it {
-                    let v: i64 = tok
-                        .split('/')
-                        .next()
-                        .unwrap_or("")
-                        .parse()
-                        .map_err(|e| format!("line {}: {e}", ln + 1))?;
-                    let i = if v < 0 { positions.len() as i64 + v } else { v - 1 };
-                    if i < 0 || i >= positions.len() as i64 {
-                        return Err(format!("line {}: index {v} out of range", ln + 1));
-                    }
-                    idx.push(i as u32);
-                }
-                for k in 1..idx.len().saturating_sub(1) {
-                    triangles.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok(TriMesh::new(positions, triangles))
+    let read = fieldtex_io::read_mesh(path).map_err(|e| e.to_string())?.mesh;
+    Ok(TriMesh::new(read.positions, read.triangles))
 }
 
 /// Records when each stage starts and finishes.

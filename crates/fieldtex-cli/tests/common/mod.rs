@@ -13,6 +13,7 @@ pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_fieldtex")
 }
 
+pub mod golden;
 mod paths;
 pub use paths::{shared, tmp_in};
 
