@@ -239,6 +239,34 @@ pub fn transfer_files(
         carrier_texture(&map, &covered, &colors).0
     });
     // Report.
+    transfer_metrics_and_notes(&mut report, options, &result);
+    // Outputs.
+    report.stage(progress, "write", || {
+        super::write_model(out_dir, &atlas.mesh, Some(&texture_out))
+    })?;
+    let preview = report.stage(progress, "preview", || {
+        let opts = RenderOptions { size: 600, ..Default::default() };
+        let left = render(&Scene::new(&source_mesh).with_texture(texture), &opts);
+        let right = render(&Scene::new(&atlas.mesh).with_texture(&texture_out), &opts);
+        side_by_side(&left, &right)
+    });
+    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
+    if options.keep {
+        report.stage(progress, "keep", || {
+            write_guidance_ply(&out_dir.join("guidance.ply"), &target_mesh, &result)
+        })?;
+    }
+    commit_outputs(out, &mut report)?;
+    Ok(report)
+}
+
+/// The transfer's metrics (samples, guidance, feature matching, engine statistics) and
+/// the notes naming its substitutes.
+fn transfer_metrics_and_notes(
+    report: &mut Report,
+    options: &TransferCommandOptions,
+    result: &fieldtex_transfer::TransferResult,
+) {
     let named = |w: &[f64]| -> serde_json::Map<String, serde_json::Value> {
         DESCRIPTOR_NAMES.iter().zip(w).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect()
     };
@@ -296,24 +324,6 @@ pub fn transfer_files(
         }
     }
     report.notes.push("colours are processed as sRGB-encoded values".into());
-    // Outputs.
-    report.stage(progress, "write", || {
-        super::write_model(out_dir, &atlas.mesh, Some(&texture_out))
-    })?;
-    let preview = report.stage(progress, "preview", || {
-        let opts = RenderOptions { size: 600, ..Default::default() };
-        let left = render(&Scene::new(&source_mesh).with_texture(texture), &opts);
-        let right = render(&Scene::new(&atlas.mesh).with_texture(&texture_out), &opts);
-        side_by_side(&left, &right)
-    });
-    fieldtex_io::write_png(&out_dir.join("preview.png"), &preview)?;
-    if options.keep {
-        report.stage(progress, "keep", || {
-            write_guidance_ply(&out_dir.join("guidance.ply"), &target_mesh, &result)
-        })?;
-    }
-    commit_outputs(out, &mut report)?;
-    Ok(report)
 }
 
 /// `guidance.ply`: the target with per-vertex descriptors, guidance and colour,

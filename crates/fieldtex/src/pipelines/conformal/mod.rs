@@ -13,20 +13,20 @@
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
-use fieldtex_core::{Image, stream_seed};
+use fieldtex_core::Image;
 use fieldtex_mesh::TriMesh;
 use fieldtex_param::conformal::{
     ConformalComponent, GeometryImage, MassSpringOptions, global_conformal,
 };
-use fieldtex_synth::exemplar_scales::{resample, scale_levels};
-use fieldtex_synth::{QuiltTarget, QuiltingOptions, quilt};
 use serde::Serialize;
 
 mod blocks;
 mod report;
+mod stages;
 use blocks::{assemble, fallback_atlas, write_keep};
-use report::{add_notes, component_json, texel_density, weighted_quantile};
+use report::add_notes;
 use serde_json::json;
+use stages::{RunParts, check_options, conformal_metrics, exemplar_levels, quilt_blocks};
 use std::path::{Path, PathBuf};
 
 /// A quilting patch whose texels' `τ` spans more than this factor is placed as four
@@ -90,35 +90,7 @@ pub fn conformal(
     out_dir: &Path,
     progress: &dyn Progress,
 ) -> Result<Report> {
-    if !(64..=8192).contains(&options.size) {
-        return Err(Error::bad_input(
-            None,
-            format!("--size must be in 64..=8192, got {}", options.size),
-        ));
-    }
-    if !(8..=256).contains(&options.patch_size) || options.patch_size * 2 > options.size {
-        return Err(Error::bad_input(
-            None,
-            format!(
-                "--patch-size must be in 8..=256 and at most half of --size, got {}",
-                options.patch_size
-            ),
-        ));
-    }
-    // Below 1/64 (orient's bound too) the run time grows without bound: 10⁻⁴ took 3×
-    // the default's time, 10⁻⁶ and 10⁻³⁰ did not finish in a minute.
-    if !(options.scale >= 1.0 / 64.0 && options.scale <= 16.0) {
-        return Err(Error::bad_input(
-            None,
-            format!("--scale must be in [0.015625, 16], got {:?}", options.scale),
-        ));
-    }
-    if options.levels == 0 || options.levels > 16 {
-        return Err(Error::bad_input(
-            None,
-            format!("--levels must be in 1..=16, got {}", options.levels),
-        ));
-    }
+    check_options(options)?;
     let mut report =
         Report::new("conformal", options.seed, serde_json::to_value(options).unwrap_or_default());
     begin_command();
@@ -196,129 +168,11 @@ pub fn conformal(
         })?)
     };
     // 4. τ reference and exemplar levels (global, so features match across images).
-    let mut tau_w: Vec<(f64, f64)> = Vec::new();
-    for img in images.iter().flatten() {
-        for (l, a) in img.face_lambda.iter().zip(&img.face_area) {
-            if l.is_finite() && *l > 0.0 {
-                tau_w.push((1.0 / l, *a));
-            }
-        }
-    }
-    if let Some(fb) = &fallback {
-        for (l, a) in fb.face_lambda.iter().zip(&fb.face_area) {
-            if l.is_finite() && *l > 0.0 {
-                tau_w.push((1.0 / l, *a));
-            }
-        }
-    }
-    // The paper places the original sample "close to the lowest level" (§4.2): the
-    // reference is the 5th area-weighted percentile of τ, so almost every patch takes an
-    // enlarged level and only the 1 % tail below needs a minified one (at least one
-    // patch wide).
-    let tau_ref = weighted_quantile(&mut tau_w.clone(), 0.05).unwrap_or(1.0);
-    let q05 = tau_ref;
-    let q01 = weighted_quantile(&mut tau_w.clone(), 0.01).unwrap_or(1.0);
-    let q95 = weighted_quantile(&mut tau_w.clone(), 0.95).unwrap_or(1.0);
-    let q99 = weighted_quantile(&mut tau_w.clone(), 0.99).unwrap_or(1.0);
-    let ex_side = exemplar.width.min(exemplar.height) as f64;
-    // Never above 1: an exemplar whose short side is under patch + 8 px (accepted: one
-    // patch fits) gets no minified level instead of an empty range.
-    let min_scale = ((options.patch_size as f64 + 8.0) / ex_side).clamp(0.25, 1.0);
-    // Largest enlargement: 12×, and no level over 2048 px on its short side.
-    let max_scale = (2048.0 / (ex_side * options.scale)).clamp(1.0, 12.0);
-    let (scales, level_names) = if options.multiscale {
-        let lo = (q01 / tau_ref).clamp(min_scale, 1.0);
-        let hi = (q99 / tau_ref).clamp(1.0, max_scale);
-        // At least one level per factor 1.3 of the range (at most 14).
-        let n = options.levels.max(((hi / lo).ln() / 1.3f64.ln()).ceil() as usize + 1).min(14);
-        let s = scale_levels(lo, hi, n);
-        (s.clone(), s)
-    } else {
-        (vec![1.0], vec![1.0])
-    };
-    let levels: Vec<Image> = report.stage(progress, "exemplar-levels", || {
-        scales.iter().map(|s| resample(&exemplar, s * options.scale)).collect()
-    });
-    let level_for = |t: f64| -> usize {
-        if !t.is_finite() || scales.len() == 1 {
-            return scales.iter().position(|s| (*s - 1.0).abs() < 1e-9).unwrap_or(0);
-        }
-        let r = (t / tau_ref).ln();
-        (0..scales.len())
-            .min_by(|&i, &j| (scales[i].ln() - r).abs().total_cmp(&(scales[j].ln() - r).abs()))
-            .unwrap_or(0)
-    };
+    let lv = exemplar_levels(&mut report, progress, options, &exemplar, &images, fallback.as_ref());
     // 5. Quilting per geometry image (and the fallback atlas).
-    let qbase = QuiltingOptions {
-        patch_size: options.patch_size,
-        overlap: (options.patch_size / 5).max(2),
-        // A 40-px patch over a fast τ change (near zero points, across neighbouring
-        // charts) is placed as four half-size patches, each with its own level; the
-        // ablation keeps whole patches (one level, nothing to choose).
-        split_spread: if options.multiscale { PATCH_SPLIT_SPREAD } else { f64::INFINITY },
-        seed: options.seed,
-        ..Default::default()
-    };
-    let mut blocks: Vec<Block> = Vec::new();
-    let mut quilt_stats = Vec::new();
     let quilting = fieldtex_core::StageGuard::begin(progress, "quilting", 0);
-    for (c, img) in comps.iter().zip(&images) {
-        let Some(img) = img else { continue };
-        let partners = |i: usize, j: usize, out: &mut Vec<(usize, usize)>| img.partners(i, j, out);
-        let target = QuiltTarget {
-            width: img.width,
-            height: img.height,
-            tau: &img.tau,
-            level_for: &level_for,
-            partners: &partners,
-        };
-        let q = QuiltingOptions {
-            seed: stream_seed(options.seed, "conformal-image", c.component as u64),
-            ..qbase
-        };
-        crate::outputs::check_cancelled(progress)?;
-        let (mut image, st) = quilt(&levels, &target, &q, progress);
-        // Margins across patch cuts take their partners' colours (§4.2); count those the
-        // quilting left different from their partner (both sides written in one patch).
-        let changed = img
-            .margin_copies
-            .iter()
-            .filter(|&&(g, r, _)| image.pixels[g as usize] != image.pixels[r as usize])
-            .count();
-        let pairs_changed = img
-            .seam_pairs
-            .iter()
-            .filter(|&&(a, b)| image.pixels[a as usize] != image.pixels[b as usize])
-            .count();
-        img.copy_margins(&mut image.pixels);
-        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len(), "margin_texels_changed_by_copy": changed, "seam_texel_pairs": img.seam_pairs.len(), "seam_texel_pairs_changed_by_copy": pairs_changed}));
-        let faces = c.faces.iter().copied().zip(img.corner_texel.iter().copied()).collect();
-        blocks.push(Block {
-            image,
-            faces,
-            tau: img.tau.clone(),
-            label: format!("component{}", c.component),
-        });
-    }
-    if let Some(fb) = &fallback {
-        let none = |_: usize, _: usize, _: &mut Vec<(usize, usize)>| {};
-        let target = QuiltTarget {
-            width: fb.width,
-            height: fb.height,
-            tau: &fb.tau,
-            level_for: &level_for,
-            partners: &none,
-        };
-        let q = QuiltingOptions { seed: stream_seed(options.seed, "conformal-atlas", 0), ..qbase };
-        let (image, st) = quilt(&levels, &target, &q, progress);
-        quilt_stats.push(json!({"component": "fallback-atlas", "stats": st}));
-        blocks.push(Block {
-            image,
-            faces: fb.faces.clone(),
-            tau: fb.tau.clone(),
-            label: "fallback_atlas".into(),
-        });
-    }
+    let (blocks, quilt_stats, split_spread) =
+        quilt_blocks(progress, options, &comps, &images, fallback.as_ref(), &lv)?;
     report.timings_ms.push(("quilting".into(), quilting.elapsed_ms()));
     drop(quilting);
     crate::outputs::check_cancelled(progress)?;
@@ -331,40 +185,17 @@ pub fn conformal(
     });
     fieldtex_io::write_png(&stage.join("preview.png"), &preview)?;
     // 8. Metrics.
-    let comp_json: Vec<serde_json::Value> =
-        comps.iter().zip(&images).map(|(c, img)| component_json(c, img.as_ref())).collect();
-    report.metric("components", comp_json);
-    report.metric("exemplar_levels", json!({"scales": level_names, "tau_reference": tau_ref, "tau_q05": q05, "tau_q95": q95, "multiscale": options.multiscale, "patch_split_spread": qbase.split_spread}));
-    report.metric("quilting", quilt_stats);
-    if options.quasi_isometric {
-        report.metric("mass_spring", relax_stats);
-    }
-    let seams = report.stage(progress, "eval-seams", || {
-        fieldtex_eval::seam_metrics::seam_metrics(&out_mesh, &texture)
-    });
-    report.metric("seams", seams);
-    let feature = report.stage(progress, "eval-feature-size", || {
-        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, true, true)
-    });
-    report.metric("feature_size", feature);
-    let feature_centre = report.stage(progress, "eval-feature-size-centre", || {
-        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, true, false)
-    });
-    report.metric("feature_size_centre_lambda", feature_centre);
-    let feature24 = report.stage(progress, "eval-feature-size-fixed", || {
-        fieldtex_eval::feature_size::feature_size_variation(&out_mesh, &texture, 24, false, false)
-    });
-    report.metric("feature_size_fixed_window", feature24);
-    // Whole-mesh distortion in texel units (the texture is not square).
-    let whole = out_mesh.uvs.as_ref().and_then(|uv| {
-        let mut texel_uv = uv.clone();
-        for v in texel_uv.values.iter_mut() {
-            *v = [v[0] * texture.width as f64, v[1] * texture.height as f64];
-        }
-        fieldtex_param::parameterization_distortion(&out_mesh, &texel_uv).ok()
-    });
-    report.metric("distortion_all_faces", whole);
-    report.metric("texel_density", texel_density(&tau_w));
+    let run = RunParts { comps: &comps, images: &images, levels: &lv, split_spread };
+    conformal_metrics(
+        &mut report,
+        progress,
+        options,
+        &run,
+        quilt_stats,
+        relax_stats,
+        &out_mesh,
+        &texture,
+    );
     add_notes(&mut report, &comps, options);
     if options.keep {
         report.stage(progress, "keep", || write_keep(&stage, &mesh, &comps, &blocks))?;
