@@ -42,6 +42,7 @@ pub mod phase_defects;
 pub mod query_sampling;
 pub mod rosy_seam;
 pub mod seam_metrics;
+mod single_linkage;
 pub mod singularities;
 pub mod source_coverage;
 pub mod surface_metrics;

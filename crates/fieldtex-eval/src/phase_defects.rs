@@ -477,7 +477,7 @@ pub fn phase_defects(
 /// Single-linkage merge of raw loop windings (`raw` sorted by y) within `radius`.
 fn merge_defects(raw: &[(f64, f64, i32)], radius: f64) -> Vec<PhaseDefect> {
     let points: Vec<[f64; 2]> = raw.iter().map(|d| [d.0, d.1]).collect();
-    let (labels, count) = crate::singularities::single_linkage_labels(&points, radius);
+    let (labels, count) = crate::single_linkage::single_linkage_labels(&points, radius);
     let mut acc: Vec<(f64, f64, i32, usize)> = vec![(0.0, 0.0, 0, 0); count];
     for (d, &l) in raw.iter().zip(&labels) {
         acc[l].0 += d.0;

@@ -21,7 +21,6 @@
 
 use crate::orientation::OrientationMap;
 use fieldtex_fields::singularity_index::loop_turns;
-use fieldtex_mesh::UnionFind;
 use serde::Serialize;
 
 /// Options of [`singularities`].
@@ -145,43 +144,10 @@ pub fn singularities(map: &OrientationMap, options: &SingularityOptions) -> Sing
     summarize(raw, merge)
 }
 
-/// Single-linkage clusters of points sorted by `y` (scan order), linking points at most
-/// `radius` apart: each point's cluster label, labels numbered by first appearance, and
-/// the number of clusters. Shared by singularity merging and phase-defect merging.
-pub(crate) fn single_linkage_labels(points: &[[f64; 2]], radius: f64) -> (Vec<usize>, usize) {
-    let n = points.len();
-    let mut sets = UnionFind::new(n);
-    // Points are sorted by y, so only a window needs checking.
-    for i in 0..n {
-        for j in i + 1..n {
-            let (dx, dy) = (points[j][0] - points[i][0], points[j][1] - points[i][1]);
-            if dy > radius {
-                break;
-            }
-            if dx * dx + dy * dy <= radius * radius {
-                sets.union(i, j);
-            }
-        }
-    }
-    let mut label_of_root = vec![usize::MAX; n];
-    let mut count = 0;
-    let labels = (0..n)
-        .map(|i| {
-            let r = sets.find(i);
-            if label_of_root[r] == usize::MAX {
-                label_of_root[r] = count;
-                count += 1;
-            }
-            label_of_root[r]
-        })
-        .collect();
-    (labels, count)
-}
-
 /// Single-linkage clustering within `merge` pixels, then the report.
 fn summarize(raw: Vec<Singularity>, merge: f64) -> SingularityReport {
     let points: Vec<[f64; 2]> = raw.iter().map(|s| [s.x, s.y]).collect();
-    let (labels, count) = single_linkage_labels(&points, merge);
+    let (labels, count) = crate::single_linkage::single_linkage_labels(&points, merge);
     let mut acc: Vec<(f64, f64, f64, usize)> = vec![(0.0, 0.0, 0.0, 0); count];
     for (s, &l) in raw.iter().zip(&labels) {
         acc[l].0 += s.x;

@@ -77,10 +77,7 @@ pub fn synthesize_field_texture_with(
     orient.size = width.max(height);
     orient.metrics = false;
     let mut report = Report::new("field_texture", options.seed, serde_json::Value::Null);
-    // The exemplar policy of every pipeline (reduce above the size limit, with a warning).
-    let fitted = fieldtex_synth::fit_exemplar(exemplar.clone(), fieldtex_synth::MAX_EXEMPLAR_SIDE);
-    report.warnings.extend(fitted.warning.clone());
-    let per_pixel = orient.exemplar_pixels_per_output_pixel(fitted.factor);
+    let (fitted, per_pixel) = orient.fit_exemplar(exemplar.clone(), &mut report);
     let image = super::synthesis::synthesize_image_result(
         &fitted.image,
         field,

@@ -74,18 +74,27 @@ impl OrientOptions {
         1.0 / (self.scale * reduction.max(1) as f64)
     }
 
-    /// The `read` stage: the exemplar read and fitted to the exemplar policy's size limit
-    /// (a warning in `report` when reduced), with its exemplar pixels per output pixel.
+    /// The `read` stage: the exemplar read, then [`Self::fit_exemplar`].
     pub(crate) fn read_exemplar(
         &self,
         report: &mut Report,
         progress: &dyn Progress,
     ) -> Result<(fieldtex_synth::FittedExemplar, f64)> {
         let image = report.stage(progress, "read", || fieldtex_io::read_image(&self.exemplar))?;
+        Ok(self.fit_exemplar(image, report))
+    }
+
+    /// The exemplar policy of every pipeline: `image` reduced to the size limit (a
+    /// warning in `report` when it was), with its exemplar pixels per output pixel.
+    pub(crate) fn fit_exemplar(
+        &self,
+        image: Image,
+        report: &mut Report,
+    ) -> (fieldtex_synth::FittedExemplar, f64) {
         let fitted = fieldtex_synth::fit_exemplar(image, fieldtex_synth::MAX_EXEMPLAR_SIDE);
         report.warnings.extend(fitted.warning.clone());
         let per_pixel = self.exemplar_pixels_per_output_pixel(fitted.factor);
-        Ok((fitted, per_pixel))
+        (fitted, per_pixel)
     }
 
     pub fn new(source: FieldSource, exemplar: PathBuf) -> Self {
