@@ -44,7 +44,7 @@ pub struct LoopSystem {
 }
 
 /// Edge lengths in 3-D.
-fn edge_lengths(positions: &[[f64; 3]], topology: &Topology) -> Vec<f64> {
+pub(super) fn edge_lengths(positions: &[[f64; 3]], topology: &Topology) -> Vec<f64> {
     topology
         .edges
         .iter()
@@ -54,12 +54,15 @@ fn edge_lengths(positions: &[[f64; 3]], topology: &Topology) -> Vec<f64> {
 
 /// Shortest-path tree from `root`: per vertex its distance and the tree edge to its
 /// parent (`u32::MAX` at the root and at unreachable vertices). Ties break by vertex id,
-/// so the tree is deterministic.
-fn shortest_path_tree(
+/// so the tree is deterministic. With `radius` finite the search stops there: every
+/// vertex within it has its exact distance, farther ones an upper bound above `radius`
+/// or infinity.
+pub(super) fn shortest_path_tree(
     topology: &Topology,
     vertex_edges: &[Vec<u32>],
     length: &[f64],
     root: usize,
+    radius: f64,
 ) -> (Vec<f64>, Vec<u32>) {
     let nv = topology.n_vertices;
     let mut dist = vec![f64::INFINITY; nv];
@@ -72,6 +75,9 @@ fn shortest_path_tree(
         let v = v as usize;
         if done[v] {
             continue;
+        }
+        if dist[v] > radius {
+            break;
         }
         done[v] = true;
         for &e in &vertex_edges[v] {
@@ -95,7 +101,8 @@ pub fn loop_system(positions: &[[f64; 3]], topology: &Topology, root: u32) -> Lo
     let ne = topology.n_edges();
     let length = edge_lengths(positions, topology);
     let vertex_edges = vertex_edges(topology);
-    let (dist, parent) = shortest_path_tree(topology, &vertex_edges, &length, root as usize);
+    let (dist, parent) =
+        shortest_path_tree(topology, &vertex_edges, &length, root as usize, f64::INFINITY);
     let mut in_tree = vec![false; ne];
     for &e in &parent {
         if e != u32::MAX {

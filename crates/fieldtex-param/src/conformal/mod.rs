@@ -32,6 +32,7 @@ pub mod homology_loops;
 pub mod mass_spring;
 pub mod patch_merging;
 pub mod periodic_uv;
+pub mod protrusion_slits;
 mod rigid_triangles;
 pub mod seam_placement;
 pub mod slit_cylinder;
@@ -43,6 +44,8 @@ pub mod zero_points;
 pub use geometry_image::GeometryImage;
 pub use mass_spring::{MassSpringOptions, MassSpringStats, Targets};
 pub use periodic_uv::Lattice;
+pub use protrusion_slits::ProtrusionSummary;
+use protrusion_slits::{GenusZero, genus_zero};
 pub use translation_patches::Ghost;
 
 use crate::ParamError;
@@ -183,8 +186,12 @@ pub struct ConformalComponent {
     pub conjugate_residual: f64,
     pub harmonic_forms: usize,
     pub note: Option<String>,
-    /// Genus of the double cover when the component (with boundary) was doubled.
+    /// Genus of the double cover when the component (with boundary, or slit open at its
+    /// protrusions) was doubled.
     pub double_cover_genus: Option<usize>,
+    /// Genus 0: the protrusion tips chosen instead of the two extremal slit points
+    /// ([`protrusion_slits`]), when they were.
+    pub protrusion_slits: Option<ProtrusionSummary>,
     /// Capped (or doubled) component mesh (local indices) and local → global vertex ids.
     pub local_mesh: TriMesh,
     pub local_to_global: Vec<u32>,
@@ -311,6 +318,7 @@ pub fn global_conformal(
             .collect();
         let cover_genus = (2 * genus + large.len()).saturating_sub(1);
         let mut double = None;
+        let mut cylinder: Option<Result<ComponentMap, ParamError>> = None;
         if manifold && !large.is_empty() && cover_genus >= 2 && faces.len() >= 8 {
             // The input with its small holes capped, large holes open, doubled.
             let partly = TriMesh::new(
@@ -333,9 +341,58 @@ pub fn global_conformal(
             }
         }
         let mut twin: Vec<u32> = Vec::new();
+        let mut slits: Option<ProtrusionSummary> = None;
+        let mut slit_cover_genus = None;
+        // Genus 0 (small holes capped, at most two large ones left as the cylinder's
+        // ends): the slit cylinder, unless protrusion slits spread the area scale less
+        // (protrusion_slits.rs).
+        if double.is_none() && manifold && genus == 0 && faces.len() >= 8 {
+            let mut caps = capped.caps.clone();
+            caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+            caps.retain(|c| c.1 >= LARGE_HOLE * sub_area.sqrt());
+            let a = caps.first().map(|c| c.0 as usize);
+            let b = match (caps.first(), caps.get(1)) {
+                (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),
+                _ => None,
+            };
+            match genus_zero(&capped.mesh, faces.len(), [a, b]) {
+                Ok(GenusZero::Slits { cut, cover, map }) => {
+                    local_to_global.resize(capped.mesh.n_vertices(), u32::MAX);
+                    for v in capped.mesh.n_vertices()..cut.mesh.n_vertices() {
+                        local_to_global.push(local_to_global[cut.original[v] as usize]);
+                    }
+                    slits = Some(ProtrusionSummary {
+                        tips: cut.tips.iter().map(|&t| local_to_global[t as usize]).collect(),
+                        log_area_std: map.1,
+                        cylinder_log_area_std: map.2,
+                    });
+                    slit_cover_genus = Some(cut.tips.len() + a.iter().chain(&b).count() - 1);
+                    double = Some((*cover, map.0));
+                }
+                Ok(GenusZero::Cylinder(m, moved)) => {
+                    if let Some(std) = moved {
+                        slits = Some(ProtrusionSummary {
+                            tips: m
+                                .slit_vertices
+                                .iter()
+                                .map(|&t| {
+                                    local_to_global.get(t as usize).copied().unwrap_or(u32::MAX)
+                                })
+                                .collect(),
+                            log_area_std: std[0],
+                            cylinder_log_area_std: std[1],
+                        });
+                    }
+                    cylinder = Some(Ok(*m));
+                }
+                Err(e) => cylinder = Some(Err(e)),
+            }
+        }
         let (capped_mesh, result, is_double) = if let Some((dc, m)) = double {
             twin = dc.twin;
             (dc.mesh, Ok(m), true)
+        } else if let Some(r) = cylinder {
+            (capped.mesh, r, false)
         } else {
             let r = if !manifold {
                 Err(cotan_system::conformal_error(
@@ -343,18 +400,6 @@ pub fn global_conformal(
                 ))
             } else if faces.len() < 8 {
                 Err(cotan_system::conformal_error("fewer than 8 triangles"))
-            } else if genus == 0 {
-                let mut caps = capped.caps.clone();
-                caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
-                // A hole becomes a cylinder end only when it is large (its boundary at least
-                // 0.3 √area); small holes stay capped and the slits go to extremal points.
-                caps.retain(|c| c.1 >= LARGE_HOLE * sub_area.sqrt());
-                let a = caps.first().map(|c| c.0 as usize);
-                let b = match (caps.first(), caps.get(1)) {
-                    (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),
-                    _ => None,
-                };
-                slit_cylinder::slit_cylinder(&capped.mesh, [a, b])
             } else {
                 holomorphic_map::holomorphic_map(&capped.mesh, genus, faces.len())
             };
@@ -416,7 +461,8 @@ pub fn global_conformal(
             conjugate_residual: map.conjugate_residual,
             harmonic_forms: map.harmonic_forms,
             note,
-            double_cover_genus: is_double.then_some(cover_genus),
+            double_cover_genus: is_double.then_some(slit_cover_genus.unwrap_or(cover_genus)),
+            protrusion_slits: slits,
             local_mesh: capped_mesh,
             local_to_global,
             map,

@@ -608,3 +608,63 @@ fn greedy_homology_basis_is_no_longer_than_the_best_loop_system_and_keeps_charts
         |c: &[[[f64; 2]; 3]]| c.iter().flatten().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&m.corner), bits(&again.corner));
 }
+
+/// A sphere with four long fingers along the tetrahedron's directions (radius
+/// `1 + 4 Σ max(0, d·aᵢ)²⁴`): genus 0, a shape the two-point cylinder squeezes.
+fn four_fingers() -> fieldtex_mesh::TriMesh {
+    let mut mesh = primitives::icosphere(4);
+    let s = 1.0 / 3f64.sqrt();
+    let dirs = [[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]];
+    for p in &mut mesh.positions {
+        let r: f64 =
+            dirs.iter().map(|a| (p[0] * a[0] + p[1] * a[1] + p[2] * a[2]).max(0.0).powi(24)).sum();
+        *p = p.map(|x| x * (1.0 + 4.0 * r));
+    }
+    mesh
+}
+
+#[test]
+fn protrusions_get_slits_and_a_double_cover_that_evens_the_area_scale() {
+    let mesh = four_fingers();
+    let (comps, _) = global_conformal(&mesh, &NoProgress).unwrap();
+    let c = &comps[0];
+    assert_eq!(c.genus, 0);
+    let p = c.protrusion_slits.as_ref().expect("the fingers get slits");
+    assert_eq!(p.tips.len(), 4, "{p:?}");
+    assert_eq!(c.double_cover_genus, Some(3));
+    assert_eq!(c.method, ConformalMethod::CriticalTrajectoryPatches);
+    // The two-point cylinder squeezes two fingers by orders of magnitude.
+    assert!(p.log_area_std < 0.5 * p.cylinder_log_area_std, "{p:?}");
+    assert!(c.corner_uv.iter().flatten().flatten().all(|x| x.is_finite()));
+    let d = distortion(c);
+    assert_eq!(d.flipped, 0);
+    assert!(
+        (d.log_area_std - p.log_area_std).abs() < 1e-9 || d.log_area_std < p.cylinder_log_area_std
+    );
+    // Every tip is a finger's end: far from the centre.
+    for &t in &p.tips {
+        assert!(fieldtex_core::vec3::norm(mesh.positions[t as usize]) > 2.5, "tip {t}");
+    }
+}
+
+#[test]
+fn protrusion_slits_are_the_same_for_one_and_two_threads() {
+    let mesh = four_fingers();
+    let run = |t: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
+        pool.install(|| global_conformal(&mesh, &NoProgress).unwrap().0.remove(0))
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(
+        a.protrusion_slits.as_ref().map(|p| p.tips.clone()),
+        b.protrusion_slits.map(|p| p.tips)
+    );
+    assert!(
+        a.corner_uv
+            .iter()
+            .flatten()
+            .flatten()
+            .zip(b.corner_uv.iter().flatten().flatten())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    );
+}

@@ -70,6 +70,7 @@ pub(super) fn component_json(
         "conjugate_residual": c.conjugate_residual,
         "conjugate_residual_wedge_system": c.map.conjugate_residual_wedge_system,
         "double_cover_genus": c.double_cover_genus,
+        "protrusion_slits": c.protrusion_slits,
         "note": c.note,
     });
     if c.has_uv() {
@@ -145,6 +146,9 @@ pub(super) fn add_notes(
     }
     if comps.iter().any(|c| c.boundaries > 0 && c.double_cover_genus.is_none()) {
         n.push("Open disks and annuli (double cover of genus 0 or 1): holes are capped with fans and the capped closed surface is parameterised (caps dropped afterwards); a disk's boundary and an annulus's two boundaries become the ends of the cylinder, which for an annulus is the map its double cover (a torus) gives.".into());
+    }
+    if comps.iter().any(|c| c.protrusion_slits.is_some()) {
+        n.push("Genus 0 with protrusions (protrusion_slits; our construction, the paper is silent): the two-point slit cylinder shrinks a protrusion that holds neither end by orders of magnitude, so where its area scale falls more than 10⁴ below the median over at least 0.2 % of the surface, each such region's tip (and each cylinder end) whose cap has a rim (the first geodesic circle no longer than 4 × its radius, within 0.3 √area) gets a slit of half the rim's length; with three openings or more (slits and large holes) the double cover of the slit surface is parameterised as for genus ≥ 2 and its first copy kept, with two the cylinder runs between them; kept only when the log-area std over the input's faces is lower than the two-point cylinder's (both reported). A slit is a seam of the layout; its two ends are branch points of the double cover.".into());
     }
     if comps.iter().any(|c| c.method == ConformalMethod::SlitCylinder) {
         n.push("Genus 0 (the paper is silent): two point slits (vertex stars) at extremal vertices; harmonic u = 0/1 on their rings and its conjugate from the annulus's harmonic 1-form give one cylinder image, periodic across one seam.".into());
