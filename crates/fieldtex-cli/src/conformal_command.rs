@@ -26,6 +26,10 @@ pub struct ConformalArgs {
     /// Ablation: one exemplar scale everywhere (paper Fig. 1a/b).
     #[arg(long)]
     no_multiscale: bool,
+    /// Genus 0: always the two-point slit cylinder, without slits at protrusion tips
+    /// (legs, ears) and the double cover that keeps them from shrinking.
+    #[arg(long)]
+    no_protrusion_slits: bool,
     /// Number of exemplar scale levels.
     #[arg(long, default_value_t = 6)]
     levels: usize,
@@ -53,6 +57,7 @@ pub fn run(
         size: args.size,
         quasi_isometric: args.quasi_isometric,
         multiscale: !args.no_multiscale,
+        protrusion_slits: !args.no_protrusion_slits,
         levels: args.levels,
         scale: args.scale,
         patch_size: args.patch_size,

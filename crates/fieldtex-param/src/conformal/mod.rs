@@ -264,11 +264,37 @@ impl ConformalComponent {
     }
 }
 
+/// The slit cylinder's ends on a genus-0 component: the cap centres of its largest hole
+/// and, when at least half as long, its second largest, counting only holes whose
+/// boundary is at least [`LARGE_HOLE`] `√area` long; small holes stay capped and the
+/// slits go to extremal points.
+fn cylinder_ends(caps: &[(u32, f64)], area: f64) -> [Option<usize>; 2] {
+    let mut caps = caps.to_vec();
+    caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+    caps.retain(|c| c.1 >= LARGE_HOLE * area.sqrt());
+    let a = caps.first().map(|c| c.0 as usize);
+    let b = match (caps.first(), caps.get(1)) {
+        (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),
+        _ => None,
+    };
+    [a, b]
+}
+
 /// Parameterises every component of `mesh` (which must be manifold and consistently
 /// oriented; run `fieldtex_mesh::repair` first). Components whose construction fails get
 /// [`ConformalMethod::Failed`] and a warning, never an error.
 pub fn global_conformal(
     mesh: &TriMesh,
+    progress: &dyn Progress,
+) -> Result<(Vec<ConformalComponent>, Vec<Warning>), ParamError> {
+    global_conformal_with(mesh, true, progress)
+}
+
+/// [`global_conformal`] with the genus-0 protrusion slits ([`protrusion_slits`]) on or
+/// off (off: every genus-0 component gets the two-point slit cylinder).
+pub fn global_conformal_with(
+    mesh: &TriMesh,
+    protrusion_slits: bool,
     progress: &dyn Progress,
 ) -> Result<(Vec<ConformalComponent>, Vec<Warning>), ParamError> {
     mesh.validate()?;
@@ -346,15 +372,8 @@ pub fn global_conformal(
         // Genus 0 (small holes capped, at most two large ones left as the cylinder's
         // ends): the slit cylinder, unless protrusion slits spread the area scale less
         // (protrusion_slits.rs).
-        if double.is_none() && manifold && genus == 0 && faces.len() >= 8 {
-            let mut caps = capped.caps.clone();
-            caps.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
-            caps.retain(|c| c.1 >= LARGE_HOLE * sub_area.sqrt());
-            let a = caps.first().map(|c| c.0 as usize);
-            let b = match (caps.first(), caps.get(1)) {
-                (Some(c0), Some(c1)) if c1.1 >= 0.5 * c0.1 => Some(c1.0 as usize),
-                _ => None,
-            };
+        if protrusion_slits && double.is_none() && manifold && genus == 0 && faces.len() >= 8 {
+            let [a, b] = cylinder_ends(&capped.caps, sub_area);
             match genus_zero(&capped.mesh, faces.len(), [a, b]) {
                 Ok(GenusZero::Slits { cut, cover, map }) => {
                     local_to_global.resize(capped.mesh.n_vertices(), u32::MAX);
@@ -400,6 +419,8 @@ pub fn global_conformal(
                 ))
             } else if faces.len() < 8 {
                 Err(cotan_system::conformal_error("fewer than 8 triangles"))
+            } else if genus == 0 {
+                slit_cylinder::slit_cylinder(&capped.mesh, cylinder_ends(&capped.caps, sub_area))
             } else {
                 holomorphic_map::holomorphic_map(&capped.mesh, genus, faces.len())
             };

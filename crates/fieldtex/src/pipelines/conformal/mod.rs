@@ -16,7 +16,7 @@ use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_mesh::TriMesh;
 use fieldtex_param::conformal::{
-    ConformalComponent, GeometryImage, MassSpringOptions, global_conformal,
+    ConformalComponent, GeometryImage, MassSpringOptions, global_conformal_with,
 };
 use serde::Serialize;
 
@@ -46,6 +46,10 @@ pub struct ConformalOptions {
     pub quasi_isometric: bool,
     /// Pick the exemplar level per patch from `τ` (§4.2). Default true.
     pub multiscale: bool,
+    /// Genus 0: slits at protrusion tips and the double cover where the two-point slit
+    /// cylinder squeezes protrusions (`fieldtex_param::conformal::protrusion_slits`).
+    /// Default true.
+    pub protrusion_slits: bool,
     /// Number of exemplar levels. Default 6.
     pub levels: usize,
     /// Exemplar texels per texture texel where `τ` is at its reference (the 5th
@@ -66,6 +70,7 @@ impl Default for ConformalOptions {
             size: 1024,
             quasi_isometric: false,
             multiscale: true,
+            protrusion_slits: true,
             levels: 6,
             scale: 1.0,
             patch_size: 40,
@@ -127,7 +132,9 @@ pub fn conformal(
 
     // 1. Global conformal parameterisation, per component.
     let (mut comps, warnings) = report
-        .stage(progress, "conformal-map", || global_conformal(&mesh, progress))
+        .stage(progress, "conformal-map", || {
+            global_conformal_with(&mesh, options.protrusion_slits, progress)
+        })
         .map_err(|e| Error::classify(&e, None, "conformal map"))?;
     report.warnings.extend(warnings);
     crate::outputs::check_cancelled(progress)?;
