@@ -40,6 +40,16 @@ fn diff(a: [f32; 4], b: [f32; 4]) -> f64 {
 
 /// Seam statistics of `mesh` (with per-corner UVs; `None` without) textured by `tex`.
 pub fn seam_metrics(mesh: &TriMesh, tex: &Image) -> Option<SeamMetrics> {
+    seam_metrics_where(mesh, tex, &|_| true)
+}
+
+/// [`seam_metrics`] over the seam edges `[a, b]` (vertex ids) that `counts` accepts;
+/// the interior jump is over every triangle as before.
+pub fn seam_metrics_where(
+    mesh: &TriMesh,
+    tex: &Image,
+    counts: &dyn Fn([u32; 2]) -> bool,
+) -> Option<SeamMetrics> {
     let uvs = mesh.uvs.as_ref()?;
     let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
     let uv_of = |f: usize, v: u32| -> [f64; 2] {
@@ -70,7 +80,7 @@ pub fn seam_metrics(mesh: &TriMesh, tex: &Image) -> Option<SeamMetrics> {
         let (f0, f1) = (fs[0] as usize, fs[1] as usize);
         let (a0, b0, a1, b1) = (uv_of(f0, a), uv_of(f0, b), uv_of(f1, a), uv_of(f1, b));
         let d = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
-        if d(a0, a1) <= 1e-9 && d(b0, b1) <= 1e-9 {
+        if (d(a0, a1) <= 1e-9 && d(b0, b1) <= 1e-9) || !counts([a, b]) {
             continue;
         }
         n += 1;

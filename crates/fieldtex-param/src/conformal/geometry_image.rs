@@ -77,15 +77,21 @@ impl GeometryImage {
         // Margin: how far corners reach outside the domain, plus filtering slack.
         let mut spill: f64 = 0.0;
         let nf = component.faces.len();
-        let ghost_corners: Vec<(usize, [f64; 2], [[f64; 2]; 3])> = component
+        // Per ghost: face, translation (`None` for a similarity ghost, whose points map
+        // to the face's chart by barycentric coordinates) and corners.
+        type GhostCorners = (usize, Option<[f64; 2]>, [[f64; 2]; 3]);
+        let ghost_corners: Vec<GhostCorners> = component
             .map
             .ghosts
             .iter()
             .filter(|g| (g.face as usize) < nf)
-            .map(|g| {
-                let c = component.corner_uv[g.face as usize]
-                    .map(|p| [p[0] - g.shift[0], p[1] - g.shift[1]]);
-                (g.face as usize, g.shift, c)
+            .map(|g| match g.corners {
+                Some(c) => (g.face as usize, None, c),
+                None => {
+                    let c = component.corner_uv[g.face as usize]
+                        .map(|p| [p[0] - g.shift[0], p[1] - g.shift[1]]);
+                    (g.face as usize, Some(g.shift), c)
+                }
             })
             .collect();
         for cu in component.corner_uv.iter().chain(ghost_corners.iter().map(|g| &g.2)) {
@@ -180,16 +186,20 @@ impl GeometryImage {
             let f = *f;
             let Some(tv) = corner_tau(f) else { continue };
             let t = cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]);
-            let (dx, dy) = (shift[0] * sx, -shift[1] * sy);
             let det = doubled_area(&t);
             if det.abs() <= 0.0 {
                 continue;
             }
+            let real_tri = corner_texel[f];
+            let to_real = |p: [f64; 2]| match shift {
+                Some(s) => [p[0] + s[0] * sx, p[1] - s[1] * sy],
+                None => carry(&t, det, p, &real_tri),
+            };
             for_texels(t, width, height, |i, p| {
                 if !tau[i].is_nan() {
                     return;
                 }
-                let Some(j) = texel_at([p[0] + dx, p[1] + dy], width, height) else { return };
+                let Some(j) = texel_at(to_real(p), width, height) else { return };
                 if !real[j] {
                     return; // rounding landed off the surface: leave it free
                 }
@@ -215,12 +225,20 @@ impl GeometryImage {
         let mut near_of = vec![u32::MAX; width * height];
         for (f, shift, cu) in &ghost_corners {
             let ghost = cu.map(|p| [(p[0] - x0) * sx + m, (y1 - p[1]) * sy + m]);
-            let (dx, dy) = (shift[0] * sx, -shift[1] * sy);
+            let real_tri = corner_texel[*f];
+            let det = doubled_area(&real_tri);
+            if det.abs() <= 0.0 {
+                continue;
+            }
+            let to_ghost = |p: [f64; 2]| match shift {
+                Some(s) => [p[0] - s[0] * sx, p[1] + s[1] * sy],
+                None => carry(&real_tri, det, p, &ghost),
+            };
             for_texels(corner_texel[*f], width, height, |j, p| {
                 if !real[j] || paired[j] {
                     return;
                 }
-                let Some(i) = texel_at([p[0] - dx, p[1] - dy], width, height) else { return };
+                let Some(i) = texel_at(to_ghost(p), width, height) else { return };
                 let centre = [(i % width) as f64 + 0.5, (i / width) as f64 + 0.5];
                 if !real[i] || i == j || contains(&ghost, centre) {
                     return;
@@ -308,17 +326,32 @@ impl GeometryImage {
     }
 }
 
-/// Barycentric interpolation of the corner values `v` of triangle `t` (signed doubled
-/// area `det`) at `p`, with the coordinates clamped to the triangle (texel centres just
-/// outside it take the nearest boundary value).
-fn interpolate(t: &[[f64; 2]; 3], det: f64, p: [f64; 2], v: [f64; 3]) -> f32 {
+/// Barycentric coordinates of `p` for corners 1 and 2 of triangle `t` (signed doubled
+/// area `det`).
+fn barycentric(t: &[[f64; 2]; 3], det: f64, p: [f64; 2]) -> [f64; 2] {
     let l1 =
         ((p[0] - t[0][0]) * (t[2][1] - t[0][1]) - (p[1] - t[0][1]) * (t[2][0] - t[0][0])) / det;
     let l2 =
         ((t[1][0] - t[0][0]) * (p[1] - t[0][1]) - (t[1][1] - t[0][1]) * (p[0] - t[0][0])) / det;
+    [l1, l2]
+}
+
+/// Barycentric interpolation of the corner values `v` of triangle `t` (signed doubled
+/// area `det`) at `p`, with the coordinates clamped to the triangle (texel centres just
+/// outside it take the nearest boundary value).
+fn interpolate(t: &[[f64; 2]; 3], det: f64, p: [f64; 2], v: [f64; 3]) -> f32 {
+    let [l1, l2] = barycentric(t, det, p);
     let (l1, l2) = (l1.clamp(0.0, 1.0), l2.clamp(0.0, 1.0));
     let l0 = (1.0 - l1 - l2).max(0.0);
     ((l0 * v[0] + l1 * v[1] + l2 * v[2]) / (l0 + l1 + l2)) as f32
+}
+
+/// The point of triangle `to` with the barycentric coordinates that `p` has in `from`
+/// (signed doubled area `det`).
+fn carry(from: &[[f64; 2]; 3], det: f64, p: [f64; 2], to: &[[f64; 2]; 3]) -> [f64; 2] {
+    let [l1, l2] = barycentric(from, det, p);
+    let l0 = 1.0 - l1 - l2;
+    [l0 * to[0][0] + l1 * to[1][0] + l2 * to[2][0], l0 * to[0][1] + l1 * to[1][1] + l2 * to[2][1]]
 }
 
 /// Whether `p` lies in triangle `t` (either orientation, boundary included).

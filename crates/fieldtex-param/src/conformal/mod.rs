@@ -382,6 +382,11 @@ pub fn global_conformal_with(
                     }
                     slits = Some(ProtrusionSummary {
                         tips: cut.tips.iter().map(|&t| local_to_global[t as usize]).collect(),
+                        slit_paths: cut
+                            .paths
+                            .iter()
+                            .map(|p| p.iter().map(|&v| local_to_global[v as usize]).collect())
+                            .collect(),
                         log_area_std: map.1,
                         cylinder_log_area_std: map.2,
                     });
@@ -398,6 +403,7 @@ pub fn global_conformal_with(
                                     local_to_global.get(t as usize).copied().unwrap_or(u32::MAX)
                                 })
                                 .collect(),
+                            slit_paths: Vec::new(),
                             log_area_std: std[0],
                             cylinder_log_area_std: std[1],
                         });

@@ -668,3 +668,26 @@ fn protrusion_slits_are_the_same_for_one_and_two_threads() {
             .all(|(x, y)| x.to_bits() == y.to_bits())
     );
 }
+
+#[test]
+fn slit_ghosts_continue_each_chart_across_its_slit() {
+    let (comps, _) = global_conformal(&four_fingers(), &NoProgress).unwrap();
+    let c = &comps[0];
+    let slit: Vec<&Ghost> = c.map.ghosts.iter().filter(|g| g.corners.is_some()).collect();
+    assert!(!slit.is_empty());
+    let len = |p: [f64; 2], q: [f64; 2]| ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt();
+    for g in &slit {
+        // A similarity of the face's own chart: same orientation, same edge ratios.
+        let (gc, rc) = (g.corners.unwrap(), c.map.corner[g.face as usize]);
+        assert!(periodic_uv::signed_area(&gc) * periodic_uv::signed_area(&rc) > 0.0);
+        let s = len(gc[0], gc[1]) / len(rc[0], rc[1]);
+        for (i, j) in [(1, 2), (2, 0)] {
+            assert!((len(gc[i], gc[j]) / len(rc[i], rc[j]) / s - 1.0).abs() < 1e-6, "{g:?}");
+        }
+    }
+    // The geometry image links more margin texels with the slit ghosts than without.
+    let with = GeometryImage::new(c, 256).margin_copies.len();
+    let mut without = c.clone();
+    without.map.ghosts.retain(|g| g.corners.is_none());
+    assert!(with > GeometryImage::new(&without, 256).margin_copies.len() + 10);
+}

@@ -37,13 +37,17 @@ use std::collections::{HashMap, HashSet, VecDeque};
 /// Sweeps of [`shorten_seams`] after merging.
 pub const SEAM_ROUNDS: usize = 8;
 
-/// A face drawn shifted beside another patch: corners `corner[face] − shift` continue
-/// the chart across a seam; a point `p` of the ghost shows the surface point at
-/// `p + shift` in the packed layout.
+/// A face drawn beside another patch to continue its chart across a seam. Across a
+/// cut between translation charts its corners are `corner[face] − shift` and a point
+/// `p` of the ghost shows the surface point at `p + shift` in the packed layout; across
+/// a protrusion slit ([`super::protrusion_slits::slit_ghosts`]) the two charts differ
+/// by a similarity, `corners` gives the ghost's corners and a point of the ghost shows
+/// the point with the same barycentric coordinates in `corner[face]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ghost {
     pub face: u32,
     pub shift: [f64; 2],
+    pub corners: Option<[[f64; 2]; 3]>,
 }
 
 /// Layout parameters of [`translation_patches`].
@@ -295,7 +299,7 @@ pub fn translation_patches(
                     if !seen.insert((g as u32, kx, ky)) {
                         continue;
                     }
-                    ghosts.push(Ghost { face: g as u32, shift });
+                    ghosts.push(Ghost { face: g as u32, shift, corners: None });
                     if depth == rings {
                         continue;
                     }
