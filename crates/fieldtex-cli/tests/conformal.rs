@@ -152,3 +152,35 @@ fn zero_points_of_shared_meshes() {
         }
     }
 }
+
+/// Genus 0 with protrusions (the horse's legs, head and tail): slits at the tips and the
+/// double cover instead of a cylinder that shrinks the legs to points; the ablation flag
+/// gives the two-point cylinder back.
+#[test]
+fn horse_gets_protrusion_slits() {
+    let ex = pebbles();
+    let mesh = shared().join("meshes/horse.ply");
+    let d = tmp("horse");
+    let out = conformal(&mesh, &ex, &d, &["--size", "256", "--quiet"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&d);
+    let c = &r["metrics"]["components"][0];
+    assert_eq!(c["genus"], 0);
+    assert_eq!(c["method"], "critical-trajectory-patches");
+    let p = &c["protrusion_slits"];
+    let tips = p["tips"].as_array().unwrap().len();
+    assert!(tips >= 3, "{p}");
+    assert_eq!(c["double_cover_genus"].as_u64(), Some(tips as u64 - 1));
+    assert_eq!(p["slit_paths"].as_array().unwrap().len(), tips);
+    let (now, cylinder) =
+        (p["log_area_std"].as_f64().unwrap(), p["cylinder_log_area_std"].as_f64());
+    assert!(now < 2.0 && cylinder.is_none_or(|c| now < 0.5 * c), "{p}");
+    assert_eq!(c["distortion"]["flipped"], 0);
+    assert!(c["margin_links"].as_u64().unwrap() > 0);
+    let d2 = tmp("horse-two-point");
+    let out = conformal(&mesh, &ex, &d2, &["--size", "256", "--quiet", "--no-protrusion-slits"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let c2 = &report(&d2)["metrics"]["components"][0];
+    assert_eq!(c2["method"], "slit-cylinder");
+    assert!(c2["protrusion_slits"].is_null());
+}
