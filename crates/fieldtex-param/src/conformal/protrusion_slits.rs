@@ -50,9 +50,9 @@ use serde::Serialize;
 use std::collections::HashMap;
 
 /// A face is compressed when its area scale is below the median's by more than
-/// `e^COMPRESSION` (here 10⁴: a length scale below 1/100, beyond what the multi-scale
-/// quilting's exemplar levels can follow).
-pub const COMPRESSION: f64 = 9.21;
+/// `e^COMPRESSION` (here 144: a length scale below 1/12, the largest enlargement the
+/// multi-scale quilting's exemplar levels offer, so texture there cannot keep its size).
+pub const COMPRESSION: f64 = 4.97;
 /// Smallest compressed region that counts as a protrusion, as a share of the surface.
 pub const MIN_REGION_AREA: f64 = 0.002;
 /// Largest cap rim radius searched, in units of `√area`.
