@@ -57,6 +57,10 @@ use serde::Serialize;
 /// cover; smaller ones are capped.
 pub const LARGE_HOLE: f64 = 0.3;
 
+/// Largest mean angle distortion `σ1/σ2` of a map that is kept (see [`rejection`]); the
+/// shared meshes' maps stay below 1.12.
+pub const MAX_ANGLE_DISTORTION: f64 = 2.0;
+
 /// Vertex rings around slit and zero points flagged as near a singularity.
 pub const NEAR_RINGS: usize = 3;
 
@@ -280,6 +284,32 @@ fn cylinder_ends(caps: &[(u32, f64)], area: f64) -> [Option<usize>; 2] {
     [a, b]
 }
 
+/// Why a component's map is not worth texturing, if it is not: it still folds triangles
+/// after untangling, or its area-weighted mean angle distortion `σ1/σ2` (slit fans left
+/// out) exceeds [`MAX_ANGLE_DISTORTION`] — coarse CAD-like pieces whose long thin
+/// triangles give negative cotan weights. Such a component falls back to the chart
+/// atlas like a failed one.
+fn rejection(mesh: &TriMesh, n_keep: usize, map: &ComponentMap) -> Option<String> {
+    if map.corner.is_empty() {
+        return None;
+    }
+    let slit = |f: usize| map.apex.get(f).is_some_and(|a| a.is_some());
+    let d = mass_spring::map_distortion(mesh, n_keep.min(map.corner.len()), &map.corner, &slit);
+    if d.flipped > 0 {
+        Some(format!(
+            "the discrete conformal map folds {} triangles; the component is textured through the chart atlas instead",
+            d.flipped
+        ))
+    } else if d.angle_mean > MAX_ANGLE_DISTORTION {
+        Some(format!(
+            "the discrete conformal map's mean angle distortion is {:.2} (above {MAX_ANGLE_DISTORTION}); the component is textured through the chart atlas instead",
+            d.angle_mean
+        ))
+    } else {
+        None
+    }
+}
+
 /// Parameterises every component of `mesh` (which must be manifold and consistently
 /// oriented; run `fieldtex_mesh::repair` first). Components whose construction fails get
 /// [`ConformalMethod::Failed`] and a warning, never an error.
@@ -454,7 +484,19 @@ pub fn global_conformal_with(
                         note = Some(note.map_or(text.clone(), |n| format!("{n}; {text}")));
                     }
                 }
-                (m, note)
+                match rejection(&capped_mesh, faces.len(), &m) {
+                    Some(why) => {
+                        warnings.push(Warning::new(
+                            "conformal-map-rejected",
+                            format!(
+                                "component {ci} ({} triangles, genus {genus}): {why}",
+                                faces.len()
+                            ),
+                        ));
+                        (ComponentMap::empty(ConformalMethod::Failed), Some(why))
+                    }
+                    None => (m, note),
+                }
             }
             Err(e) => {
                 warnings.push(Warning::new(

@@ -691,3 +691,20 @@ fn slit_ghosts_continue_each_chart_across_its_slit() {
     without.map.ghosts.retain(|g| g.corners.is_none());
     assert!(with > GeometryImage::new(&without, 256).margin_copies.len() + 10);
 }
+
+#[test]
+fn a_coarse_plank_whose_map_is_garbage_falls_back_to_the_atlas() {
+    // A 30 × 1 × 0.2 box of 48 triangles: long thin triangles, negative cotan weights,
+    // a cylinder map with a mean angle distortion in the hundreds.
+    let mut mesh = primitives::cube(2);
+    for p in &mut mesh.positions {
+        p[0] *= 30.0;
+        p[2] *= 0.2;
+    }
+    let (comps, warnings) = global_conformal(&mesh, &NoProgress).unwrap();
+    let c = &comps[0];
+    assert_eq!(c.method, ConformalMethod::Failed);
+    assert!(!c.has_uv());
+    assert!(c.note.as_deref().is_some_and(|n| n.contains("chart atlas")), "{:?}", c.note);
+    assert!(warnings.iter().any(|w| w.code == "conformal-map-rejected"), "{warnings:?}");
+}
