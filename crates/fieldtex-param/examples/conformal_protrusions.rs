@@ -4,10 +4,14 @@
 //! Repairs each mesh, runs [`global_conformal`], and for every genus-0 component prints
 //! the compressed regions of the two-point slit cylinder (tip vertex, log area scale
 //! below the median), the tips that qualify for a slit (rim length in `√area`, slit
-//! length in vertices) and what `global_conformal` chose, with the log-area std.
+//! length in vertices) and what `global_conformal` chose, with the log-area std; for
+//! genus ≥ 1 components (which the pipeline keeps on the paper's map) what protrusion
+//! slits would give.
 
 use fieldtex_param::conformal::global_conformal;
-use fieldtex_param::conformal::protrusion_slits::{compressed_tips, protrusion_tips};
+use fieldtex_param::conformal::protrusion_slits::{
+    ProtrusionChoice, compressed_tips, protrusion_map, protrusion_tips,
+};
 use fieldtex_param::conformal::slit_cylinder::slit_cylinder;
 use std::time::Instant;
 
@@ -21,6 +25,31 @@ fn main() -> Result<(), String> {
         let (comps, _) =
             global_conformal(&mesh, &fieldtex_core::NoProgress).map_err(|e| e.to_string())?;
         let secs = t.elapsed().as_secs_f64();
+        for c in comps.iter().filter(|c| c.genus >= 1 && c.has_uv()) {
+            let tips = compressed_tips(&c.local_mesh, c.faces.len(), &c.map);
+            println!(
+                "{path}: component {} genus {} {:?}: {} compressed regions {:?}",
+                c.component,
+                c.genus,
+                c.method,
+                tips.len(),
+                tips
+            );
+            // What slits would give (the pipeline keeps genus ≥ 1 on the paper's map).
+            if c.double_cover_genus.is_none() {
+                match protrusion_map(&c.local_mesh, c.faces.len(), c.genus, [None, None]) {
+                    Ok(ProtrusionChoice::Slits { cut, map, .. }) => println!(
+                        "  with slits at {:?}: log-area std {:.3} (plain {:.3}), {} zero points",
+                        cut.tips,
+                        map.1,
+                        map.2,
+                        map.0.zero_points.len()
+                    ),
+                    Ok(_) => println!("  slits would not lower the log-area std"),
+                    Err(e) => println!("  {e}"),
+                }
+            }
+        }
         for c in comps.iter().filter(|c| c.genus == 0) {
             let n = c.faces.len();
             println!("{path}: component {} ({n} faces), {:?}, {secs:.2} s", c.component, c.method);

@@ -45,7 +45,7 @@ pub use geometry_image::GeometryImage;
 pub use mass_spring::{MassSpringOptions, MassSpringStats, Targets};
 pub use periodic_uv::Lattice;
 pub use protrusion_slits::ProtrusionSummary;
-use protrusion_slits::{GenusZero, genus_zero};
+use protrusion_slits::{ProtrusionChoice, protrusion_map};
 pub use translation_patches::Ghost;
 
 use crate::ParamError;
@@ -401,11 +401,12 @@ pub fn global_conformal_with(
         let mut slit_cover_genus = None;
         // Genus 0 (small holes capped, at most two large ones left as the cylinder's
         // ends): the slit cylinder, unless protrusion slits spread the area scale less
-        // (protrusion_slits.rs).
+        // (protrusion_slits.rs). Genus ≥ 1 keeps the paper's holomorphic map: slits there
+        // would add zero points to a torus (measured on the rocker arm: docs/conformal.md).
         if protrusion_slits && double.is_none() && manifold && genus == 0 && faces.len() >= 8 {
             let [a, b] = cylinder_ends(&capped.caps, sub_area);
-            match genus_zero(&capped.mesh, faces.len(), [a, b]) {
-                Ok(GenusZero::Slits { cut, cover, map }) => {
+            match protrusion_map(&capped.mesh, faces.len(), genus, [a, b]) {
+                Ok(ProtrusionChoice::Slits { cut, cover, map }) => {
                     local_to_global.resize(capped.mesh.n_vertices(), u32::MAX);
                     for v in capped.mesh.n_vertices()..cut.mesh.n_vertices() {
                         local_to_global.push(local_to_global[cut.original[v] as usize]);
@@ -420,10 +421,11 @@ pub fn global_conformal_with(
                         log_area_std: map.1,
                         cylinder_log_area_std: map.2,
                     });
-                    slit_cover_genus = Some(cut.tips.len() + a.iter().chain(&b).count() - 1);
+                    slit_cover_genus =
+                        Some(2 * genus + cut.tips.len() + a.iter().chain(&b).count() - 1);
                     double = Some((*cover, map.0));
                 }
-                Ok(GenusZero::Cylinder(m, moved)) => {
+                Ok(ProtrusionChoice::Cylinder(m, moved)) => {
                     if let Some(std) = moved {
                         slits = Some(ProtrusionSummary {
                             tips: m

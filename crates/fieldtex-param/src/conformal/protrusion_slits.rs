@@ -474,10 +474,11 @@ pub fn slit_ghosts(
     ghosts
 }
 
-/// What [`genus_zero`] chose for a closed genus-0 component.
-pub enum GenusZero {
-    /// The slit cylinder; `Some([log-area std, that of the two extremal points'
-    /// cylinder])` when its ends were moved to the only two protrusion tips.
+/// What [`protrusion_map`] chose for a component.
+pub enum ProtrusionChoice {
+    /// The plain map (genus 0: the slit cylinder; `Some([log-area std, that of the two
+    /// extremal points' cylinder])` when its ends were moved to the only two protrusion
+    /// tips).
     Cylinder(Box<ComponentMap>, Option<[f64; 2]>),
     /// Slits at three or more protrusion tips, the double cover of the cut mesh and its
     /// map with the log-area std of its first copy and of the cylinder's.
@@ -503,43 +504,47 @@ fn area_spread(mesh: &TriMesh, n_keep: usize, map: &ComponentMap) -> f64 {
     if d.flipped > 0 { f64::INFINITY } else { d.log_area_std }
 }
 
-/// The map of a genus-0 component, `mesh` its capped surface (first `n_keep` faces the
-/// input's) and `ends` the cap centres of the (at most two) large holes that the slit
-/// cylinder takes as its ends: the slit cylinder, or — when it leaves protrusions
-/// compressed and the alternative spreads the area scale less — the cylinder between
-/// the only two openings (holes and protrusion tips), or the double cover of the surface
-/// with those holes open and slits at the protrusion tips when there are three openings
-/// or more (see the module docs).
-pub fn genus_zero(
+/// The map of a component of genus `genus`, `mesh` its capped surface (first `n_keep`
+/// faces the input's) and `ends` the cap centres of the (at most two, genus 0 only)
+/// large holes that the slit cylinder takes as its ends: the plain map (the slit
+/// cylinder for genus 0, [`holomorphic_map`] otherwise), or — when it leaves protrusions
+/// compressed and the alternative spreads the area scale less — for genus 0 the cylinder
+/// between the only two openings (holes and protrusion tips), or the double cover of the
+/// surface with those holes open and slits at the protrusion tips (genus `2g + openings
+/// − 1`) when that is at least 2 (see the module docs).
+pub fn protrusion_map(
     mesh: &TriMesh,
     n_keep: usize,
+    genus: usize,
     ends: [Option<usize>; 2],
-) -> Result<GenusZero, ParamError> {
-    let cylinder = slit_cylinder(mesh, ends)?;
+) -> Result<ProtrusionChoice, ParamError> {
+    let cylinder =
+        if genus == 0 { slit_cylinder(mesh, ends)? } else { holomorphic_map(mesh, genus, n_keep)? };
     let (tips, paths, rims) = protrusion_tips(mesh, n_keep, &cylinder);
     let holes: Vec<usize> = ends.iter().flatten().copied().collect();
     let openings: Vec<usize> =
         holes.iter().copied().chain(tips.iter().map(|&t| t as usize)).collect();
-    if tips.is_empty() || openings.len() < 2 {
-        return Ok(GenusZero::Cylinder(Box::new(cylinder), None));
+    let cover_genus = (2 * genus + openings.len()).saturating_sub(1);
+    if tips.is_empty() || openings.len() < 2 && genus == 0 {
+        return Ok(ProtrusionChoice::Cylinder(Box::new(cylinder), None));
     }
     let before = area_spread(mesh, n_keep, &cylinder);
-    if openings.len() == 2 {
+    if genus == 0 && openings.len() == 2 {
         let mut same: Vec<usize> = cylinder.slit_vertices.iter().map(|&v| v as usize).collect();
         same.sort_unstable();
         if same == [openings[0].min(openings[1]), openings[0].max(openings[1])] {
-            return Ok(GenusZero::Cylinder(Box::new(cylinder), None));
+            return Ok(ProtrusionChoice::Cylinder(Box::new(cylinder), None));
         }
         return Ok(match slit_cylinder(mesh, [Some(openings[0]), Some(openings[1])]) {
             Ok(moved) => {
                 let after = area_spread(mesh, n_keep, &moved);
                 if after < before {
-                    GenusZero::Cylinder(Box::new(moved), Some([after, before]))
+                    ProtrusionChoice::Cylinder(Box::new(moved), Some([after, before]))
                 } else {
-                    GenusZero::Cylinder(Box::new(cylinder), None)
+                    ProtrusionChoice::Cylinder(Box::new(cylinder), None)
                 }
             }
-            Err(_) => GenusZero::Cylinder(Box::new(cylinder), None),
+            Err(_) => ProtrusionChoice::Cylinder(Box::new(cylinder), None),
         });
     }
     // The large holes open (their caps dropped; every cap face comes after the input's),
@@ -553,10 +558,10 @@ pub fn genus_zero(
             .collect(),
     );
     let Some((cut_mesh, original)) = cut_along_paths(&open, &paths) else {
-        return Ok(GenusZero::Cylinder(Box::new(cylinder), None));
+        return Ok(ProtrusionChoice::Cylinder(Box::new(cylinder), None));
     };
     let cover = double_cover(&cut_mesh);
-    match holomorphic_map(&cover.mesh, openings.len() - 1, n_keep) {
+    match holomorphic_map(&cover.mesh, cover_genus, n_keep) {
         Ok(mut map) => {
             map.ghosts.extend(slit_ghosts(
                 &cover.mesh.triangles,
@@ -569,16 +574,16 @@ pub fn genus_zero(
             let after = area_spread(&cover.mesh, n_keep, &map);
             if after < before {
                 let cut = ProtrusionSlits { mesh: cut_mesh, original, tips, paths, rims };
-                Ok(GenusZero::Slits {
+                Ok(ProtrusionChoice::Slits {
                     cut: Box::new(cut),
                     cover: Box::new(cover),
                     map: Box::new((map, after, before)),
                 })
             } else {
-                Ok(GenusZero::Cylinder(Box::new(cylinder), None))
+                Ok(ProtrusionChoice::Cylinder(Box::new(cylinder), None))
             }
         }
-        Err(_) => Ok(GenusZero::Cylinder(Box::new(cylinder), None)),
+        Err(_) => Ok(ProtrusionChoice::Cylinder(Box::new(cylinder), None)),
     }
 }
 
