@@ -184,3 +184,26 @@ fn horse_gets_protrusion_slits() {
     assert_eq!(c2["method"], "slit-cylinder");
     assert!(c2["protrusion_slits"].is_null());
 }
+
+/// `--quasi-isometric` on a patch layout (fertility, genus 4): relaxed chart by chart,
+/// no flips, area distortion lower, angle distortion within the bound.
+#[test]
+fn quasi_isometric_relaxes_a_patch_layout() {
+    let mesh = shared().join("meshes/fertility.obj");
+    let d = tmp("fertility-quasi");
+    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet", "--quasi-isometric"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&d);
+    let s = &r["metrics"]["mass_spring"][0]["stats"];
+    let (before, after) = (&s["before"], &s["after"]);
+    assert_eq!(after["flipped"], 0, "{s}");
+    assert!(
+        after["log_area_std"].as_f64().unwrap() < 0.8 * before["log_area_std"].as_f64().unwrap(),
+        "{s}"
+    );
+    assert!(after["angle_mean"].as_f64().unwrap() <= 1.3 + 1e-9, "{s}");
+    let c = &r["metrics"]["components"][0];
+    assert_eq!(c["method"], "critical-trajectory-patches");
+    assert_eq!(c["distortion"]["flipped"], 0);
+    assert!(c["margin_links"].as_u64().unwrap() > 0);
+}

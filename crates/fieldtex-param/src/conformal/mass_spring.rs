@@ -45,7 +45,7 @@ use super::periodic_uv::{reduce_faces, signed_area};
 use super::rigid_triangles::RigidTriangles;
 use crate::distortion::triangle_jacobian;
 use fieldtex_core::vec3;
-use fieldtex_mesh::{Topology, TriMesh};
+use fieldtex_mesh::{Topology, TriMesh, UnionFind};
 use serde::Serialize;
 
 /// Options of [`relax`].
@@ -307,10 +307,21 @@ fn relax_with(
     } else {
         None
     };
-    let gauge = (0..nv).find(|&v| has_spring[v] && !phi[v][0].is_nan());
+    // One gauge vertex per connected piece of the spring graph (a patch layout has one
+    // piece per chart): its first vertex with a spring.
+    let mut pieces = UnionFind::new(nv);
+    for (e, ed) in sub.edges.iter().enumerate() {
+        if weights[e] != 0.0 {
+            pieces.union(ed[0] as usize, ed[1] as usize);
+        }
+    }
+    let mut gauged = vec![false; nv];
     let fixed: Vec<Option<f64>> = (0..nv)
         .map(|v| {
-            if !has_spring[v] || Some(v) == gauge || phi[v][0].is_nan() { Some(0.0) } else { None }
+            let gauge = has_spring[v]
+                && !phi[v][0].is_nan()
+                && !std::mem::replace(&mut gauged[pieces.find(v)], true);
+            if !has_spring[v] || gauge || phi[v][0].is_nan() { Some(0.0) } else { None }
         })
         .collect();
     let Ok(mut lap) = FixedLaplacian::new(&sub, &weights, &fixed) else {

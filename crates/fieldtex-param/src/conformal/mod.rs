@@ -31,10 +31,12 @@ pub mod holomorphic_map;
 pub mod homology_loops;
 pub mod mass_spring;
 pub mod patch_merging;
+pub mod patch_relaxation;
 pub mod periodic_uv;
 pub mod protrusion_slits;
 mod rigid_triangles;
 pub mod seam_placement;
+pub mod similarity_ghosts;
 pub mod slit_cylinder;
 pub mod translation_patches;
 pub mod tree_cotree;
@@ -258,11 +260,21 @@ impl ConformalComponent {
         &mut self,
         options: &MassSpringOptions,
     ) -> Option<MassSpringStats> {
-        if !self.has_uv() || self.method == ConformalMethod::CriticalTrajectoryPatches {
+        if !self.has_uv() {
             return None;
         }
         let n_orig = self.faces.len();
-        let stats = mass_spring::relax(&self.local_mesh, n_orig, &mut self.map, options);
+        let stats = if self.method == ConformalMethod::CriticalTrajectoryPatches {
+            patch_relaxation::relax_patches(
+                &self.local_mesh,
+                n_orig,
+                &mut self.map,
+                &self.local_to_global,
+                options,
+            )
+        } else {
+            mass_spring::relax(&self.local_mesh, n_orig, &mut self.map, options)
+        };
         self.refresh();
         Some(stats)
     }

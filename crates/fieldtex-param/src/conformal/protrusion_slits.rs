@@ -40,6 +40,7 @@ use super::holomorphic_map::{GHOST_RINGS, holomorphic_map};
 use super::homology_loops::{edge_lengths, shortest_path_tree};
 use super::mass_spring::map_distortion;
 use super::periodic_uv::signed_area;
+use super::similarity_ghosts::similarity_ghosts;
 use super::slit_cylinder::slit_cylinder;
 use super::translation_patches::Ghost;
 use super::tree_cotree::vertex_edges;
@@ -47,7 +48,7 @@ use crate::ParamError;
 use fieldtex_core::vec3;
 use fieldtex_mesh::{Topology, TriMesh, UnionFind};
 use serde::Serialize;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// A face is compressed when its area scale is below the median's by more than
 /// `e^COMPRESSION` (here 144: a length scale below 1/12, the largest enlargement the
@@ -375,17 +376,12 @@ pub fn protrusion_tips(
     (tips, paths, rims)
 }
 
-/// Ghost faces across the slits, for the geometry image's margins (Wang et al. 2005
-/// §4.2, extended to our slits): in the double cover each side of a slit continues into
-/// the second copy, which gets no texture, so without them the two sides would be
-/// synthesised independently. For every slit edge and each of its two faces (`near`),
-/// the face on the other side (`far`) and its neighbours up to `rings` steps (not
-/// across a UV seam) are drawn in `near`'s chart by the similarity that maps the shared
-/// edge of `far`'s chart onto `near`'s (`z ↦ a_n + (z − a_f)(b_n − a_n)/(b_f − a_f)`
-/// in complex numbers; both charts are conformal, so the similarity continues one into
-/// the other to first order). `triangles` and `corner` are the cut mesh's first
-/// `n_keep` faces and their packed UVs, `original` maps cut-mesh vertices to the input
-/// vertices the `paths` name.
+/// Ghost faces across the slits, for the geometry image's margins: in the double cover
+/// each side of a slit continues into the second copy, which gets no texture, and the
+/// two sides' charts differ by a similarity, so without them the two sides would be
+/// synthesised independently ([`similarity_ghosts`] over the slit edges). `triangles`
+/// and `corner` are the cut mesh's first `n_keep` faces and their packed UVs,
+/// `original` maps cut-mesh vertices to the input vertices the `paths` name.
 pub fn slit_ghosts(
     triangles: &[[u32; 3]],
     original: &[u32],
@@ -394,84 +390,9 @@ pub fn slit_ghosts(
     n_keep: usize,
     rings: usize,
 ) -> Vec<Ghost> {
-    let n = n_keep.min(triangles.len()).min(corner.len());
-    let slit: std::collections::HashSet<(u32, u32)> =
+    let slit: HashSet<(u32, u32)> =
         paths.iter().flat_map(|p| p.windows(2).map(|w| (w[0].min(w[1]), w[0].max(w[1])))).collect();
-    let mut sides: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (f, t) in triangles[..n].iter().enumerate() {
-        let o = t.map(|v| original[v as usize]);
-        for k in 0..3 {
-            let key = (o[k].min(o[(k + 1) % 3]), o[k].max(o[(k + 1) % 3]));
-            if slit.contains(&key) {
-                sides.entry(key).or_default().push(f);
-            }
-        }
-    }
-    let uv_at = |f: usize, v: u32| {
-        (0..3).find(|&k| original[triangles[f][k] as usize] == v).map(|k| corner[f][k])
-    };
-    let topo = Topology::build(original.len(), &triangles[..n]);
-    let same_uv = |f: usize, g: usize, e: usize| {
-        topo.edges[e].iter().all(|&v| {
-            let (a, b) = (
-                (0..3).find(|&k| triangles[f][k] == v).map(|k| corner[f][k]),
-                (0..3).find(|&k| triangles[g][k] == v).map(|k| corner[g][k]),
-            );
-            matches!((a, b), (Some(a), Some(b)) if (a[0] - b[0]).abs() + (a[1] - b[1]).abs() <= 1e-9)
-        })
-    };
-    let mut keys: Vec<&(u32, u32)> = sides.keys().collect();
-    keys.sort_unstable();
-    let mut ghosts = Vec::new();
-    for key in keys {
-        let faces = &sides[key];
-        let [f1, f2] = faces[..] else { continue };
-        for (near, far) in [(f1, f2), (f2, f1)] {
-            let (Some(an), Some(bn), Some(af), Some(bf)) =
-                (uv_at(near, key.0), uv_at(near, key.1), uv_at(far, key.0), uv_at(far, key.1))
-            else {
-                continue;
-            };
-            // Complex ratio (b_n − a_n) / (b_f − a_f).
-            let (dn, df) = ([bn[0] - an[0], bn[1] - an[1]], [bf[0] - af[0], bf[1] - af[1]]);
-            let den = df[0] * df[0] + df[1] * df[1];
-            if den.is_nan() || den <= 0.0 {
-                continue;
-            }
-            let r = [(dn[0] * df[0] + dn[1] * df[1]) / den, (dn[1] * df[0] - dn[0] * df[1]) / den];
-            let map = |z: [f64; 2]| {
-                let d = [z[0] - af[0], z[1] - af[1]];
-                [an[0] + d[0] * r[0] - d[1] * r[1], an[1] + d[0] * r[1] + d[1] * r[0]]
-            };
-            let mut seen = vec![far];
-            let mut frontier = vec![far];
-            for depth in 0..=rings {
-                let mut next = Vec::new();
-                for &g in &frontier {
-                    ghosts.push(Ghost {
-                        face: g as u32,
-                        shift: [0.0; 2],
-                        corners: Some(corner[g].map(map)),
-                    });
-                    if depth == rings {
-                        continue;
-                    }
-                    for &e in &topo.face_edges[g] {
-                        let e = e as usize;
-                        if let Some(&h) = topo.edge_faces(e).iter().find(|&&h| h as usize != g) {
-                            let h = h as usize;
-                            if h != near && !seen.contains(&h) && same_uv(g, h, e) {
-                                seen.push(h);
-                                next.push(h);
-                            }
-                        }
-                    }
-                }
-                frontier = next;
-            }
-        }
-    }
-    ghosts
+    similarity_ghosts(triangles, original, corner, n_keep, rings, Some(&slit))
 }
 
 /// What [`protrusion_map`] chose for a component.

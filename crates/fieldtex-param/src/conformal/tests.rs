@@ -708,3 +708,44 @@ fn a_coarse_plank_whose_map_is_garbage_falls_back_to_the_atlas() {
     assert!(c.note.as_deref().is_some_and(|n| n.contains("chart atlas")), "{:?}", c.note);
     assert!(warnings.iter().any(|w| w.code == "conformal-map-rejected"), "{warnings:?}");
 }
+
+#[test]
+fn patch_layouts_relax_chart_by_chart_without_flips() {
+    for mesh in [four_fingers(), genus_two_slab(4)] {
+        let (mut comps, _) = global_conformal(&mesh, &NoProgress).unwrap();
+        let c = &mut comps[0];
+        assert_eq!(c.method, ConformalMethod::CriticalTrajectoryPatches);
+        let opts = MassSpringOptions::default();
+        let st = c.relax_quasi_isometric(&opts).expect("patch layouts relax");
+        assert_eq!((st.after.flipped, distortion(c).flipped), (0, 0), "{st:?}");
+        assert!(st.after.log_area_std < 0.9 * st.before.log_area_std, "{st:?}");
+        assert!(st.after.angle_mean <= opts.max_angle_distortion + 1e-9, "{st:?}");
+        // Every seam's margin is drawn by similarity now, and the image links it.
+        assert!(!c.map.ghosts.is_empty() && c.map.ghosts.iter().all(|g| g.corners.is_some()));
+        assert!(!GeometryImage::new(c, 256).margin_copies.is_empty());
+        // Repacked charts do not overlap: no two faces of different charts share area.
+        let n = c.faces.len();
+        let mut boxes: Vec<(u32, [f64; 4])> = Vec::new();
+        for f in 0..n {
+            let cu = c.map.corner[f];
+            let b = cu.iter().fold(
+                [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY],
+                |b, p| [b[0].min(p[0]), b[1].min(p[1]), b[2].max(p[0]), b[3].max(p[1])],
+            );
+            boxes.push((c.map.patch[f], b));
+        }
+        let mut chart_box: std::collections::BTreeMap<u32, [f64; 4]> = Default::default();
+        for (p, b) in boxes {
+            let e = chart_box.entry(p).or_insert(b);
+            *e = [e[0].min(b[0]), e[1].min(b[1]), e[2].max(b[2]), e[3].max(b[3])];
+        }
+        let v: Vec<[f64; 4]> = chart_box.into_values().collect();
+        for i in 0..v.len() {
+            for j in i + 1..v.len() {
+                let (a, b) = (v[i], v[j]);
+                let apart = a[2] <= b[0] || b[2] <= a[0] || a[3] <= b[1] || b[3] <= a[1];
+                assert!(apart, "charts {i} and {j} overlap: {a:?} {b:?}");
+            }
+        }
+    }
+}

@@ -215,46 +215,10 @@ pub fn translation_patches(
     }
     let n_patches = renumber.len();
     // Shelf packing, tallest first.
-    let gap = (2.0 * rings as f64 + 1.0) * mean_len;
-    let mut bbox =
-        vec![[f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY]; n_patches];
+    shelf_pack(&mut corner, &patch, keep, n_patches, (2.0 * rings as f64 + 1.0) * mean_len);
     let mut count = vec![0usize; n_patches];
     for f in (0..nf).filter(|&f| keep[f]) {
-        let b = &mut bbox[patch[f] as usize];
         count[patch[f] as usize] += 1;
-        for p in &corner[f] {
-            b[0] = b[0].min(p[0]);
-            b[1] = b[1].min(p[1]);
-            b[2] = b[2].max(p[0]);
-            b[3] = b[3].max(p[1]);
-        }
-    }
-    let area: f64 = bbox.iter().map(|b| (b[2] - b[0] + gap) * (b[3] - b[1] + gap)).sum();
-    let widest = bbox.iter().map(|b| b[2] - b[0] + gap).fold(0.0, f64::max);
-    let row_width = (1.2 * area.sqrt()).max(widest);
-    let mut order: Vec<usize> = (0..n_patches).collect();
-    order.sort_by(|&i, &j| {
-        (bbox[j][3] - bbox[j][1]).total_cmp(&(bbox[i][3] - bbox[i][1])).then(i.cmp(&j))
-    });
-    let mut offset = vec![[0.0; 2]; n_patches];
-    let (mut x, mut y, mut row_h) = (0.0, 0.0, 0.0f64);
-    for &i in &order {
-        let (w, h) = (bbox[i][2] - bbox[i][0] + gap, bbox[i][3] - bbox[i][1] + gap);
-        if x > 0.0 && x + w > row_width {
-            x = 0.0;
-            y += row_h;
-            row_h = 0.0;
-        }
-        offset[i] = [x - bbox[i][0], y - bbox[i][1]];
-        x += w;
-        row_h = row_h.max(h);
-    }
-    for f in (0..nf).filter(|&f| keep[f]) {
-        let o = offset[patch[f] as usize];
-        for p in corner[f].iter_mut() {
-            p[0] += o[0];
-            p[1] += o[1];
-        }
     }
     // Seams: edges whose faces disagree on a shared corner.
     let uv_of = |f: usize, v: u32| corner[f][(0..3).find(|&j| triangles[f][j] == v).unwrap_or(0)];
@@ -322,6 +286,57 @@ pub fn translation_patches(
     let n_kept = keep.iter().filter(|k| **k).count();
     let small_patches = count.iter().filter(|&&c| (c as f64) < 0.01 * n_kept as f64).count();
     PatchLayout { corner, patch, n_patches, small_patches, folded, merges, seam_edges, ghosts }
+}
+
+/// Shelf packing without rotation, tallest chart first: moves the corners of every kept
+/// face by its chart's offset so that the `n_patches` charts' bounding boxes, `gap`
+/// apart, fill rows about `1.2 √(total box area)` wide.
+pub(super) fn shelf_pack(
+    corner: &mut [[[f64; 2]; 3]],
+    patch: &[u32],
+    keep: &[bool],
+    n_patches: usize,
+    gap: f64,
+) {
+    let nf = corner.len();
+    let mut bbox =
+        vec![[f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY]; n_patches];
+    for f in (0..nf).filter(|&f| keep[f]) {
+        let b = &mut bbox[patch[f] as usize];
+        for p in &corner[f] {
+            b[0] = b[0].min(p[0]);
+            b[1] = b[1].min(p[1]);
+            b[2] = b[2].max(p[0]);
+            b[3] = b[3].max(p[1]);
+        }
+    }
+    let area: f64 = bbox.iter().map(|b| (b[2] - b[0] + gap) * (b[3] - b[1] + gap)).sum();
+    let widest = bbox.iter().map(|b| b[2] - b[0] + gap).fold(0.0, f64::max);
+    let row_width = (1.2 * area.sqrt()).max(widest);
+    let mut order: Vec<usize> = (0..n_patches).collect();
+    order.sort_by(|&i, &j| {
+        (bbox[j][3] - bbox[j][1]).total_cmp(&(bbox[i][3] - bbox[i][1])).then(i.cmp(&j))
+    });
+    let mut offset = vec![[0.0; 2]; n_patches];
+    let (mut x, mut y, mut row_h) = (0.0, 0.0, 0.0f64);
+    for &i in &order {
+        let (w, h) = (bbox[i][2] - bbox[i][0] + gap, bbox[i][3] - bbox[i][1] + gap);
+        if x > 0.0 && x + w > row_width {
+            x = 0.0;
+            y += row_h;
+            row_h = 0.0;
+        }
+        offset[i] = [x - bbox[i][0], y - bbox[i][1]];
+        x += w;
+        row_h = row_h.max(h);
+    }
+    for f in (0..nf).filter(|&f| keep[f]) {
+        let o = offset[patch[f] as usize];
+        for p in corner[f].iter_mut() {
+            p[0] += o[0];
+            p[1] += o[1];
+        }
+    }
 }
 
 pub(super) fn insert(

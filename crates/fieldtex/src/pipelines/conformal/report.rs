@@ -160,7 +160,7 @@ pub(super) fn add_notes(
         }
         n.push("The genus ≥ 2 holomorphic form minimises the area-weighted CV of |φ|² over all holomorphic forms by a compass search from the best basis form — a substitute for Jin et al. 2004's own solver (both CVs reported).".into());
         if options.quasi_isometric {
-            n.push("Mass-spring relaxation is not applied to genus ≥ 2 patch layouts (it would break the translation links across cuts).".into());
+            n.push("Quasi-isometric relaxation of a patch layout (our extension): every chart gets its own copies of its vertices and the relaxation below runs on all charts at once with free chart boundaries (one gauge vertex per chart); the charts are then repacked, and since they no longer differ by translations across their seams, every seam's margin is drawn by similarity ghosts (the far face placed by the similarity that maps the shared edge).".into());
         }
     }
     if comps.iter().any(|c| !c.has_uv()) {
