@@ -492,6 +492,12 @@ pub fn protrusion_map(
                 n_keep,
                 GHOST_RINGS,
             ));
+            // The slits' vertices, both sides: the "away from slits" statistics skip
+            // their neighbourhoods as they skip the point slits of a cylinder.
+            let on_path: HashSet<u32> = paths.iter().flatten().copied().collect();
+            map.slit_vertices = (0..original.len() as u32)
+                .filter(|&v| on_path.contains(&original[v as usize]))
+                .collect();
             let after = area_spread(&cover.mesh, n_keep, &map);
             if after < before {
                 let cut = ProtrusionSlits { mesh: cut_mesh, original, tips, paths, rims };
