@@ -9,7 +9,7 @@
 //! `cargo run --release -p fieldtex --example solid_slice_probe -- BOX.obj SKETCH.json
 //! EXEMPLAR.png RES OUTDIR SEEDS [key=value …]` with SEEDS like `1,2,3` and keys
 //! `passes`, `level_passes` (`2/4/4/4/4`), `integrate`, `trilinear`,
-//! `projected` (0/1), `subpart` (K), `constant=1` (no sketch).
+//! `projected` (0/1), `subpart` (K), `integrated` (0/1), `constant=1` (no sketch).
 
 use fieldtex::{SolidOptions, SolidSession};
 use fieldtex_core::NoProgress;
@@ -41,6 +41,7 @@ fn main() {
             "constant" => opts.sketch = None,
             "projected" => s.projected_predictions = v == "1",
             "subpart" => s.subpart = v.parse().unwrap(),
+            "integrated" => s.integrated_init = v == "1",
             _ => panic!("unknown key {k}"),
         }
     }

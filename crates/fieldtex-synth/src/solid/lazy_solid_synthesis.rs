@@ -58,6 +58,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 mod block_regions;
+use super::integrated_init::IntegratedInit;
 mod voxel_correction;
 use block_regions::{BlockCursor, for_box, local_index, region_of};
 
@@ -96,6 +97,10 @@ pub struct SolidSynthesisOptions {
     /// bits): on the bent stripes box (docs/solid.md, session 13) it was neutral within
     /// the seed-to-seed spread, so it stays opt-in.
     pub projected_predictions: bool,
+    /// Initial slab coordinates integrated from the frame field over the grid's coarsest
+    /// voxels ([`super::integrated_init`]) instead of one pivot per subpart; takes effect
+    /// once the grid is known ([`SolidSynthesizer::with_extent`]). Default false.
+    pub integrated_init: bool,
     pub seed: u64,
 }
 
@@ -112,6 +117,7 @@ impl Default for SolidSynthesisOptions {
             trilinear_levels: 3,
             integrate_levels: 2,
             projected_predictions: false,
+            integrated_init: false,
             seed: 1,
         }
     }
@@ -154,6 +160,8 @@ pub struct SolidSynthesizer<'a> {
     /// `pca_dims`), so that the correction's projection runs over all dimensions at
     /// once while each dimension still sums its products in the basis's order.
     bases: Vec<[Vec<f32>; 3]>,
+    /// Integrated initial coordinates ([`SolidSynthesisOptions::integrated_init`]).
+    init: Option<IntegratedInit>,
 }
 
 /// The computed blocks of a [`SolidSynthesizer`], detached from its borrows
@@ -234,7 +242,21 @@ impl<'a> SolidSynthesizer<'a> {
             cache: (0..levels).map(|_| LevelCache::default()).collect(),
             heads,
             bases,
+            init: None,
         })
+    }
+
+    /// This synthesizer over the finest grid `[0, extent)` (voxel counts per axis): with
+    /// [`SolidSynthesisOptions::integrated_init`] the initial coordinates are then
+    /// integrated from the frames over the grid's coarsest voxels (voxels outside it
+    /// keep the subpart pivots). Without the option it changes nothing. Call it before
+    /// any request and give every synthesizer that shares a cache the same extent.
+    pub fn with_extent(mut self, extent: [usize; 3]) -> Self {
+        if self.options.integrated_init {
+            let c = self.cache.len().saturating_sub(1);
+            self.init = Some(IntegratedInit::new(&self.lattice, self.frames, c, extent));
+        }
+        self
     }
 
     /// The cached blocks, for [`Self::with_cache`] on a later synthesizer.
@@ -443,9 +465,12 @@ impl<'a> SolidSynthesizer<'a> {
         let rm = self.frames.frame(self.lattice.centre(c, v));
         let d: [f64; 3] = std::array::from_fn(|a| v[a] as f64 - o[a]);
         // Local coordinates Rᵀ d.
-        let w: [i32; 3] = std::array::from_fn(|col| {
-            round_f64_i32(rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2])
-        });
+        let w: [i32; 3] = match self.init.as_ref().and_then(|u| u.get(v)) {
+            Some(u) => u.map(round_f64_i32),
+            None => std::array::from_fn(|col| {
+                round_f64_i32(rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2])
+            }),
+        };
         let layer = floor_div(w[2], n);
         let t = w[2] - layer * n - n / 2;
         let key = fieldtex_core::rng::mix64(

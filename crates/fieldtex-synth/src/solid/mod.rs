@@ -29,6 +29,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod candidate_triples;
+mod integrated_init;
 pub mod lazy_solid_synthesis;
 pub mod solid_exemplar;
 pub mod voxel_lattice;

@@ -363,3 +363,30 @@ fn feature_masks_are_all_or_none_and_exemplar_sized() {
     );
     assert!(matches!(wrong, Err(crate::SynthError::FeatureMaskSize { plane: "xy", .. })));
 }
+
+/// The integrated initialisation (opt-in) changes the triples of a bent field and keeps
+/// the on-demand equality: a few voxels alone equal the same voxels of the full volume
+/// (all voxels here lie at negative and positive lattice indices, inside and outside
+/// the grid the coordinates were integrated over).
+#[test]
+fn integrated_initialisation_keeps_the_on_demand_equality() {
+    let img = exemplar();
+    let (ao, so) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let voxels = all_voxels(10);
+    let run = |integrated_init: bool, voxels: &[[i32; 3]]| {
+        let o = SolidSynthesisOptions { integrated_init, ..so.clone() };
+        SolidSynthesizer::new(&ex, lattice, &Bent, o)
+            .unwrap()
+            .with_extent([12, 12, 12])
+            .triples(voxels, &NoProgress)
+            .0
+    };
+    let plain = run(false, &voxels);
+    let integrated = run(true, &voxels);
+    assert_ne!(plain, integrated, "the integrated initialisation changed nothing");
+    for i in [0, 137, 512, voxels.len() - 1] {
+        assert_eq!(run(true, &voxels[i..i + 1])[0], integrated[i], "voxel {:?}", voxels[i]);
+    }
+}

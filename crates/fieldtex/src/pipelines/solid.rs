@@ -244,7 +244,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let frames = FieldFrames(field.as_ref());
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
     let synth = SolidSynthesizer::new(&ex, lattice, &frames, options.synthesis.clone())
-        .map_err(|e| Error::classify(&e, None, "synthesis options"))?;
+        .map_err(|e| Error::classify(&e, None, "synthesis options"))?
+        .with_extent(grid.sizes);
     let bvh = Bvh::build(&mesh).map_err(|e| Error::internal("bvh", e))?;
     // The interior region (paper E Fig. 15): its own analysis, same lattice and field.
     let ex_inner = match &options.interior {
@@ -260,7 +261,8 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     let inner = match &ex_inner {
         Some(e) => Some(Interior {
             synth: SolidSynthesizer::new(e, lattice, &frames, options.synthesis.clone())
-                .map_err(|e| Error::classify(&e, None, "synthesis options"))?,
+                .map_err(|e| Error::classify(&e, None, "synthesis options"))?
+                .with_extent(grid.sizes),
             bvh: &bvh,
             depth,
             band,

@@ -289,7 +289,8 @@ fn synthesizer<'a>(
 ) -> Result<SolidSynthesizer<'a>> {
     let lattice = VoxelLattice { origin: grid.origin, spacing: grid.spacing };
     let s = SolidSynthesizer::new(exemplar, lattice, frames, options.clone())
-        .map_err(|e| Error::classify(&e, None, "synthesis options"))?;
+        .map_err(|e| Error::classify(&e, None, "synthesis options"))?
+        .with_extent(grid.sizes);
     Ok(match cache {
         Some(c) => s.with_cache(c),
         None => s,

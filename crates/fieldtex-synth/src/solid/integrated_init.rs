@@ -1,0 +1,170 @@
+//! Initial slab coordinates integrated from the frame field over the coarsest level — an
+//! option of [`super::lazy_solid_synthesis`]'s initialisation (our variant of paper E
+//! §4.1, off by default).
+//!
+//! The paper warps the candidate slabs by the field in subparts: voxel `v` reads the
+//! slab at `Rᵥᵀ (v − o)` with `o` its subpart's centre. Where the frame turns, two
+//! neighbours whose frames differ by `Δθ` read points about `|v − o| Δθ` apart, so far
+//! from the pivot the initial coordinates of a bent field are close to random (the
+//! phase dislocations of the bent stripes, docs/solid.md). Here the coordinates are
+//! instead the least-squares integral of the frame over the coarsest voxels of the
+//! grid: `U` minimises `Σ |U(v + e_a) − U(v) − ½ (Rᵥᵀ + R_{v+e_a}ᵀ) e_a|²` over the
+//! 6-neighbour edges (three independent Poisson problems with one graph Laplacian,
+//! conjugate gradients from zero: the system is singular but consistent, and the
+//! iterates stay orthogonal to the constants, so the mean of `U` is zero). Where the field's
+//! axis is a gradient (the stripe normal of concentric rings is the radius) `U` follows
+//! it exactly; elsewhere the misfit is spread smoothly instead of growing with the
+//! distance from a pivot. Sequential and deterministic; a few thousand unknowns.
+
+use super::voxel_lattice::{FrameSource, VoxelLattice};
+
+/// `U` over a box of coarsest-level voxels (see the module docs).
+pub(crate) struct IntegratedInit {
+    lo: [i32; 3],
+    dims: [usize; 3],
+    u: Vec<[f64; 3]>,
+}
+
+/// Voxels added around the grid on every side (blocks read a halo beyond it).
+const PAD: i32 = 3;
+
+impl IntegratedInit {
+    /// `U` on level `c` of `lattice` over the coarsest voxels covering the finest grid
+    /// `[0, extent)` plus a margin.
+    pub(crate) fn new(
+        lattice: &VoxelLattice,
+        frames: &dyn FrameSource,
+        c: usize,
+        extent: [usize; 3],
+    ) -> Self {
+        let lo = [-PAD; 3];
+        let dims: [usize; 3] =
+            std::array::from_fn(|a| (extent[a].div_ceil(1usize << c)) + 2 * PAD as usize);
+        let n = dims[0] * dims[1] * dims[2];
+        let idx = |i: [usize; 3]| (i[2] * dims[1] + i[1]) * dims[0] + i[0];
+        let voxel = |i: [usize; 3]| -> [i32; 3] { std::array::from_fn(|a| lo[a] + i[a] as i32) };
+        let mut rt: Vec<[f64; 9]> = Vec::with_capacity(n);
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    rt.push(frames.frame(lattice.centre(c, voxel([i, j, k]))));
+                }
+            }
+        }
+        // Rᵀ e_a: row a of R (rows of the row-major matrix).
+        let axis = |r: &[f64; 9], a: usize| [r[3 * a], r[3 * a + 1], r[3 * a + 2]];
+        let mut b = vec![[0.0f64; 3]; n];
+        let mut degree = vec![0.0f64; n];
+        let mut edges: Vec<(usize, usize)> = Vec::with_capacity(3 * n);
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let p = idx([i, j, k]);
+                    for a in 0..3 {
+                        let mut q3 = [i, j, k];
+                        q3[a] += 1;
+                        if q3[a] >= dims[a] {
+                            continue;
+                        }
+                        let q = idx(q3);
+                        let (gp, gq) = (axis(&rt[p], a), axis(&rt[q], a));
+                        for d in 0..3 {
+                            let g = 0.5 * (gp[d] + gq[d]);
+                            b[q][d] += g;
+                            b[p][d] -= g;
+                        }
+                        degree[p] += 1.0;
+                        degree[q] += 1.0;
+                        edges.push((p, q));
+                    }
+                }
+            }
+        }
+        let apply = |x: &[f64], y: &mut [f64]| {
+            for (i, yi) in y.iter_mut().enumerate() {
+                *yi = degree[i] * x[i];
+            }
+            for &(p, q) in &edges {
+                y[p] -= x[q];
+                y[q] -= x[p];
+            }
+        };
+        let mut u = vec![[0.0f64; 3]; n];
+        for d in 0..3 {
+            let rhs: Vec<f64> = b.iter().map(|v| v[d]).collect();
+            let x = conjugate_gradients(&apply, &rhs, 4000, 1e-10);
+            for (ui, xi) in u.iter_mut().zip(x) {
+                ui[d] = xi;
+            }
+        }
+        Self { lo, dims, u }
+    }
+
+    /// `U(v)`, or `None` outside the box.
+    pub(crate) fn get(&self, v: [i32; 3]) -> Option<[f64; 3]> {
+        let mut i = [0usize; 3];
+        for a in 0..3 {
+            let o = v[a] - self.lo[a];
+            if o < 0 || o as usize >= self.dims[a] {
+                return None;
+            }
+            i[a] = o as usize;
+        }
+        Some(self.u[(i[2] * self.dims[1] + i[1]) * self.dims[0] + i[0]])
+    }
+}
+
+/// Conjugate gradients for the symmetric positive definite operator `apply` (sequential,
+/// so the result does not depend on the thread count).
+fn conjugate_gradients(
+    apply: &dyn Fn(&[f64], &mut [f64]),
+    rhs: &[f64],
+    max_iterations: usize,
+    tolerance: f64,
+) -> Vec<f64> {
+    let n = rhs.len();
+    let mut x = vec![0.0; n];
+    let mut r = rhs.to_vec();
+    let mut p = r.clone();
+    let mut ap = vec![0.0; n];
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let mut rr = dot(&r, &r);
+    let stop = tolerance * tolerance * rr.max(f64::MIN_POSITIVE);
+    for _ in 0..max_iterations {
+        if rr <= stop {
+            break;
+        }
+        apply(&p, &mut ap);
+        let alpha = rr / dot(&p, &ap);
+        for i in 0..n {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * ap[i];
+        }
+        let next = dot(&r, &r);
+        let beta = next / rr;
+        rr = next;
+        for i in 0..n {
+            p[i] = r[i] + beta * p[i];
+        }
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solid::voxel_lattice::ConstantFrame;
+
+    #[test]
+    fn a_constant_frame_integrates_to_its_own_coordinates() {
+        // Frame turned 90° about z: local x = world y, local y = −world x.
+        let r = [0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+        let init = IntegratedInit::new(&lattice, &ConstantFrame(r), 2, [20, 16, 12]);
+        let (a, b) = (init.get([1, 1, 1]).unwrap(), init.get([2, 1, 1]).unwrap());
+        // One voxel along world x is Rᵀ e_x = (0, −1, 0) in local coordinates.
+        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        assert!((d[0]).abs() < 1e-6 && (d[1] + 1.0).abs() < 1e-6 && d[2].abs() < 1e-6, "{d:?}");
+        assert!(init.get([-4, 0, 0]).is_none());
+    }
+}
