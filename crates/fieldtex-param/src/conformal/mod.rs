@@ -420,7 +420,7 @@ pub fn global_conformal_with(
             match protrusion_map(&capped.mesh, faces.len(), genus, [a, b]) {
                 Ok(ProtrusionChoice::Slits { cut, cover, map }) => {
                     local_to_global.resize(capped.mesh.n_vertices(), u32::MAX);
-                    for v in capped.mesh.n_vertices()..cut.mesh.n_vertices() {
+                    for v in capped.mesh.n_vertices()..cut.original.len() {
                         local_to_global.push(local_to_global[cut.original[v] as usize]);
                     }
                     slits = Some(ProtrusionSummary {
@@ -558,5 +558,7 @@ pub fn global_conformal_with(
     Ok((out, warnings))
 }
 
+#[cfg(test)]
+mod protrusion_tests;
 #[cfg(test)]
 mod tests;

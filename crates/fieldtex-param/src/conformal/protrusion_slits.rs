@@ -66,16 +66,13 @@ const RADIUS_SAMPLES: usize = 96;
 /// The slit-open surface (see the module docs).
 #[derive(Debug, Clone)]
 pub struct ProtrusionSlits {
-    /// The cut mesh: the input's vertices, then one copy per inner slit vertex; the
-    /// input's triangles in the same order (corners on the left of a slit renumbered).
-    pub mesh: TriMesh,
-    /// Per vertex of `mesh`: the input vertex it is (or copies).
+    /// Per vertex of the cut mesh (the input's vertices, then one copy per inner slit
+    /// vertex; [`cut_along_paths`]; the double cover's first copy): the input vertex it
+    /// is or copies.
     pub original: Vec<u32>,
     /// Per slit: the tip it opens and its vertex path (input ids).
     pub tips: Vec<u32>,
     pub paths: Vec<Vec<u32>>,
-    /// Per slit: the cap rim's circumference (the hole's boundary length).
-    pub rims: Vec<f64>,
 }
 
 /// Protrusion tips of a closed genus-0 `mesh` (its first `n_keep` faces the input's)
@@ -441,7 +438,7 @@ pub fn protrusion_map(
 ) -> Result<ProtrusionChoice, ParamError> {
     let cylinder =
         if genus == 0 { slit_cylinder(mesh, ends)? } else { holomorphic_map(mesh, genus, n_keep)? };
-    let (tips, paths, rims) = protrusion_tips(mesh, n_keep, &cylinder);
+    let (tips, paths, _) = protrusion_tips(mesh, n_keep, &cylinder);
     let holes: Vec<usize> = ends.iter().flatten().copied().collect();
     let openings: Vec<usize> =
         holes.iter().copied().chain(tips.iter().map(|&t| t as usize)).collect();
@@ -500,7 +497,7 @@ pub fn protrusion_map(
                 .collect();
             let after = area_spread(&cover.mesh, n_keep, &map);
             if after < before {
-                let cut = ProtrusionSlits { mesh: cut_mesh, original, tips, paths, rims };
+                let cut = ProtrusionSlits { original, tips, paths };
                 Ok(ProtrusionChoice::Slits {
                     cut: Box::new(cut),
                     cover: Box::new(cover),
