@@ -30,6 +30,10 @@ pub struct ConformalArgs {
     /// (legs, ears) and the double cover that keeps them from shrinking.
     #[arg(long)]
     no_protrusion_slits: bool,
+    /// Keep the integrated holomorphic map as it is: no per-chart least squares
+    /// conformal polish (which lowers its angle distortion on coarse meshes).
+    #[arg(long)]
+    no_polish: bool,
     /// Number of exemplar scale levels.
     #[arg(long, default_value_t = 6)]
     levels: usize,
@@ -58,6 +62,7 @@ pub fn run(
         quasi_isometric: args.quasi_isometric,
         multiscale: !args.no_multiscale,
         protrusion_slits: !args.no_protrusion_slits,
+        polish: !args.no_polish,
         levels: args.levels,
         scale: args.scale,
         patch_size: args.patch_size,

@@ -207,3 +207,34 @@ fn quasi_isometric_relaxes_a_patch_layout() {
     assert_eq!(c["distortion"]["flipped"], 0);
     assert!(c["margin_links"].as_u64().unwrap() > 0);
 }
+
+/// The conformal polish on a coarse CAD mesh (fandisk, a slit cylinder whose integrated
+/// map is 1.06 away from its slits): applied by default, the angle distortion away from
+/// singularities within 1.05, no folds, the cylinder one chart with margin links;
+/// `--no-polish` keeps the integrated periodic map.
+#[test]
+fn fandisk_is_polished_within_the_angle_target() {
+    let mesh = shared().join("meshes/fandisk.obj");
+    let d = tmp("fandisk-polish");
+    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&d);
+    let c = &r["metrics"]["components"][0];
+    let p = &c["polish"];
+    assert_eq!(p["applied"], true, "{p}");
+    let (before, after) = (p["away_before"].as_f64().unwrap(), p["away_after"].as_f64().unwrap());
+    assert!(before > 1.05 && after <= 1.05, "{p}");
+    let away = c["distortion"]["angle_mean_away_from_singularities"].as_f64().unwrap();
+    assert!((away - after).abs() < 1e-9, "{c}");
+    assert_eq!(c["distortion"]["flipped"], 0);
+    assert!(c["lattice"]["a"].is_null());
+    assert!(c["margin_links"].as_u64().unwrap() > 0, "{c}");
+    let d2 = tmp("fandisk-no-polish");
+    let out = conformal(&mesh, &pebbles(), &d2, &["--size", "256", "--quiet", "--no-polish"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let c2 = &report(&d2)["metrics"]["components"][0];
+    assert!(c2["polish"].is_null());
+    assert!(c2["lattice"]["a"].is_number());
+    let away2 = c2["distortion"]["angle_mean_away_from_singularities"].as_f64().unwrap();
+    assert!((away2 - before).abs() < 1e-9);
+}

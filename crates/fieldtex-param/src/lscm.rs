@@ -52,6 +52,22 @@ fn local_corners(p: [V3; 3]) -> [[f64; 2]; 3] {
     z
 }
 
+/// The two real residual rows of one triangle with complex corners `z`, over its six
+/// scalar unknowns (`u_k` at `2k`, `v_k` at `2k + 1`), scaled by `w` (module docs).
+fn face_rows(z: &[[f64; 2]; 3], w: f64) -> [[f64; 6]; 2] {
+    let mut rows = [[0.0f64; 6]; 2];
+    for k in 0..3 {
+        let a = z[(k + 2) % 3];
+        let b = z[(k + 1) % 3];
+        let (ex, ey) = (a[0] - b[0], a[1] - b[1]);
+        rows[0][2 * k] = ex * w;
+        rows[0][2 * k + 1] = -ey * w;
+        rows[1][2 * k] = ey * w;
+        rows[1][2 * k + 1] = ex * w;
+    }
+    rows
+}
+
 /// LSCM of `chart` (module docs): one UV per local vertex.
 pub fn lscm(
     chart: &ChartMesh,
@@ -122,18 +138,7 @@ pub fn lscm(
     let mut rhs = vec![0.0; m];
     for (lf, &f) in chart.faces.iter().enumerate() {
         let z = local_corners(mesh.triangle_positions(f as usize));
-        let w = 1.0 / graph.areas[f as usize].max(floor).sqrt();
-        // Both rows over the 6 scalar unknowns (u_k at 2k, v_k at 2k + 1).
-        let mut rows = [[0.0f64; 6]; 2];
-        for k in 0..3 {
-            let a = z[(k + 2) % 3];
-            let b = z[(k + 1) % 3];
-            let (ex, ey) = (a[0] - b[0], a[1] - b[1]);
-            rows[0][2 * k] = ex * w;
-            rows[0][2 * k + 1] = -ey * w;
-            rows[1][2 * k] = ey * w;
-            rows[1][2 * k + 1] = ex * w;
-        }
+        let rows = face_rows(&z, 1.0 / graph.areas[f as usize].max(floor).sqrt());
         // Global unknown of each local scalar (None when pinned) and pinned values.
         let mut gidx = [None; 6];
         let mut xp = [0.0; 6];
@@ -194,6 +199,66 @@ pub fn lscm(
     }
     orient_positive(chart, &mut uv);
     Ok(uv)
+}
+
+/// LSCM of `chart` held near a given map `anchor` (one UV per local vertex) instead of
+/// by two pins: minimises the LSCM energy plus `weight · Σ_v (A_v / Ā) |U_v − anchor_v|²`
+/// (`A_v` a third of the 3-D area of the chart's faces at `v`, `Ā` their mean). The
+/// LSCM rows fix angles at the scale of a few triangles; the anchor keeps what varies
+/// slowly (the conformal factor, the chart's placement) from `anchor`. Used by
+/// [`crate::conformal::conformal_polish`].
+pub fn lscm_anchored(
+    chart: &ChartMesh,
+    mesh: &TriMesh,
+    graph: &FaceGraph,
+    anchor: &[[f64; 2]],
+    weight: f64,
+) -> Result<Vec<[f64; 2]>, LinalgError> {
+    let n = chart.n_vertices;
+    let free: Vec<u32> = (0..n as u32).collect();
+    let mean_area: f64 = chart.faces.iter().map(|&f| graph.areas[f as usize]).sum::<f64>()
+        / chart.faces.len().max(1) as f64;
+    let floor = (1e-6 * mean_area).max(f64::MIN_POSITIVE);
+    let mut vertex_area = vec![0.0f64; n];
+    for (lf, &f) in chart.faces.iter().enumerate() {
+        for &v in &chart.corners[lf] {
+            vertex_area[v as usize] += graph.areas[f as usize] / 3.0;
+        }
+    }
+    let mean_va = vertex_area.iter().sum::<f64>() / n.max(1) as f64;
+    let pattern = BlockPattern::build(chart, &free, n);
+    let mut blocks = vec![[0.0f64; 4]; pattern.rows.len()];
+    let mut rhs = vec![0.0; 2 * n];
+    for (lf, &f) in chart.faces.iter().enumerate() {
+        let z = local_corners(mesh.triangle_positions(f as usize));
+        let rows = face_rows(&z, 1.0 / graph.areas[f as usize].max(floor).sqrt());
+        let gidx: [usize; 6] =
+            std::array::from_fn(|i| 2 * chart.corners[lf][i / 2] as usize + i % 2);
+        let mut bidx = [[0usize; 3]; 3];
+        for k in 0..3 {
+            for l in 0..3 {
+                bidx[k][l] = pattern.find(gidx[2 * l] / 2, gidx[2 * k] / 2);
+            }
+        }
+        for i in 0..6 {
+            for j in 0..6 {
+                blocks[bidx[i / 2][j / 2]][2 * (gidx[i] % 2) + gidx[j] % 2] +=
+                    rows[0][i] * rows[0][j] + rows[1][i] * rows[1][j];
+            }
+        }
+    }
+    for v in 0..n {
+        let m = weight * vertex_area[v] / mean_va.max(f64::MIN_POSITIVE);
+        let b = pattern.find(v, v);
+        blocks[b][0] += m;
+        blocks[b][3] += m;
+        rhs[2 * v] += m * anchor[v][0];
+        rhs[2 * v + 1] += m * anchor[v][1];
+    }
+    let a = pattern.into_matrix(&blocks)?;
+    let chol = Cholesky::factor(&a)?;
+    let x = chol.solve(&rhs)?;
+    Ok((0..n).map(|v| [x[2 * v], x[2 * v + 1]]).collect())
 }
 
 /// Sparsity of the LSCM normal matrix by free-vertex pairs: for block column `j` (a
@@ -497,6 +562,42 @@ mod tests {
         assert!(segments_intersect([0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [1.0, 0.0]));
         assert!(!segments_intersect([0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]));
         assert!(segments_intersect([0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [1.0, 1.0]));
+    }
+
+    #[test]
+    fn anchored_lscm_keeps_a_conformal_anchor_and_follows_a_heavy_one() {
+        // A flat grid: its own coordinates, rotated, scaled and moved, are exactly
+        // conformal, so the LSCM rows vanish there and the anchor is the minimiser.
+        let mesh = fieldtex_mesh::primitives::grid(6, 5, 2.0, 1.5);
+        let graph = FaceGraph::build(&mesh);
+        let chart =
+            ChartMesh::build((0..mesh.n_triangles() as u32).collect(), &graph, &mesh.triangles);
+        let (c, s) = (0.6f64, 0.8f64);
+        let anchor: Vec<[f64; 2]> = chart
+            .vertex_global
+            .iter()
+            .map(|&v| {
+                let p = mesh.positions[v as usize];
+                [3.0 * (c * p[0] - s * p[1]) + 1.0, 3.0 * (s * p[0] + c * p[1]) - 2.0]
+            })
+            .collect();
+        let uv = lscm_anchored(&chart, &mesh, &graph, &anchor, 1e-3).unwrap();
+        for (a, b) in uv.iter().zip(&anchor) {
+            assert!((a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-8, "{a:?} {b:?}");
+        }
+        // A shear is not conformal: a weak anchor undoes most of it, a heavy one keeps it.
+        let sheared: Vec<[f64; 2]> = anchor.iter().map(|p| [p[0] + 0.5 * p[1], p[1]]).collect();
+        let shear_left = |uv: &[[f64; 2]]| {
+            let (i, j) = (chart.vertex_global.iter().position(|&v| v == 0).unwrap(), 1usize);
+            let j = chart.vertex_global.iter().position(|&v| v as usize == j).unwrap();
+            let d = |p: &[[f64; 2]]| [p[j][0] - p[i][0], p[j][1] - p[i][1]];
+            let (a, b) = (d(uv), d(&sheared));
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+        };
+        let heavy = lscm_anchored(&chart, &mesh, &graph, &sheared, 1e6).unwrap();
+        let weak = lscm_anchored(&chart, &mesh, &graph, &sheared, 1e-4).unwrap();
+        assert!(shear_left(&heavy) < 1e-4);
+        assert!(shear_left(&weak) > 100.0 * shear_left(&heavy));
     }
 
     #[test]

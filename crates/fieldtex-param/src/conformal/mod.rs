@@ -19,6 +19,7 @@
 //! fundamental domain by one lattice translation; corners may stick out of the domain by
 //! up to one triangle, which is why texture images get margins (Wang et al. §4.2).
 
+pub mod conformal_polish;
 pub mod cotan_system;
 pub mod critical_trajectories;
 pub mod double_cover;
@@ -202,6 +203,8 @@ pub struct ConformalComponent {
     pub local_mesh: TriMesh,
     pub local_to_global: Vec<u32>,
     pub map: ComponentMap,
+    /// What [`ConformalComponent::polish_conformal`] did, when it ran.
+    pub polish: Option<conformal_polish::PolishStats>,
 }
 
 impl ConformalComponent {
@@ -255,6 +258,40 @@ impl ConformalComponent {
         self.domain = [x0, y0, x1, y1];
     }
 
+    /// Conformal polish ([`conformal_polish`]) of this component's map where its mean
+    /// angle distortion away from singularities exceeds `options.above`: slit cylinders
+    /// and patch layouts; `None` (and no change) for the torus image or without UVs.
+    pub fn polish_conformal(
+        &mut self,
+        options: &conformal_polish::PolishOptions,
+    ) -> Option<conformal_polish::PolishStats> {
+        if !self.has_uv()
+            || !matches!(
+                self.method,
+                ConformalMethod::SlitCylinder | ConformalMethod::CriticalTrajectoryPatches
+            )
+        {
+            return None;
+        }
+        let slit = self.slit.clone();
+        let near = self.near_singularity.clone();
+        let stats = conformal_polish::polish_layout(
+            &self.local_mesh,
+            self.faces.len(),
+            &mut self.map,
+            &self.local_to_global,
+            &|f| slit[f],
+            &|f| near[f],
+            options,
+        )?;
+        if stats.applied {
+            self.lattice = self.map.lattice;
+            self.refresh();
+        }
+        self.polish = Some(stats);
+        Some(stats)
+    }
+
     /// Quasi-isometric relaxation (Wang et al. 2005 §5) of this component's map.
     pub fn relax_quasi_isometric(
         &mut self,
@@ -264,7 +301,10 @@ impl ConformalComponent {
             return None;
         }
         let n_orig = self.faces.len();
-        let stats = if self.method == ConformalMethod::CriticalTrajectoryPatches {
+        // A polished map is a set of charts like a patch layout, even from the cylinder.
+        let charts = self.method == ConformalMethod::CriticalTrajectoryPatches
+            || self.polish.is_some_and(|p| p.applied);
+        let stats = if charts {
             patch_relaxation::relax_patches(
                 &self.local_mesh,
                 n_orig,
@@ -549,6 +589,7 @@ pub fn global_conformal_with(
             local_mesh: capped_mesh,
             local_to_global,
             map,
+            polish: None,
         };
         c.refresh();
         out.push(c);
@@ -558,6 +599,8 @@ pub fn global_conformal_with(
     Ok((out, warnings))
 }
 
+#[cfg(test)]
+mod polish_tests;
 #[cfg(test)]
 mod protrusion_tests;
 #[cfg(test)]

@@ -31,9 +31,29 @@ pub fn relax_patches(
     options: &MassSpringOptions,
 ) -> MassSpringStats {
     let n = n_faces.min(map.corner.len()).min(mesh.n_triangles());
+    let (split, base) = split_by_chart(mesh, n, map);
+    let mut pieces = ComponentMap {
+        corner: map.corner[..n].to_vec(),
+        base,
+        apex: vec![None; n],
+        lattice: Lattice { a: None, b: None },
+        ..ComponentMap::empty(map.method)
+    };
+    let stats = relax(&split, n, &mut pieces, options);
+    repack_with_similarity_ghosts(mesh, n, map, original, pieces.corner);
+    stats
+}
+
+/// The first `n` faces of `map` as a mesh of their own in which every chart has its own
+/// copy of each vertex it holds, one per distinct position (a vertex on a seam gets one
+/// copy per side, also where a chart meets itself), and each copy's position in the
+/// layout. Its connected pieces are the layout's charts.
+pub(super) fn split_by_chart(
+    mesh: &TriMesh,
+    n: usize,
+    map: &ComponentMap,
+) -> (TriMesh, Vec<[f64; 2]>) {
     let chart = |f: usize| map.patch.get(f).copied().unwrap_or(0);
-    // One vertex per (vertex, chart, position): a chart that meets itself along a seam
-    // keeps its two sides apart.
     let extent = map.corner[..n]
         .iter()
         .flatten()
@@ -57,19 +77,25 @@ pub fn relax_patches(
         });
         triangles.push(t);
     }
-    let split = TriMesh::new(positions, triangles);
-    let mut pieces = ComponentMap {
-        corner: map.corner[..n].to_vec(),
-        base,
-        apex: vec![None; n],
-        lattice: Lattice { a: None, b: None },
-        ..ComponentMap::empty(map.method)
-    };
-    let stats = relax(&split, n, &mut pieces, options);
+    (TriMesh::new(positions, triangles), base)
+}
+
+/// Writes the moved chart corners `moved` (first `n` faces) into `map`, repacks the
+/// charts and draws every seam's margin by similarity ghosts: after a chart-by-chart
+/// change the charts no longer differ by translations across their seams, and the map
+/// is no longer periodic.
+pub(super) fn repack_with_similarity_ghosts(
+    mesh: &TriMesh,
+    n: usize,
+    map: &mut ComponentMap,
+    original: &[u32],
+    mut moved: Vec<[[f64; 2]; 3]>,
+) {
+    let chart = |f: usize| map.patch.get(f).copied().unwrap_or(0);
     // Repack with the layout's gap (its mean edge length in the plane, as the patches
     // were packed) and draw every seam's margin by similarity.
     let (mut len, mut count) = (0.0, 0usize);
-    for c in &pieces.corner {
+    for c in &moved {
         for k in 0..3 {
             let (a, b) = (c[k], c[(k + 1) % 3]);
             len += ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
@@ -77,18 +103,12 @@ pub fn relax_patches(
         }
     }
     let mean_len = len / count.max(1) as f64;
-    let keep: Vec<bool> = (0..n)
-        .map(|f| chart(f) != u32::MAX && signed_area(&pieces.corner[f]).is_finite())
-        .collect();
+    let keep: Vec<bool> =
+        (0..n).map(|f| chart(f) != u32::MAX && signed_area(&moved[f]).is_finite()).collect();
     let n_charts = (0..n).filter(|&f| keep[f]).map(|f| chart(f) as usize + 1).max().unwrap_or(0);
-    shelf_pack(
-        &mut pieces.corner,
-        &map.patch[..n],
-        &keep,
-        n_charts,
-        (2.0 * GHOST_RINGS as f64 + 1.0) * mean_len,
-    );
-    map.corner[..n].copy_from_slice(&pieces.corner);
+    let patch: Vec<u32> = (0..n).map(chart).collect();
+    shelf_pack(&mut moved, &patch, &keep, n_charts, (2.0 * GHOST_RINGS as f64 + 1.0) * mean_len);
+    map.corner[..n].copy_from_slice(&moved);
+    map.lattice = Lattice { a: None, b: None };
     map.ghosts = similarity_ghosts(&mesh.triangles, original, &map.corner, n, GHOST_RINGS, None);
-    stats
 }

@@ -15,6 +15,7 @@ use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_mesh::TriMesh;
+use fieldtex_param::conformal::conformal_polish::PolishOptions;
 use fieldtex_param::conformal::{
     ConformalComponent, GeometryImage, MassSpringOptions, global_conformal_with,
 };
@@ -50,6 +51,11 @@ pub struct ConformalOptions {
     /// cylinder squeezes protrusions (`fieldtex_param::conformal::protrusion_slits`).
     /// Default true.
     pub protrusion_slits: bool,
+    /// Conformal polish: each chart of a slit-cylinder or patch layout re-solved as a
+    /// free-boundary least squares conformal map held near the holomorphic map
+    /// (`fieldtex_param::conformal::conformal_polish`); not with `quasi_isometric`,
+    /// which relaxes the map instead. Default true.
+    pub polish: bool,
     /// Number of exemplar levels. Default 6.
     pub levels: usize,
     /// Exemplar texels per texture texel where `τ` is at its reference (the 5th
@@ -71,6 +77,7 @@ impl Default for ConformalOptions {
             quasi_isometric: false,
             multiscale: true,
             protrusion_slits: true,
+            polish: true,
             levels: 6,
             scale: 1.0,
             patch_size: 40,
@@ -138,7 +145,14 @@ pub fn conformal(
         .map_err(|e| Error::classify(&e, None, "conformal map"))?;
     report.warnings.extend(warnings);
     crate::outputs::check_cancelled(progress)?;
-    // 2. Optional quasi-isometric relaxation.
+    // 2. Conformal polish of the charts, or the optional quasi-isometric relaxation.
+    if options.polish && !options.quasi_isometric {
+        report.stage(progress, "conformal-polish", || {
+            for c in comps.iter_mut() {
+                c.polish_conformal(&PolishOptions::default());
+            }
+        });
+    }
     let mut relax_stats = Vec::new();
     if options.quasi_isometric {
         report.stage(progress, "mass-spring", || {

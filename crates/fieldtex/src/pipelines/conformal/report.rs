@@ -71,6 +71,7 @@ pub(super) fn component_json(
         "conjugate_residual_wedge_system": c.map.conjugate_residual_wedge_system,
         "double_cover_genus": c.double_cover_genus,
         "protrusion_slits": c.protrusion_slits,
+        "polish": c.polish,
         "note": c.note,
     });
     if c.has_uv() {
@@ -92,6 +93,15 @@ pub(super) fn component_json(
             v["patch_merges"] = json!(c.map.patch_merges);
             v["stretch_cv_best_basis_form"] = json!(c.map.stretch_cv.map(|x| x[0]));
             v["stretch_cv_optimised_form"] = json!(c.map.stretch_cv.map(|x| x[1]));
+            if let Some(img) = img {
+                v["margin_links"] = json!(img.links.len() / 2);
+            }
+        }
+        if c.method != ConformalMethod::CriticalTrajectoryPatches
+            && c.polish.is_some_and(|p| p.applied)
+        {
+            // The polished cylinder is one chart whose margins are drawn by ghosts.
+            v["ghost_faces"] = json!(c.map.ghosts.len());
             if let Some(img) = img {
                 v["margin_links"] = json!(img.links.len() / 2);
             }
@@ -162,6 +172,9 @@ pub(super) fn add_notes(
         if options.quasi_isometric {
             n.push("Quasi-isometric relaxation of a patch layout (our extension): every chart gets its own copies of its vertices and the relaxation below runs on all charts at once with free chart boundaries (one gauge vertex per chart); the charts are then repacked, and since they no longer differ by translations across their seams, every seam's margin is drawn by similarity ghosts (the far face placed by the similarity that maps the shared edge).".into());
         }
+    }
+    if comps.iter().any(|c| c.polish.is_some_and(|p| p.applied)) {
+        n.push("Conformal polish (our addition; --no-polish keeps the integrated map): each chart (the slit cylinder cut along its seam, or each patch) is re-solved as a free-boundary least squares conformal map (Lévy et al. 2002) plus a weak area-weighted pull (weight 3e-4 of the LSCM energy) towards the holomorphic map, which keeps its conformal factor and the charts' placement while removing the piecewise-linear angle error at the scale of a few triangles; a chart whose solve folds a triangle keeps its holomorphic corners, and the polish is dropped when it does not lower the mean angle distortion (polish.before / polish.after, non-slit faces). The charts no longer differ by translations across their seams (and the cylinder is no longer periodic), so every seam's margin is drawn by similarity ghosts.".into());
     }
     if comps.iter().any(|c| !c.has_uv()) {
         n.push("Failed components are textured through a chart atlas (LSCM charts) without boundary consistency across chart seams.".into());
