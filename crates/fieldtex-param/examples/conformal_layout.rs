@@ -1,6 +1,6 @@
 //! Patch-layout probe for closed genus ≥ 2 meshes (issue 13):
 //! `cargo run --release -p fieldtex-param --example conformal_layout -- MESH.obj GENUS
-//! [TRAJECTORY_LENGTH] [PIECE_SIDE] [MERGE: 0|1] [LOOPS: 0|1]`.
+//! [TRAJECTORY_LENGTH] [PIECE_SIDE] [MERGE: 0|1] [LOOPS: 0|1] [SPANNING: 0|1]`.
 //!
 //! Runs [`holomorphic_map_with`] on a plain `v`/`f` triangle OBJ and prints the patch
 //! count, small patches, folded faces, the 3-D seam length (edges whose two faces
@@ -13,7 +13,8 @@
 use fieldtex_core::vec3;
 use fieldtex_mesh::{Topology, TriMesh};
 use fieldtex_param::conformal::holomorphic_map::{
-    HOMOLOGY_LOOPS, PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with,
+    HOMOLOGY_LOOPS, LayoutOptions, PIECE_SIDE, SPANNING_CUT, TRAJECTORY_LENGTH,
+    holomorphic_map_with,
 };
 use fieldtex_param::conformal::periodic_uv::signed_area;
 use std::time::Instant;
@@ -33,8 +34,15 @@ fn main() -> Result<(), String> {
     let mesh = load_mesh(path)?;
     let nf = mesh.n_triangles();
     let t = Instant::now();
-    let map = holomorphic_map_with(&mesh, genus, nf, traj, piece, merge, loops)
-        .map_err(|e| e.to_string())?;
+    let spanning = args.get(6).map_or(SPANNING_CUT, |s| s != "0");
+    let options = LayoutOptions {
+        trajectory_length: traj,
+        piece_side: piece,
+        merge,
+        homology_loops: loops,
+        spanning_cut: spanning,
+    };
+    let map = holomorphic_map_with(&mesh, genus, nf, &options).map_err(|e| e.to_string())?;
     let secs = t.elapsed().as_secs_f64();
     let topo = Topology::build(mesh.n_vertices(), &mesh.triangles);
     let uv = |f: usize, v: u32| map.corner[f][(0..3).find(|&k| mesh.triangles[f][k] == v).unwrap()];

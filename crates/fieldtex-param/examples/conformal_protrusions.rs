@@ -37,7 +37,13 @@ fn main() -> Result<(), String> {
             );
             // What slits would give (the pipeline keeps genus ≥ 1 on the paper's map).
             if c.double_cover_genus.is_none() {
-                match protrusion_map(&c.local_mesh, c.faces.len(), c.genus, [None, None]) {
+                match protrusion_map(
+                    &c.local_mesh,
+                    c.faces.len(),
+                    c.genus,
+                    [None, None],
+                    &Default::default(),
+                ) {
                     Ok(ProtrusionChoice::Slits { cut, map, .. }) => println!(
                         "  with slits at {:?}: log-area std {:.3} (plain {:.3}), {} zero points",
                         cut.tips,

@@ -21,6 +21,7 @@
 
 use super::cotan_system::{FixedLaplacian, conformal_error, edge_weights};
 use super::critical_trajectories::critical_trajectories;
+use super::cut_graph;
 use super::harmonic_one_forms::{face_areas_normals, face_vectors, harmonic_projection};
 use super::holomorphic_basis::conjugates;
 use super::homology_loops::shortest_homology_basis;
@@ -51,6 +52,37 @@ pub const HOMOLOGY_LOOPS: bool = false;
 pub const LOOP_BASES: usize = 32;
 /// Face rings drawn as ghosts beyond each cut (image margins, §4.2).
 pub const GHOST_RINGS: usize = 1;
+/// Also cut along the spanning tree of shortest paths joining the kept region's
+/// openings and the zero points ([`super::cut_graph`]).
+pub const SPANNING_CUT: bool = true;
+
+/// How a genus ≥ 2 surface is cut into patches ([`holomorphic_map_with`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LayoutOptions {
+    /// Length budget of a critical trajectory, × `√area` ([`TRAJECTORY_LENGTH`]).
+    pub trajectory_length: f64,
+    /// Largest patch piece side, × `√(UV area)` ([`PIECE_SIDE`]).
+    pub piece_side: f64,
+    /// Merge patches into maximal injective charts ([`super::patch_merging`]).
+    pub merge: bool,
+    /// Cut along a short homology basis first ([`HOMOLOGY_LOOPS`]).
+    pub homology_loops: bool,
+    /// Cut along the spanning tree of the openings and zero points as well
+    /// ([`SPANNING_CUT`]).
+    pub spanning_cut: bool,
+}
+
+impl Default for LayoutOptions {
+    fn default() -> Self {
+        Self {
+            trajectory_length: TRAJECTORY_LENGTH,
+            piece_side: PIECE_SIDE,
+            merge: true,
+            homology_loops: HOMOLOGY_LOOPS,
+            spanning_cut: SPANNING_CUT,
+        }
+    }
+}
 
 /// Holomorphic data and the UV map of a closed genus-`g ≥ 1` mesh.
 /// For `g ≥ 2` only the first `n_keep` faces get UVs (the input's faces of a capped or
@@ -60,21 +92,18 @@ pub fn holomorphic_map(
     genus: usize,
     n_keep: usize,
 ) -> Result<ComponentMap, ParamError> {
-    holomorphic_map_with(mesh, genus, n_keep, TRAJECTORY_LENGTH, PIECE_SIDE, true, HOMOLOGY_LOOPS)
+    holomorphic_map_with(mesh, genus, n_keep, &LayoutOptions::default())
 }
 
-/// [`holomorphic_map`] with the trajectory length budget (× `√area`), the patch piece
-/// side (× `√(UV area)`), patch merging ([`super::patch_merging`]) and the homology-loop
-/// cut ([`super::homology_loops`], genus ≥ 2) given.
+/// [`holomorphic_map`] with the genus ≥ 2 layout options given.
 pub fn holomorphic_map_with(
     mesh: &TriMesh,
     genus: usize,
     n_keep: usize,
-    trajectory_length: f64,
-    piece_side: f64,
-    merge: bool,
-    loops: bool,
+    options: &LayoutOptions,
 ) -> Result<ComponentMap, ParamError> {
+    let LayoutOptions { trajectory_length, piece_side, merge, homology_loops: loops, spanning_cut } =
+        *options;
     let nv = mesh.n_vertices();
     let nf = mesh.n_triangles();
     let tris = &mesh.triangles;
@@ -166,9 +195,17 @@ pub fn holomorphic_map_with(
             trajectory_length * area.sqrt(),
             &on_loop,
         );
+        let kept: Vec<bool> = (0..nf).map(|f| f < n_keep).collect();
+        // The trajectories and the spanning tree of the openings and the zero points.
+        let cut = if spanning_cut {
+            let cones: Vec<u32> = zero_points.iter().filter(|z| z.1 < 0).map(|z| z.0).collect();
+            let span = cut_graph::spanning_cut(&mesh.positions, &topo, &kept, &cones);
+            cut.iter().zip(&span).map(|(&a, &b)| a || b).collect()
+        } else {
+            cut
+        };
         let all_cut: Vec<bool> =
             (0..cut.len()).map(|e| cut[e] || loop_cut.get(e).is_some_and(|&c| c)).collect();
-        let kept: Vec<bool> = (0..nf).map(|f| f < n_keep).collect();
         let layout = translation_patches(
             &mesh.positions,
             tris,

@@ -64,13 +64,27 @@ pub(super) fn shortest_path_tree(
     root: usize,
     radius: f64,
 ) -> (Vec<f64>, Vec<u32>) {
+    shortest_path_forest(topology, vertex_edges, length, &[root], radius)
+}
+
+/// [`shortest_path_tree`] grown from all of `roots` at once (distance to the nearest
+/// root); an infinite edge length closes that edge.
+pub(super) fn shortest_path_forest(
+    topology: &Topology,
+    vertex_edges: &[Vec<u32>],
+    length: &[f64],
+    roots: &[usize],
+    radius: f64,
+) -> (Vec<f64>, Vec<u32>) {
     let nv = topology.n_vertices;
     let mut dist = vec![f64::INFINITY; nv];
     let mut parent = vec![u32::MAX; nv];
     let mut done = vec![false; nv];
     let mut heap = BinaryHeap::new();
-    dist[root] = 0.0;
-    heap.push(Reverse((0u64, root as u32)));
+    for &root in roots {
+        dist[root] = 0.0;
+        heap.push(Reverse((0u64, root as u32)));
+    }
     while let Some(Reverse((_, v))) = heap.pop() {
         let v = v as usize;
         if done[v] {

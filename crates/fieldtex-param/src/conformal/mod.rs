@@ -22,6 +22,7 @@
 pub mod conformal_polish;
 pub mod cotan_system;
 pub mod critical_trajectories;
+pub mod cut_graph;
 pub mod double_cover;
 pub mod flip_untangle;
 pub mod geometry_image;
@@ -369,14 +370,29 @@ pub fn global_conformal(
     mesh: &TriMesh,
     progress: &dyn Progress,
 ) -> Result<(Vec<ConformalComponent>, Vec<Warning>), ParamError> {
-    global_conformal_with(mesh, true, progress)
+    global_conformal_with(mesh, &MapOptions::default(), progress)
 }
 
-/// [`global_conformal`] with the genus-0 protrusion slits ([`protrusion_slits`]) on or
-/// off (off: every genus-0 component gets the two-point slit cylinder).
+/// How [`global_conformal_with`] maps the components.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapOptions {
+    /// Genus 0: slits at protrusion tips ([`protrusion_slits`]); off: every genus-0
+    /// component gets the two-point slit cylinder. Default on.
+    pub protrusion_slits: bool,
+    /// How patch layouts are cut ([`holomorphic_map::LayoutOptions`]).
+    pub layout: holomorphic_map::LayoutOptions,
+}
+
+impl Default for MapOptions {
+    fn default() -> Self {
+        Self { protrusion_slits: true, layout: holomorphic_map::LayoutOptions::default() }
+    }
+}
+
+/// [`global_conformal`] with the map options given.
 pub fn global_conformal_with(
     mesh: &TriMesh,
-    protrusion_slits: bool,
+    options: &MapOptions,
     progress: &dyn Progress,
 ) -> Result<(Vec<ConformalComponent>, Vec<Warning>), ParamError> {
     mesh.validate()?;
@@ -440,7 +456,7 @@ pub fn global_conformal_with(
                     .collect(),
             );
             let dc = double_cover::double_cover(&partly);
-            match holomorphic_map::holomorphic_map(&dc.mesh, cover_genus, faces.len()) {
+            match holomorphic_map::holomorphic_map_with(&dc.mesh, cover_genus, faces.len(), &options.layout) {
                 Ok(m) => double = Some((dc, m)),
                 Err(e) => warnings.push(Warning::new(
                     "conformal-double-cover-failed",
@@ -455,9 +471,14 @@ pub fn global_conformal_with(
         // ends): the slit cylinder, unless protrusion slits spread the area scale less
         // (protrusion_slits.rs). Genus ≥ 1 keeps the paper's holomorphic map: slits there
         // would add zero points to a torus (measured on the rocker arm: docs/conformal.md).
-        if protrusion_slits && double.is_none() && manifold && genus == 0 && faces.len() >= 8 {
+        if options.protrusion_slits
+            && double.is_none()
+            && manifold
+            && genus == 0
+            && faces.len() >= 8
+        {
             let [a, b] = cylinder_ends(&capped.caps, sub_area);
-            match protrusion_map(&capped.mesh, faces.len(), genus, [a, b]) {
+            match protrusion_map(&capped.mesh, faces.len(), genus, [a, b], &options.layout) {
                 Ok(ProtrusionChoice::Slits { cut, cover, map }) => {
                     local_to_global.resize(capped.mesh.n_vertices(), u32::MAX);
                     for v in capped.mesh.n_vertices()..cut.original.len() {
@@ -512,7 +533,12 @@ pub fn global_conformal_with(
             } else if genus == 0 {
                 slit_cylinder::slit_cylinder(&capped.mesh, cylinder_ends(&capped.caps, sub_area))
             } else {
-                holomorphic_map::holomorphic_map(&capped.mesh, genus, faces.len())
+                holomorphic_map::holomorphic_map_with(
+                    &capped.mesh,
+                    genus,
+                    faces.len(),
+                    &options.layout,
+                )
             };
             (capped.mesh, r, false)
         };

@@ -48,7 +48,7 @@ pub fn relax_patches(
 /// copy of each vertex it holds, one per distinct position (a vertex on a seam gets one
 /// copy per side, also where a chart meets itself), and each copy's position in the
 /// layout. Its connected pieces are the layout's charts.
-pub(super) fn split_by_chart(
+pub(crate) fn split_by_chart(
     mesh: &TriMesh,
     n: usize,
     map: &ComponentMap,

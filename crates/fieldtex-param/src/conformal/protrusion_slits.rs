@@ -36,7 +36,7 @@
 
 use super::ComponentMap;
 use super::double_cover::{DoubleCover, double_cover};
-use super::holomorphic_map::{GHOST_RINGS, holomorphic_map};
+use super::holomorphic_map::{GHOST_RINGS, LayoutOptions, holomorphic_map_with};
 use super::homology_loops::{edge_lengths, shortest_path_tree};
 use super::mass_spring::map_distortion;
 use super::periodic_uv::signed_area;
@@ -435,9 +435,13 @@ pub fn protrusion_map(
     n_keep: usize,
     genus: usize,
     ends: [Option<usize>; 2],
+    layout: &LayoutOptions,
 ) -> Result<ProtrusionChoice, ParamError> {
-    let cylinder =
-        if genus == 0 { slit_cylinder(mesh, ends)? } else { holomorphic_map(mesh, genus, n_keep)? };
+    let cylinder = if genus == 0 {
+        slit_cylinder(mesh, ends)?
+    } else {
+        holomorphic_map_with(mesh, genus, n_keep, layout)?
+    };
     let (tips, paths, _) = protrusion_tips(mesh, n_keep, &cylinder);
     let holes: Vec<usize> = ends.iter().flatten().copied().collect();
     let openings: Vec<usize> =
@@ -479,7 +483,7 @@ pub fn protrusion_map(
         return Ok(ProtrusionChoice::Cylinder(Box::new(cylinder), None));
     };
     let cover = double_cover(&cut_mesh);
-    match holomorphic_map(&cover.mesh, cover_genus, n_keep) {
+    match holomorphic_map_with(&cover.mesh, cover_genus, n_keep, layout) {
         Ok(mut map) => {
             map.ghosts.extend(slit_ghosts(
                 &cover.mesh.triangles,

@@ -113,7 +113,9 @@ fn patch_layouts_relax_chart_by_chart_without_flips() {
         let (mut comps, _) = global_conformal(&mesh, &NoProgress).unwrap();
         let c = &mut comps[0];
         assert_eq!(c.method, ConformalMethod::CriticalTrajectoryPatches);
-        let opts = MassSpringOptions::default();
+        // The coarse fingers' map is itself at a mean σ1/σ2 near 1.4 over all faces (the
+        // faces next to its zero points): the bound sits above it.
+        let opts = MassSpringOptions { max_angle_distortion: 1.6, ..Default::default() };
         let st = c.relax_quasi_isometric(&opts).expect("patch layouts relax");
         assert_eq!((st.after.flipped, distortion(c).flipped), (0, 0), "{st:?}");
         assert!(st.after.log_area_std < 0.9 * st.before.log_area_std, "{st:?}");

@@ -325,11 +325,13 @@ fn seam_length(mesh: &fieldtex_mesh::TriMesh, corner: &[[[f64; 2]; 3]]) -> f64 {
 
 #[test]
 fn patch_merging_keeps_every_chart_injective_and_shortens_the_seams() {
-    use holomorphic_map::{PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with};
+    use holomorphic_map::{LayoutOptions, holomorphic_map_with};
     let mesh = genus_two_slab(4);
     let nf = mesh.n_triangles();
-    let run =
-        |merge| holomorphic_map_with(&mesh, 2, nf, TRAJECTORY_LENGTH, PIECE_SIDE, merge, false);
+    let run = |merge| {
+        let options = LayoutOptions { merge, homology_loops: false, ..Default::default() };
+        holomorphic_map_with(&mesh, 2, nf, &options)
+    };
     let (plain, merged) = (run(false).unwrap(), run(true).unwrap());
     assert_eq!(plain.patch_merges, 0);
     assert!(merged.patch_merges > 0, "nothing merged");
@@ -566,7 +568,7 @@ fn shortest_homology_loops_cut_every_period() {
 
 #[test]
 fn greedy_homology_basis_is_no_longer_than_the_best_loop_system_and_keeps_charts_injective() {
-    use holomorphic_map::{PIECE_SIDE, TRAJECTORY_LENGTH, holomorphic_map_with};
+    use holomorphic_map::{LayoutOptions, holomorphic_map_with};
     use homology_loops::{loop_system, shortest_homology_basis};
     let mesh = genus_two_slab(3);
     let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
@@ -594,7 +596,8 @@ fn greedy_homology_basis_is_no_longer_than_the_best_loop_system_and_keeps_charts
     }
     // With the loop cut the layout stays injective, and is the same when run twice.
     let nf = mesh.n_triangles();
-    let run = || holomorphic_map_with(&mesh, 2, nf, TRAJECTORY_LENGTH, PIECE_SIDE, true, true);
+    let options = LayoutOptions { homology_loops: true, ..Default::default() };
+    let run = || holomorphic_map_with(&mesh, 2, nf, &options);
     let (m, again) = (run().unwrap(), run().unwrap());
     assert!(m.loop_cut.iter().any(|&c| c));
     for f in 0..nf {

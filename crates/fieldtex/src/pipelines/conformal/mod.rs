@@ -16,8 +16,9 @@ use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_mesh::TriMesh;
 use fieldtex_param::conformal::conformal_polish::PolishOptions;
+use fieldtex_param::conformal::holomorphic_map::LayoutOptions;
 use fieldtex_param::conformal::{
-    ConformalComponent, GeometryImage, MassSpringOptions, global_conformal_with,
+    ConformalComponent, GeometryImage, MapOptions, MassSpringOptions, global_conformal_with,
 };
 use serde::Serialize;
 
@@ -140,7 +141,11 @@ pub fn conformal(
     // 1. Global conformal parameterisation, per component.
     let (mut comps, warnings) = report
         .stage(progress, "conformal-map", || {
-            global_conformal_with(&mesh, options.protrusion_slits, progress)
+            // Quasi-isometric relaxation wants the freedom of more charts: no spanning cut.
+            let layout =
+                LayoutOptions { spanning_cut: !options.quasi_isometric, ..Default::default() };
+            let map = MapOptions { protrusion_slits: options.protrusion_slits, layout };
+            global_conformal_with(&mesh, &map, progress)
         })
         .map_err(|e| Error::classify(&e, None, "conformal map"))?;
     report.warnings.extend(warnings);
