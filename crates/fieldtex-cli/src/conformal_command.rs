@@ -34,6 +34,10 @@ pub struct ConformalArgs {
     /// conformal polish (which lowers its angle distortion on coarse meshes).
     #[arg(long)]
     no_polish: bool,
+    /// Leave the colour steps the margin copy makes at patch cuts as they are (by
+    /// default the texels on the two sides of a cut meet halfway, faded over 4 texels).
+    #[arg(long)]
+    no_seam_feather: bool,
     /// Number of exemplar scale levels.
     #[arg(long, default_value_t = 6)]
     levels: usize,
@@ -63,6 +67,7 @@ pub fn run(
         multiscale: !args.no_multiscale,
         protrusion_slits: !args.no_protrusion_slits,
         polish: !args.no_polish,
+        seam_feather: !args.no_seam_feather,
         levels: args.levels,
         scale: args.scale,
         patch_size: args.patch_size,

@@ -229,6 +229,12 @@ fn fandisk_is_polished_within_the_angle_target() {
     assert_eq!(c["distortion"]["flipped"], 0);
     assert!(c["lattice"]["a"].is_null());
     assert!(c["margin_links"].as_u64().unwrap() > 0, "{c}");
+    // Its margins are feathered by default, not with --no-seam-feather.
+    assert!(r["metrics"]["quilting"][0]["feathered_pairs"].as_u64().unwrap() > 0);
+    let d3 = tmp("fandisk-no-feather");
+    let out = conformal(&mesh, &pebbles(), &d3, &["--size", "256", "--quiet", "--no-seam-feather"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(report(&d3)["metrics"]["quilting"][0]["feathered_pairs"], 0);
     let d2 = tmp("fandisk-no-polish");
     let out = conformal(&mesh, &pebbles(), &d2, &["--size", "256", "--quiet", "--no-polish"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

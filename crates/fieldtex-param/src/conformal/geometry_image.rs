@@ -292,6 +292,107 @@ impl GeometryImage {
         }
     }
 
+    /// Seam feathering after [`Self::copy_margins`] (our addition to §4.2): where the
+    /// quilting left the two sides of a cut different (it wrote both in one patch, so
+    /// the copy overwrote one), the copy leaves a colour step right at the cut. Every
+    /// pair of real texels that are neighbours across a cut — a real texel next to a
+    /// margin texel, and the texel that margin texel continues; and the
+    /// [`Self::seam_pairs`] — meets halfway, and the correction fades into both sides
+    /// over `band` texels (Jacobi steps of the correction field over the real texels,
+    /// the paired texels held). The margins are copied again afterwards. Colours are
+    /// RGB(A) `f32` in `[0, 1]`. Returns the number of texel pairs that met.
+    pub fn feather_seams(&self, pixels: &mut [[f32; 4]], band: usize) -> usize {
+        let (w, h) = (self.width, self.height);
+        let n = w * h;
+        let mut margin = vec![false; n];
+        for &(g, _, _) in &self.margin_copies {
+            margin[g as usize] = true;
+        }
+        let real = |i: usize| !self.tau[i].is_nan() && !margin[i];
+        let mut corr = vec![[0.0f32; 4]; n];
+        let mut count = vec![0u32; n];
+        let mut pairs = 0usize;
+        let mut meet = |a: usize, b: usize, pixels: &[[f32; 4]]| {
+            pairs += 1;
+            for c in 0..3 {
+                let d = 0.5 * (pixels[b][c] - pixels[a][c]);
+                corr[a][c] += d;
+                corr[b][c] -= d;
+            }
+            count[a] += 1;
+            count[b] += 1;
+        };
+        for &(g, r, _) in &self.margin_copies {
+            let (g, r) = (g as usize, r as usize);
+            let (x, y) = (g % w, g / w);
+            let nbrs = [
+                (x > 0).then(|| g - 1),
+                (x + 1 < w).then(|| g + 1),
+                (y > 0).then(|| g - w),
+                (y + 1 < h).then(|| g + w),
+            ];
+            for a in nbrs.into_iter().flatten() {
+                if real(a) && a != r {
+                    meet(a, r, pixels);
+                }
+            }
+        }
+        for &(far, near) in &self.seam_pairs {
+            meet(far as usize, near as usize, pixels);
+        }
+        let held: Vec<bool> = count.iter().map(|&k| k > 0).collect();
+        for (c, &k) in corr.iter_mut().zip(&count) {
+            if k > 0 {
+                c.iter_mut().for_each(|v| *v /= k as f32);
+            }
+        }
+        // Fade: Jacobi steps over the real texels, the paired ones held.
+        let mut next = corr.clone();
+        for _ in 0..band {
+            for i in 0..n {
+                if held[i] || !real(i) {
+                    continue;
+                }
+                let (x, y) = (i % w, i / w);
+                let mut sum = [0.0f32; 4];
+                let mut k = 0.0f32;
+                for j in [
+                    (x > 0).then(|| i - 1),
+                    (x + 1 < w).then(|| i + 1),
+                    (y > 0).then(|| i - w),
+                    (y + 1 < h).then(|| i + w),
+                ]
+                .into_iter()
+                .flatten()
+                {
+                    if real(j) {
+                        for c in 0..3 {
+                            sum[c] += corr[j][c];
+                        }
+                        k += 1.0;
+                    }
+                }
+                if k > 0.0 {
+                    // Divided by one more than the neighbours: the correction decays
+                    // outwards from the held texels.
+                    for c in 0..3 {
+                        next[i][c] = sum[c] / (k + 1.0);
+                    }
+                }
+            }
+            std::mem::swap(&mut corr, &mut next);
+        }
+        for i in 0..n {
+            if real(i) {
+                for c in 0..3 {
+                    pixels[i][c] = (pixels[i][c] + corr[i][c]).clamp(0.0, 1.0);
+                }
+            }
+        }
+        self.copy_margins(pixels);
+        pairs
+    }
+
     /// Texels that show the same surface point as `(i, j)`: its lattice translates that
     /// fall inside the canvas, and its [`Self::links`].
     pub fn partners(&self, i: usize, j: usize, out: &mut Vec<(usize, usize)>) {

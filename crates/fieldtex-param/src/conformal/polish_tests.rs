@@ -1,4 +1,5 @@
-//! Tests of the conformal polish of slit cylinders and patch layouts (session 16).
+//! Tests of the conformal polish of slit cylinders and patch layouts and of the seam
+//! feathering of geometry images (session 16).
 
 use super::conformal_polish::PolishOptions;
 use super::*;
@@ -82,4 +83,68 @@ fn polished_patch_layouts_are_the_same_for_one_and_two_threads() {
     assert_eq!(a.0, b.0);
     assert_eq!(a.1, b.1);
     assert_eq!(a.2, b.2);
+}
+
+#[test]
+fn feathering_closes_the_colour_steps_across_cuts_and_leaves_the_rest() {
+    let (comps, _) = global_conformal(&tests::genus_two_slab(6), &NoProgress).unwrap();
+    let img = GeometryImage::new(&comps[0], 256);
+    assert!(!img.margin_copies.is_empty());
+    // Each real texel a colour of its own (a hash), the margins copied: the two sides of
+    // every cut differ.
+    let n = img.width * img.height;
+    let mut px: Vec<[f32; 4]> = (0..n)
+        .map(|i| {
+            let h = fieldtex_core::rng::hash_unit(7, "feather-test", i as u64) as f32;
+            [h, 1.0 - h, 0.5 * h, 1.0]
+        })
+        .collect();
+    img.copy_margins(&mut px);
+    let before = px.clone();
+    let mut margin = vec![false; n];
+    for &(g, _, _) in &img.margin_copies {
+        margin[g as usize] = true;
+    }
+    let real = |i: usize| !img.tau[i].is_nan() && !margin[i];
+    // Pairs of real texels that are neighbours across a cut.
+    let w = img.width;
+    let mut across = Vec::new();
+    for &(g, r, _) in &img.margin_copies {
+        let g = g as usize;
+        for a in [g.wrapping_sub(1), g + 1, g.wrapping_sub(w), g + w] {
+            if a < n && real(a) && a != r as usize {
+                across.push((a, r as usize));
+            }
+        }
+    }
+    let step = |p: &[[f32; 4]]| {
+        across.iter().map(|&(a, b)| (p[a][0] - p[b][0]).abs() as f64).sum::<f64>()
+            / across.len() as f64
+    };
+    let pairs = img.feather_seams(&mut px, 4);
+    assert!(pairs >= across.len());
+    assert!(step(&px) < 0.6 * step(&before), "{} → {}", step(&before), step(&px));
+    // Texels farther than the band from every cut keep their colour; margins still match.
+    let mut near = vec![false; n];
+    for &(a, b) in &across {
+        for t in [a, b] {
+            let (x, y) = ((t % w) as i64, (t / w) as i64);
+            for dy in -6i64..=6 {
+                for dx in -6i64..=6 {
+                    let (u, v) = (x + dx, y + dy);
+                    if u >= 0 && v >= 0 && (u as usize) < w && (v as usize) < img.height {
+                        near[v as usize * w + u as usize] = true;
+                    }
+                }
+            }
+        }
+    }
+    for &(a, b) in &img.seam_pairs {
+        near[a as usize] = true;
+        near[b as usize] = true;
+    }
+    let far = (0..n).filter(|&i| real(i) && !near[i]).collect::<Vec<_>>();
+    assert!(!far.is_empty());
+    assert!(far.iter().all(|&i| px[i] == before[i]));
+    assert!(img.margin_copies.iter().all(|&(g, r, _)| px[g as usize] == px[r as usize]));
 }

@@ -37,6 +37,11 @@ use std::path::{Path, PathBuf};
 /// with whole patches; 1.25, 1.5 and 3 were no better (docs/conformal.md).
 pub const PATCH_SPLIT_SPREAD: f64 = 2.0;
 
+/// Texels over which the seam feathering fades (`GeometryImage::feather_seams`). The
+/// correction falls by about a fifth per texel, so 4 and 8 gave the same colour jumps
+/// (horse, armadillo, koala; session 16).
+pub const SEAM_FEATHER_BAND: usize = 4;
+
 /// Options of [`conformal`].
 #[derive(Debug, Clone, Serialize)]
 pub struct ConformalOptions {
@@ -57,6 +62,10 @@ pub struct ConformalOptions {
     /// (`fieldtex_param::conformal::conformal_polish`); not with `quasi_isometric`,
     /// which relaxes the map instead. Default true.
     pub polish: bool,
+    /// Seam feathering after the margin copy
+    /// (`fieldtex_param::conformal::GeometryImage::feather_seams`, band
+    /// [`SEAM_FEATHER_BAND`]). Default true.
+    pub seam_feather: bool,
     /// Number of exemplar levels. Default 6.
     pub levels: usize,
     /// Exemplar texels per texture texel where `τ` is at its reference (the 5th
@@ -79,6 +88,7 @@ impl Default for ConformalOptions {
             multiscale: true,
             protrusion_slits: true,
             polish: true,
+            seam_feather: true,
             levels: 6,
             scale: 1.0,
             patch_size: 40,

@@ -179,6 +179,9 @@ pub(super) fn add_notes(
     if comps.iter().any(|c| !c.has_uv()) {
         n.push("Failed components are textured through a chart atlas (LSCM charts) without boundary consistency across chart seams.".into());
     }
+    if options.seam_feather {
+        n.push("Seam feathering (our addition; --no-seam-feather): after the margins are copied, every pair of real texels that are neighbours across a cut (a texel next to a margin texel and the texel that margin texel continues, and the seam pairs) meets halfway, the correction fading into both sides over 4 texels; it removes the colour step the copy leaves where the quilting wrote both sides of a cut differently (quilting[].feathered_pairs).".into());
+    }
     n.push("τ per texel: barycentric interpolation of per-vertex τ (substitute for the paper's Gaussian RBF).".into());
     n.push("Quilting: random candidate subset per patch (not exhaustive), old seams not re-cut; colours compared in sRGB.".into());
     if options.quasi_isometric {

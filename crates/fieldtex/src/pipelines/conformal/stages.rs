@@ -3,7 +3,7 @@
 
 use super::blocks::FallbackAtlas;
 use super::report::{component_json, texel_density, weighted_quantile};
-use super::{Block, ConformalOptions, PATCH_SPLIT_SPREAD};
+use super::{Block, ConformalOptions, PATCH_SPLIT_SPREAD, SEAM_FEATHER_BAND};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, stream_seed};
 use fieldtex_mesh::TriMesh;
@@ -184,7 +184,12 @@ pub(super) fn quilt_blocks(
             .filter(|&&(a, b)| image.pixels[a as usize] != image.pixels[b as usize])
             .count();
         img.copy_margins(&mut image.pixels);
-        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len(), "margin_texels_changed_by_copy": changed, "seam_texel_pairs": img.seam_pairs.len(), "seam_texel_pairs_changed_by_copy": pairs_changed}));
+        let feathered = if options.seam_feather {
+            img.feather_seams(&mut image.pixels, SEAM_FEATHER_BAND)
+        } else {
+            0
+        };
+        quilt_stats.push(json!({"component": c.component, "stats": st, "margin_texels_copied": img.margin_copies.len(), "margin_texels_changed_by_copy": changed, "seam_texel_pairs": img.seam_pairs.len(), "seam_texel_pairs_changed_by_copy": pairs_changed, "feathered_pairs": feathered}));
         let faces = c.faces.iter().copied().zip(img.corner_texel.iter().copied()).collect();
         blocks.push(Block {
             image,
