@@ -1,7 +1,7 @@
 //! Conformal polish probe (issue 13): `cargo run --release -p fieldtex-param --example
 //! conformal_polish_probe -- [--weight W]... MESH...`.
 //!
-//! Repairs each mesh, runs [`global_conformal`] and, for every component with a slit
+//! Repairs each mesh, runs `fieldtex_param::conformal::global_conformal` and, for every component with a slit
 //! cylinder or a patch layout, polishes a copy of its map at each data weight (default:
 //! [`POLISH_WEIGHT`]) regardless of the threshold, printing the mean `σ1/σ2` away from
 //! singularities and over all non-slit faces, the log-area std and the folds before and
@@ -9,8 +9,10 @@
 //! 50th / 90th / 99th percentiles of `σ1/σ2` away from singularities and the share of
 //! the excess `σ1/σ2 − 1` carried by the worst 5 % of that area.
 
+#[path = "common/mod.rs"]
+mod common;
+
 use fieldtex_param::conformal::conformal_polish::{POLISH_WEIGHT, PolishOptions};
-use fieldtex_param::conformal::global_conformal;
 use std::time::Instant;
 
 fn main() -> Result<(), String> {
@@ -32,11 +34,7 @@ fn main() -> Result<(), String> {
         weights.push(POLISH_WEIGHT);
     }
     for path in meshes {
-        let mesh =
-            fieldtex_io::read_mesh(std::path::Path::new(&path)).map_err(|e| e.to_string())?.mesh;
-        let mesh = fieldtex_mesh::repair(&mesh, &Default::default()).mesh;
-        let (comps, _) =
-            global_conformal(&mesh, &fieldtex_core::NoProgress).map_err(|e| e.to_string())?;
+        let (_, comps) = common::mapped(&path)?;
         for c in &comps {
             for &weight in &weights {
                 let mut p = c.clone();

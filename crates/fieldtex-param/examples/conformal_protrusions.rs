@@ -8,6 +8,9 @@
 //! genus ≥ 1 components (which the pipeline keeps on the paper's map) what protrusion
 //! slits would give.
 
+#[path = "common/mod.rs"]
+mod common;
+
 use fieldtex_param::conformal::global_conformal;
 use fieldtex_param::conformal::protrusion_slits::{
     ProtrusionChoice, compressed_tips, protrusion_map, protrusion_tips,
@@ -17,9 +20,7 @@ use std::time::Instant;
 
 fn main() -> Result<(), String> {
     for path in std::env::args().skip(1) {
-        let mesh =
-            fieldtex_io::read_mesh(std::path::Path::new(&path)).map_err(|e| e.to_string())?.mesh;
-        let mesh = fieldtex_mesh::repair(&mesh, &Default::default()).mesh;
+        let mesh = common::repaired_mesh(&path)?;
         let scale = fieldtex_mesh::areas::total_area(&mesh).sqrt();
         let t = Instant::now();
         let (comps, _) =

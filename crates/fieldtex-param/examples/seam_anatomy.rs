@@ -2,18 +2,18 @@
 //! Per component, the 3-D seam length split into edges between two patches, edges where
 //! one patch meets itself, and edges on protrusion slits, and how much of each lies on
 //! a snapped critical trajectory. Also a lower bound for any cut layout of the kept
-//! surface: the slit lengths plus a minimum spanning tree (edge-path distances) joining
-//! the slit openings and the negative-index zero points, each of which a cut must reach.
-use fieldtex_param::conformal::global_conformal;
+//! surface: the slit lengths plus the spanning tree of shortest edge paths joining the
+//! slit openings and the negative-index zero points, each of which a cut must reach
+//! ([`spanning_cut`], which the layout now cuts too).
+
+#[path = "common/mod.rs"]
+mod common;
+use fieldtex_param::conformal::cut_graph::spanning_cut;
 use std::collections::HashMap;
 
 fn main() -> Result<(), String> {
     for path in std::env::args().skip(1) {
-        let mesh =
-            fieldtex_io::read_mesh(std::path::Path::new(&path)).map_err(|e| e.to_string())?.mesh;
-        let mesh = fieldtex_mesh::repair(&mesh, &Default::default()).mesh;
-        let (comps, _) =
-            global_conformal(&mesh, &fieldtex_core::NoProgress).map_err(|e| e.to_string())?;
+        let (mesh, comps) = common::mapped(&path)?;
         for c in &comps {
             if !c.has_uv() {
                 continue;
@@ -107,112 +107,28 @@ fn main() -> Result<(), String> {
     Ok(())
 }
 
-/// `(slit length, MST length)` of the lower bound in the module docs, on the component's
-/// first `faces.len()` faces (the kept copy), in global positions.
+/// `(slit length, spanning tree length)` of the lower bound in the module docs: the
+/// slits' 3-D length and the edges [`spanning_cut`] cuts on the kept copy (the first
+/// `faces.len()` faces of the component mesh).
 fn cut_bound(pos: &[[f64; 3]], c: &fieldtex_param::conformal::ConformalComponent) -> (f64, f64) {
-    use std::cmp::Ordering;
-    use std::collections::BinaryHeap;
-    let g = |v: u32| c.local_to_global.get(v as usize).copied().unwrap_or(u32::MAX) as usize;
-    let lp = &c.local_mesh.positions;
-    let n = c.faces.len();
-    let nv = c.local_mesh.n_vertices();
-    let mut adj: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nv];
-    for t in &c.local_mesh.triangles[..n] {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let l = fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(lp[a], lp[b]));
-            adj[a].push((b, l));
-            adj[b].push((a, l));
-        }
-    }
-    // Terminals: each slit (its vertex set) and each negative-index zero point.
-    let mut terminals: Vec<Vec<usize>> = Vec::new();
-    let mut slit_len = 0.0;
-    if let Some(p) = &c.protrusion_slits {
-        for path in &p.slit_paths {
-            let local: Vec<usize> =
-                (0..nv).filter(|&v| path.contains(&(g(v as u32) as u32))).collect();
-            for w in path.windows(2) {
-                slit_len += fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(
-                    pos[w[0] as usize],
-                    pos[w[1] as usize],
-                ));
-            }
-            if !local.is_empty() {
-                terminals.push(local);
-            }
-        }
-    }
-    for &(v, i) in &c.map.zero_points {
-        if i < 0 && (v as usize) < nv {
-            terminals.push(vec![v as usize]);
-        }
-    }
-    #[derive(PartialEq)]
-    struct Item(f64, usize);
-    impl Eq for Item {}
-    impl PartialOrd for Item {
-        fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-            Some(self.cmp(o))
-        }
-    }
-    impl Ord for Item {
-        fn cmp(&self, o: &Self) -> Ordering {
-            o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
-        }
-    }
-    let dijkstra = |src: &[usize]| {
-        let mut d = vec![f64::INFINITY; nv];
-        let mut heap = BinaryHeap::new();
-        for &s in src {
-            d[s] = 0.0;
-            heap.push(Item(0.0, s));
-        }
-        while let Some(Item(dv, v)) = heap.pop() {
-            if dv > d[v] {
-                continue;
-            }
-            for &(w, l) in &adj[v] {
-                if dv + l < d[w] {
-                    d[w] = dv + l;
-                    heap.push(Item(d[w], w));
-                }
-            }
-        }
-        d
-    };
-    let m = terminals.len();
-    let dist: Vec<Vec<f64>> = terminals
-        .iter()
-        .map(|t| {
-            let d = dijkstra(t);
-            terminals
-                .iter()
-                .map(|u| u.iter().map(|&v| d[v]).fold(f64::INFINITY, f64::min))
-                .collect()
+    let lm = &c.local_mesh;
+    let topo = fieldtex_mesh::Topology::build(lm.n_vertices(), &lm.triangles);
+    let kept: Vec<bool> = (0..lm.n_triangles()).map(|f| f < c.faces.len()).collect();
+    let zeros: Vec<u32> = c.map.zero_points.iter().filter(|z| z.1 < 0).map(|z| z.0).collect();
+    let cut = spanning_cut(&lm.positions, &topo, &kept, &zeros);
+    let len = |a: [f64; 3], b: [f64; 3]| fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(a, b));
+    let tree: f64 = (0..topo.n_edges())
+        .filter(|&e| cut[e])
+        .map(|e| {
+            len(lm.positions[topo.edges[e][0] as usize], lm.positions[topo.edges[e][1] as usize])
         })
-        .collect();
-    // Prim.
-    let mut in_tree = vec![false; m];
-    let mut best = vec![f64::INFINITY; m];
-    let mut total = 0.0;
-    if m > 0 {
-        best[0] = 0.0;
-    }
-    for _ in 0..m {
-        let Some(u) = (0..m).filter(|&i| !in_tree[i]).min_by(|&a, &b| best[a].total_cmp(&best[b]))
-        else {
-            break;
-        };
-        in_tree[u] = true;
-        if best[u].is_finite() {
-            total += best[u];
-        }
-        for v in 0..m {
-            if !in_tree[v] && dist[u][v] < best[v] {
-                best[v] = dist[u][v];
-            }
-        }
-    }
-    (slit_len, total)
+        .sum();
+    let slits: f64 = c
+        .protrusion_slits
+        .iter()
+        .flat_map(|p| &p.slit_paths)
+        .flat_map(|path| path.windows(2))
+        .map(|w| len(pos[w[0] as usize], pos[w[1] as usize]))
+        .sum();
+    (slits, tree)
 }
