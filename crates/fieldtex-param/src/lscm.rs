@@ -588,8 +588,9 @@ mod tests {
         // A shear is not conformal: a weak anchor undoes most of it, a heavy one keeps it.
         let sheared: Vec<[f64; 2]> = anchor.iter().map(|p| [p[0] + 0.5 * p[1], p[1]]).collect();
         let shear_left = |uv: &[[f64; 2]]| {
-            let (i, j) = (chart.vertex_global.iter().position(|&v| v == 0).unwrap(), 1usize);
-            let j = chart.vertex_global.iter().position(|&v| v as usize == j).unwrap();
+            // Local ids of mesh vertices 0 and 1, the grid's first edge.
+            let local = |g: u32| chart.vertex_global.iter().position(|&v| v == g).unwrap();
+            let (i, j) = (local(0), local(1));
             let d = |p: &[[f64; 2]]| [p[j][0] - p[i][0], p[j][1] - p[i][1]];
             let (a, b) = (d(uv), d(&sheared));
             ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
