@@ -22,12 +22,11 @@
 //!
 //! The gain comes only from the free chart boundaries (with the boundary held, the
 //! polish changes nothing), so the two sides of every seam move apart a little and a
-//! first-order similarity ghost no longer continues a chart exactly: the seam colour
-//! jump rises (koala 1.06 → 1.27, fandisk 0.77 → 1.14, horse 1.40 → 1.50 over five
-//! seeds), where the translation ghosts of the integrated map were exact. So the polish
-//! runs only where the integrated map's angle distortion away from singularities is
-//! above [`POLISH_ABOVE`]; below it the exact seams are worth more than the last
-//! percent of conformality.
+//! first-order similarity ghost no longer continues a chart exactly, where the
+//! translation ghosts of the integrated map were exact: the seam colour jump rises
+//! (docs/conformal.md, session 16). So the polish runs only where the integrated map's
+//! angle distortion away from singularities is above [`POLISH_ABOVE`]; below it the
+//! exact seams are worth more than the last percent of conformality.
 
 use super::ComponentMap;
 use super::mass_spring::{MapDistortion, map_distortion};
@@ -41,15 +40,13 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 /// Weight of the data term that holds each chart near the holomorphic map, relative to
-/// the LSCM energy (both in squared UV units; see [`crate::lscm::lscm_anchored`]). On the
-/// shared meshes 3·10⁻⁴ lowers both the angle and the area distortion; 10⁻² keeps too
-/// much of the holomorphic map's angle error, 10⁻⁵ lets the conformal factor drift
-/// (docs/conformal.md, session 16).
+/// the LSCM energy (both in squared UV units; see [`crate::lscm::lscm_anchored`]): much
+/// heavier keeps the holomorphic map's angle error, much lighter lets the conformal
+/// factor drift (the sweep is in docs/conformal.md, session 16).
 pub const POLISH_WEIGHT: f64 = 3e-4;
 
 /// Mean angle distortion `σ1/σ2` away from singularities above which a map is polished
-/// (module docs). The shared meshes' integrated maps lie at 1.028–1.030 (bunny, horse,
-/// torus) and 1.054–1.074 (bust, koala, fandisk, armadillo, fertility).
+/// (module docs).
 pub const POLISH_ABOVE: f64 = 1.04;
 
 /// Parameters of [`polish_layout`].

@@ -9,10 +9,8 @@
 //! the critical trajectories; the patches then grow over both as before
 //! ([`super::translation_patches`]), whose overlap guard still cuts where the
 //! development would overlap itself. Without it a growing patch closes each opening
-//! wherever its own fronts meet, which on the shared meshes made most of the seam
-//! length (docs/conformal.md, session 16): the spanning tree is 55–60 % of that.
-//! The trajectories stay: seams along them are straight in the image, and the seam
-//! colour jump was lower with them than with the tree alone.
+//! wherever its own fronts meet, which made most of the seam length on the shared
+//! meshes; the trajectories stay besides the tree (docs/conformal.md, session 16).
 
 use super::homology_loops::{edge_lengths, shortest_path_forest};
 use super::tree_cotree::vertex_edges;

@@ -37,9 +37,9 @@ use std::path::{Path, PathBuf};
 /// with whole patches; 1.25, 1.5 and 3 were no better (docs/conformal.md).
 pub const PATCH_SPLIT_SPREAD: f64 = 2.0;
 
-/// Texels over which the seam feathering fades (`GeometryImage::feather_seams`). The
-/// correction falls by about a fifth per texel, so 4 and 8 gave the same colour jumps
-/// (horse, armadillo, koala; session 16).
+/// Texels over which the seam feathering fades (`GeometryImage::feather_seams`); the
+/// correction falls by about a fifth per texel, so a longer fade changes nothing
+/// (docs/conformal.md, session 16).
 pub const SEAM_FEATHER_BAND: usize = 4;
 
 /// Options of [`conformal`].
