@@ -107,16 +107,18 @@ pub fn polish_layout(
     }
     let before = map_distortion(mesh, n, &map.corner[..n], slit);
     let away_before = map_distortion(mesh, n, &map.corner[..n], near).angle_mean;
+    // The map left as it was.
+    let unchanged = |charts: usize, charts_kept: usize| PolishStats {
+        charts,
+        charts_kept,
+        applied: false,
+        away_before,
+        away_after: away_before,
+        before,
+        after: before,
+    };
     if away_before.is_nan() || away_before <= above {
-        return Some(PolishStats {
-            charts: 0,
-            charts_kept: 0,
-            applied: false,
-            away_before,
-            away_after: away_before,
-            before,
-            after: before,
-        });
+        return Some(unchanged(0, 0));
     }
     let (split, anchor) = split_by_chart(mesh, n, map);
     let topo = Topology::build(split.n_vertices(), &split.triangles);
@@ -164,24 +166,16 @@ pub fn polish_layout(
         }
     }
     let after = map_distortion(mesh, n, &moved, slit);
-    let applied = kept < n_charts && after.flipped == 0 && after.angle_mean < before.angle_mean;
-    if !applied {
-        return Some(PolishStats {
-            charts: n_charts,
-            charts_kept: kept,
-            applied,
-            away_before,
-            away_after: away_before,
-            before,
-            after: before,
-        });
+    let lower = after.angle_mean.partial_cmp(&before.angle_mean) == Some(std::cmp::Ordering::Less);
+    if kept == n_charts || after.flipped > 0 || !lower {
+        return Some(unchanged(n_charts, kept));
     }
     let away_after = map_distortion(mesh, n, &moved, near).angle_mean;
     repack_with_similarity_ghosts(mesh, n, map, original, moved);
     Some(PolishStats {
         charts: n_charts,
         charts_kept: kept,
-        applied,
+        applied: true,
         away_before,
         away_after,
         before,

@@ -88,19 +88,14 @@ pub(super) fn component_json(
             // substitute for the paper's closed critical trajectories.
             v["homology_loop_cut_edges"] = json!(count(&c.map.loop_cut));
             v["small_patches_from_overlap_guard"] = json!(c.map.small_patches);
-            v["ghost_faces"] = json!(c.map.ghosts.len());
             v["folded_faces_own_chart"] = json!(c.map.folded_faces);
             v["patch_merges"] = json!(c.map.patch_merges);
             v["stretch_cv_best_basis_form"] = json!(c.map.stretch_cv.map(|x| x[0]));
             v["stretch_cv_optimised_form"] = json!(c.map.stretch_cv.map(|x| x[1]));
-            if let Some(img) = img {
-                v["margin_links"] = json!(img.links.len() / 2);
-            }
         }
-        if c.method != ConformalMethod::CriticalTrajectoryPatches
-            && c.polish.is_some_and(|p| p.applied)
-        {
-            // The polished cylinder is one chart whose margins are drawn by ghosts.
+        // Layouts whose margins are drawn by ghosts: patch layouts, and the polished
+        // cylinder (one chart, no longer periodic).
+        if c.method == ConformalMethod::CriticalTrajectoryPatches || !c.map.ghosts.is_empty() {
             v["ghost_faces"] = json!(c.map.ghosts.len());
             if let Some(img) = img {
                 v["margin_links"] = json!(img.links.len() / 2);
