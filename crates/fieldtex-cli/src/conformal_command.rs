@@ -38,6 +38,13 @@ pub struct ConformalArgs {
     /// default the texels on the two sides of a cut meet halfway, faded over 4 texels).
     #[arg(long)]
     no_seam_feather: bool,
+    /// Split every triangle into four (same surface) where the mesh is too coarse for a
+    /// conformal map: `auto` refines while the map's mean angle distortion (σ1/σ2, away
+    /// from zero points and slits) is above 1.04, up to 2 levels and 160K triangles;
+    /// `0` keeps the input's triangles; `1`–`3` refine that many times. The refined mesh
+    /// is what model.glb holds.
+    #[arg(long, default_value = "auto")]
+    refine: fieldtex::Refine,
     /// Number of exemplar scale levels.
     #[arg(long, default_value_t = 6)]
     levels: usize,
@@ -68,6 +75,7 @@ pub fn run(
         protrusion_slits: !args.no_protrusion_slits,
         polish: !args.no_polish,
         seam_feather: !args.no_seam_feather,
+        refine: args.refine,
         levels: args.levels,
         scale: args.scale,
         patch_size: args.patch_size,

@@ -92,6 +92,9 @@ fn torus_and_tube_end_to_end_deterministic() {
     assert_eq!(c["method"], "holomorphic-torus");
     assert_eq!(c["zero_points"], 0);
     assert_eq!(c["distortion"]["flipped"], 0);
+    // This coarse torus (2 304 triangles) is refined once, so the thread-count equality
+    // above covers the refined path too.
+    assert_eq!(r["metrics"]["refinement"]["levels"], 1, "{}", r["metrics"]["refinement"]);
     // Seams are continuous: the colour jump across them is of the order of the jump
     // between neighbouring texels inside the image.
     let ratio = r["metrics"]["seams"]["ratio"].as_f64().unwrap();
@@ -209,14 +212,15 @@ fn quasi_isometric_relaxes_a_patch_layout() {
 }
 
 /// The conformal polish on a coarse CAD mesh (fandisk, a slit cylinder whose integrated
-/// map is 1.06 away from its slits): applied by default, the angle distortion away from
+/// map is 1.06 away from its slits), on the input's triangles: applied by default, the angle distortion away from
 /// singularities within 1.05, no folds, the cylinder one chart with margin links;
 /// `--no-polish` keeps the integrated periodic map.
 #[test]
 fn fandisk_is_polished_within_the_angle_target() {
     let mesh = shared().join("meshes/fandisk.obj");
     let d = tmp("fandisk-polish");
-    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
+    // On the input's triangles (the default refines fandisk first; see the next test).
+    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet", "--refine", "0"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let r = report(&d);
     let c = &r["metrics"]["components"][0];
@@ -232,15 +236,77 @@ fn fandisk_is_polished_within_the_angle_target() {
     // Its margins are feathered by default, not with --no-seam-feather.
     assert!(r["metrics"]["quilting"][0]["feathered_pairs"].as_u64().unwrap() > 0);
     let d3 = tmp("fandisk-no-feather");
-    let out = conformal(&mesh, &pebbles(), &d3, &["--size", "256", "--quiet", "--no-seam-feather"]);
+    let out = conformal(
+        &mesh,
+        &pebbles(),
+        &d3,
+        &["--size", "256", "--quiet", "--no-seam-feather", "--refine", "0"],
+    );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(report(&d3)["metrics"]["quilting"][0]["feathered_pairs"], 0);
     let d2 = tmp("fandisk-no-polish");
-    let out = conformal(&mesh, &pebbles(), &d2, &["--size", "256", "--quiet", "--no-polish"]);
+    let out = conformal(
+        &mesh,
+        &pebbles(),
+        &d2,
+        &["--size", "256", "--quiet", "--no-polish", "--refine", "0"],
+    );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let c2 = &report(&d2)["metrics"]["components"][0];
     assert!(c2["polish"].is_null());
     assert!(c2["lattice"]["a"].is_number());
     let away2 = c2["distortion"]["angle_mean_away_from_singularities"].as_f64().unwrap();
     assert!((away2 - before).abs() < 1e-9);
+}
+
+/// Refinement of a coarse mesh (koala-lowres, 7K triangles, whose polished map is 1.047
+/// away from singularities on its own triangles): `auto` splits it once, the map on the
+/// refined mesh is within 1.04 and `model.glb` holds the refined triangles with normals;
+/// `--refine 0` keeps the input's triangles; levels beyond 3 or a refinement past the
+/// hard limit exit 2.
+#[test]
+fn a_coarse_mesh_is_refined_until_the_map_is_conformal() {
+    let mesh = shared().join("meshes/koala-lowres.obj");
+    let d = tmp("koala-refine");
+    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&d);
+    let refinement = &r["metrics"]["refinement"];
+    let n_in = r["input"]["triangles"].as_u64().unwrap();
+    assert_eq!(refinement["mode"], "auto");
+    assert_eq!(refinement["levels"], 1, "{refinement}");
+    assert_eq!(refinement["triangles"].as_u64(), Some(4 * n_in));
+    let by_level = refinement["angle_mean_away_by_level"].as_array().unwrap();
+    let (coarse, refined) = (by_level[0].as_f64().unwrap(), by_level[1].as_f64().unwrap());
+    assert!(coarse > fieldtex::REFINE_ABOVE && refined <= fieldtex::REFINE_ABOVE, "{refinement}");
+    let c = &r["metrics"]["components"][0];
+    assert_eq!(c["triangles"].as_u64(), Some(4 * n_in));
+    let away = c["distortion"]["angle_mean_away_from_singularities"].as_f64().unwrap();
+    assert!((away - refined).abs() < 1e-12, "{c}");
+    assert_eq!(c["distortion"]["flipped"], 0);
+    let glb = fieldtex::crates::io::read_mesh(&d.join("model.glb")).unwrap().mesh;
+    assert_eq!(glb.n_triangles() as u64, 4 * n_in);
+    assert!(glb.vertex_normals.is_some());
+
+    let d0 = tmp("koala-refine-0");
+    let out = conformal(&mesh, &pebbles(), &d0, &["--size", "256", "--quiet", "--refine", "0"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r0 = report(&d0);
+    assert_eq!(r0["metrics"]["refinement"]["levels"], 0);
+    assert_eq!(r0["metrics"]["components"][0]["triangles"].as_u64(), Some(n_in));
+    let away0 = r0["metrics"]["components"][0]["distortion"]["angle_mean_away_from_singularities"]
+        .as_f64()
+        .unwrap();
+    assert!((away0 - coarse).abs() < 1e-12);
+
+    for bad in ["4", "-1", "lots"] {
+        let out =
+            conformal(&mesh, &pebbles(), &tmp("koala-refine-bad"), &["--quiet", "--refine", bad]);
+        assert_eq!(out.status.code(), Some(2), "--refine {bad}");
+    }
+    // 7K × 4³ stays below the hard limit; the horse (97K) × 4³ does not.
+    let horse = shared().join("meshes/horse.ply");
+    let out = conformal(&horse, &pebbles(), &tmp("horse-refine-3"), &["--quiet", "--refine", "3"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--refine 3"));
 }

@@ -155,9 +155,11 @@ pub fn cube(n: usize) -> TriMesh {
     TriMesh::new(positions, triangles)
 }
 
-/// Splits every triangle into four through its edge midpoints (1→4 subdivision,
-/// positions only; attributes are dropped). Shared edges get one shared midpoint, so
-/// the result keeps the input's topology.
+/// Splits every triangle into four through its edge midpoints (1→4 subdivision). Shared
+/// edges get one shared midpoint, so the result keeps the input's topology, and the
+/// surface is unchanged (every new vertex lies on an input edge). Vertex normals and
+/// colours, when present, are carried: a midpoint gets the mean of its edge's two ends
+/// (normals renormalised; a zero mean keeps the first end's); corner UVs are dropped.
 pub fn subdivide_midpoint(mesh: &TriMesh) -> TriMesh {
     let topo = crate::Topology::build(mesh.n_vertices(), &mesh.triangles);
     let nv = mesh.n_vertices();
@@ -176,7 +178,26 @@ pub fn subdivide_midpoint(mesh: &TriMesh) -> TriMesh {
         triangles.push([t[2], m[2], m[1]]);
         triangles.push([m[0], m[1], m[2]]);
     }
-    TriMesh::new(positions, triangles)
+    let mut out = TriMesh::new(positions, triangles);
+    out.vertex_normals = mesh.vertex_normals.as_ref().map(|n| {
+        let mut all = n.clone();
+        all.extend(topo.edges.iter().map(|e| {
+            let (a, b) = (n[e[0] as usize], n[e[1] as usize]);
+            let m = [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+            let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+            if len > 0.0 && len.is_finite() { m.map(|x| x / len) } else { a }
+        }));
+        all
+    });
+    out.vertex_colors = mesh.vertex_colors.as_ref().map(|c| {
+        let mut all = c.clone();
+        all.extend(topo.edges.iter().map(|e| {
+            let (a, b) = (c[e[0] as usize], c[e[1] as usize]);
+            [0, 1, 2, 3].map(|i| 0.5 * (a[i] + b[i]))
+        }));
+        all
+    });
+    out
 }
 
 #[cfg(test)]
@@ -218,5 +239,47 @@ mod tests {
             let dot: f64 = (0..3).map(|k| nrm[k] * centre[k]).sum();
             assert!(dot > 0.0, "inward triangle {t:?}");
         }
+    }
+
+    #[test]
+    fn midpoint_subdivision_keeps_the_surface_and_carries_normals_and_colours() {
+        let mut m = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            vec![[0, 1, 2], [0, 3, 1]],
+        );
+        m.vertex_normals =
+            Some(vec![[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]);
+        m.vertex_colors =
+            Some(vec![[0.0, 0.0, 0.0, 1.0], [1.0, 1.0, 1.0, 1.0], [0.2; 4], [0.4; 4]]);
+        let r = subdivide_midpoint(&m);
+        assert_eq!((r.n_vertices(), r.n_triangles()), (4 + 5, 8));
+        assert_eq!(euler(&r), euler(&m));
+        let n = r.vertex_normals.as_ref().expect("normals carried");
+        let c = r.vertex_colors.as_ref().expect("colours carried");
+        assert_eq!((n.len(), c.len()), (9, 9));
+        let topo = Topology::build(m.n_vertices(), &m.triangles);
+        for (e, ends) in topo.edges.iter().enumerate() {
+            let v = 4 + e;
+            let (a, b) = (ends[0] as usize, ends[1] as usize);
+            for k in 0..3 {
+                // The midpoint lies on its edge.
+                assert!(
+                    (r.positions[v][k] - 0.5 * (m.positions[a][k] + m.positions[b][k])).abs()
+                        < 1e-15
+                );
+            }
+            let len = n[v].iter().map(|x| x * x).sum::<f64>().sqrt();
+            assert!((len - 1.0).abs() < 1e-12, "midpoint normal not unit: {:?}", n[v]);
+            assert!((c[v][0] - 0.5 * (c[a][0] + c[b][0])).abs() < 1e-7);
+        }
+        // Edge (0, 1): both ends face +z, so its midpoint does too.
+        let e01 =
+            topo.edges.iter().position(|e| e[0].min(e[1]) == 0 && e[0].max(e[1]) == 1).unwrap();
+        assert_eq!(n[4 + e01], [0.0, 0.0, 1.0]);
+        assert!(
+            subdivide_midpoint(&TriMesh::new(m.positions.clone(), m.triangles.clone()))
+                .vertex_normals
+                .is_none()
+        );
     }
 }

@@ -29,7 +29,9 @@ pub use fieldtex_core::{Image, NoProgress, Progress, Warning};
 pub use outputs::{guard_output, write_text};
 pub use pipelines::align::{AlignOptions, align, align_in_memory};
 pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
-pub use pipelines::conformal::{ConformalOptions, conformal};
+pub use pipelines::conformal::{
+    ConformalOptions, REFINE_ABOVE, REFINE_MAX_LEVELS, REFINE_MAX_TRIANGLES, Refine, conformal,
+};
 pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};
 pub use pipelines::eval::{Guidance, ImageMetrics, SeamCoordinates, eval_files};

@@ -213,6 +213,22 @@ impl ConformalComponent {
         !self.corner_uv.is_empty()
     }
 
+    /// Area-weighted mean σ1/σ2 of the map away from zero points and slits (the faces
+    /// of [`Self::near_singularity`] skipped); `None` without a map.
+    pub fn angle_mean_away(&self) -> Option<f64> {
+        if !self.has_uv() {
+            return None;
+        }
+        let near = &self.near_singularity;
+        let d = mass_spring::map_distortion(
+            &self.local_mesh,
+            self.faces.len(),
+            &self.corner_uv,
+            &|f| near[f],
+        );
+        Some(d.angle_mean)
+    }
+
     /// Recomputes `corner_uv`, `slit` and `domain` from `map` (after relaxation).
     fn refresh(&mut self) {
         let nf = self.faces.len();

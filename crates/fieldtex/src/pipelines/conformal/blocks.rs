@@ -121,6 +121,8 @@ pub(super) fn assemble(mesh: &TriMesh, blocks: &[Block]) -> (Image, TriMesh) {
     }
     let mut out = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
     out.uvs = Some(CornerUvs { values, indices });
+    // The input's normals (or the refinement's interpolated ones) shade the output.
+    out.vertex_normals = mesh.vertex_normals.clone();
     (tex, out)
 }
 

@@ -1,7 +1,8 @@
 //! `fieldtex conformal` (paper C: Wang, Gu, Mueller & Yau 2005): uniform texture
 //! synthesis on a global conformal parameterisation.
 //!
-//! Read → repair → global conformal map per component (`fieldtex_param::conformal`) →
+//! Read → repair → global conformal map per component (`fieldtex_param::conformal`),
+//! on the mesh refined where it is too coarse for a conformal map (`refinement.rs`) →
 //! optional quasi-isometric relaxation → one geometry image per component with its `τ`
 //! map → multi-scale quilting with graph-cut seams and periodic margins
 //! (`fieldtex_synth::quilt`) → images stacked into one texture → `model.glb`,
@@ -15,17 +16,15 @@ use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
 use fieldtex_mesh::TriMesh;
-use fieldtex_param::conformal::conformal_polish::PolishOptions;
-use fieldtex_param::conformal::holomorphic_map::LayoutOptions;
-use fieldtex_param::conformal::{
-    ConformalComponent, GeometryImage, MapOptions, MassSpringOptions, global_conformal_with,
-};
+use fieldtex_param::conformal::{ConformalComponent, GeometryImage, MassSpringOptions};
 use serde::Serialize;
 
 mod blocks;
+mod refinement;
 mod report;
 mod stages;
 use blocks::{assemble, fallback_atlas, write_keep};
+pub use refinement::{REFINE_ABOVE, REFINE_MAX_LEVELS, REFINE_MAX_TRIANGLES, Refine};
 use report::add_notes;
 use serde_json::json;
 use stages::{RunParts, check_options, conformal_metrics, exemplar_levels, quilt_blocks};
@@ -66,6 +65,9 @@ pub struct ConformalOptions {
     /// (`fieldtex_param::conformal::GeometryImage::feather_seams`, band
     /// [`SEAM_FEATHER_BAND`]). Default true.
     pub seam_feather: bool,
+    /// Midpoint subdivision of coarse meshes before the map (`refinement.rs`): `Auto`
+    /// refines while the map's angle distortion is above [`REFINE_ABOVE`]. Default `Auto`.
+    pub refine: Refine,
     /// Number of exemplar levels. Default 6.
     pub levels: usize,
     /// Exemplar texels per texture texel where `τ` is at its reference (the 5th
@@ -89,6 +91,7 @@ impl Default for ConformalOptions {
             protrusion_slits: true,
             polish: true,
             seam_feather: true,
+            refine: Refine::Auto,
             levels: 6,
             scale: 1.0,
             patch_size: 40,
@@ -148,26 +151,13 @@ pub fn conformal(
         "exemplar_size": [exemplar.width, exemplar.height],
     });
 
-    // 1. Global conformal parameterisation, per component.
-    let (mut comps, warnings) = report
-        .stage(progress, "conformal-map", || {
-            // Quasi-isometric relaxation wants the freedom of more charts: no spanning cut.
-            let layout =
-                LayoutOptions { spanning_cut: !options.quasi_isometric, ..Default::default() };
-            let map = MapOptions { protrusion_slits: options.protrusion_slits, layout };
-            global_conformal_with(&mesh, &map, progress)
-        })
-        .map_err(|e| Error::classify(&e, None, "conformal map"))?;
-    report.warnings.extend(warnings);
-    crate::outputs::check_cancelled(progress)?;
-    // 2. Conformal polish of the charts, or the optional quasi-isometric relaxation.
-    if options.polish && !options.quasi_isometric {
-        report.stage(progress, "conformal-polish", || {
-            for c in comps.iter_mut() {
-                c.polish_conformal(&PolishOptions::default());
-            }
-        });
-    }
+    // 1–2. Global conformal parameterisation per component and the conformal polish,
+    // on the mesh refined where it is too coarse for a conformal piecewise-linear map.
+    let mapped = refinement::map_refined(mesh, options, &mut report, progress)?;
+    let (mesh, mut comps) = (mapped.mesh, mapped.comps);
+    report.warnings.extend(mapped.warnings);
+    report.metric("refinement", &mapped.summary);
+    // The optional quasi-isometric relaxation.
     let mut relax_stats = Vec::new();
     if options.quasi_isometric {
         report.stage(progress, "mass-spring", || {

@@ -75,10 +75,9 @@ pub(super) fn component_json(
         "note": c.note,
     });
     if c.has_uv() {
-        let near = c.near_singularity.clone();
         let slit = c.slit.clone();
         let all = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &move |f| slit[f]);
-        let away = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &move |f| near[f]);
+        let away = c.angle_mean_away();
         v["patches"] = json!(c.map.n_patches());
         if c.method == ConformalMethod::CriticalTrajectoryPatches {
             v["critical_trajectories"] = json!(c.map.cut_curves.len());
@@ -109,7 +108,7 @@ pub(super) fn component_json(
                 .collect::<Vec<_>>()
         );
         v["lattice"] = json!({"a": c.lattice.a, "b": c.lattice.b});
-        v["distortion"] = json!({"angle_mean_away_from_singularities": away.angle_mean, "angle_mean_non_slit": all.angle_mean, "log_area_std": all.log_area_std, "flipped": all.flipped});
+        v["distortion"] = json!({"angle_mean_away_from_singularities": away, "angle_mean_non_slit": all.angle_mean, "log_area_std": all.log_area_std, "flipped": all.flipped});
         if all.flipped > 0 {
             v["distortion"]["flipped_examples"] = json!(flipped_examples(c, 8));
         }

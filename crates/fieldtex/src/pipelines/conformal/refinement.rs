@@ -1,0 +1,195 @@
+//! The conformal map with refinement of coarse meshes (`--refine`).
+//!
+//! A piecewise-linear map cannot be conformal where a coarse mesh bends: every vertex
+//! carries its angle defect (the discrete Gaussian curvature), and the triangles of its
+//! ring absorb it as angle distortion. This is the floor the holomorphic map and the
+//! conformal polish reach on coarse meshes (σ1/σ2 1.055–1.11 on fertility, the
+//! armadillo and spot at any polish weight; docs/conformal.md, session 16). Splitting
+//! every triangle into four through its edge midpoints
+//! (`fieldtex_mesh::primitives::subdivide_midpoint`) leaves the surface as it is (every
+//! new vertex lies on an input edge and is flat), but each ring that absorbs a defect
+//! covers a quarter of the area, so the map bends less of the surface. The refined mesh
+//! is the one written to `model.glb`; it carries the input's vertex normals (or
+//! area-weighted ones when it has none) interpolated along the edges, so its shading
+//! matches the input's.
+//!
+//! `auto` (the default): map and polish; while a component's mean σ1/σ2 away from zero
+//! points and slits exceeds [`REFINE_ABOVE`] and the refined mesh stays within
+//! [`REFINE_MAX_TRIANGLES`], refine once more and map again, at most
+//! [`REFINE_MAX_LEVELS`] times. Not with the quasi-isometric relaxation, which trades
+//! angle distortion for area on purpose. `--refine N` refines exactly `N` times first.
+//! Face `f` of the input is faces `4f … 4f + 3` after one level (so face ids in the
+//! report refer to the refined mesh); vertex ids of the input are kept.
+
+use super::ConformalOptions;
+use crate::{Error, Progress, Report, Result};
+use fieldtex_core::Warning;
+use fieldtex_mesh::{NormalWeighting, TriMesh, primitives::subdivide_midpoint, vertex_normals};
+use fieldtex_param::conformal::conformal_polish::PolishOptions;
+use fieldtex_param::conformal::holomorphic_map::LayoutOptions;
+use fieldtex_param::conformal::{ConformalComponent, MapOptions, global_conformal_with};
+use serde::{Serialize, Serializer};
+
+/// `auto` refines while a component's mean σ1/σ2 away from singularities is above this
+/// (the issue's target is 1.05; the polish threshold is the same 1.04).
+pub const REFINE_ABOVE: f64 = 1.04;
+
+/// `auto` never refines past this many triangles (the 388K-triangle horse ×4 took
+/// 18.8 s and 1 GB; 160K keeps a run of the armadillo, 29K → 117K, near 5 s).
+pub const REFINE_MAX_TRIANGLES: usize = 160_000;
+
+/// `auto` refines at most this many times (×16 triangles).
+pub const REFINE_MAX_LEVELS: usize = 2;
+
+/// An explicit `--refine N` may not produce more triangles than this.
+pub const REFINE_HARD_LIMIT: usize = 4_000_000;
+
+/// How many times the mesh is split 1→4 before (or while) it is mapped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Refine {
+    /// Refine while the map's angle distortion says the mesh is too coarse.
+    #[default]
+    Auto,
+    /// Exactly this many levels (0 keeps the input's triangles).
+    Levels(u8),
+}
+
+impl Serialize for Refine {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            Refine::Auto => s.serialize_str("auto"),
+            Refine::Levels(n) => s.serialize_u8(*n),
+        }
+    }
+}
+
+impl std::str::FromStr for Refine {
+    type Err = String;
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        match text.trim() {
+            "auto" => Ok(Refine::Auto),
+            t => match t.parse::<u8>() {
+                Ok(n) if n <= 3 => Ok(Refine::Levels(n)),
+                _ => Err(format!("expected auto or a level count 0..=3, got {t:?}")),
+            },
+        }
+    }
+}
+
+/// What the refinement did, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub(super) struct RefinementSummary {
+    pub mode: Refine,
+    pub levels: usize,
+    pub triangles_in: usize,
+    pub triangles: usize,
+    /// Per mapped level: the largest component mean σ1/σ2 away from singularities.
+    pub angle_mean_away_by_level: Vec<Option<f64>>,
+    pub method: &'static str,
+}
+
+/// The mapped (and polished) mesh: possibly refined, its components, the map's warnings.
+pub(super) struct Mapped {
+    pub mesh: TriMesh,
+    pub comps: Vec<ConformalComponent>,
+    pub warnings: Vec<Warning>,
+    pub summary: RefinementSummary,
+}
+
+/// Maps `mesh` per component (and polishes unless the options say not to), refining it
+/// first or in between as `options.refine` says (module docs).
+pub(super) fn map_refined(
+    mesh: TriMesh,
+    options: &ConformalOptions,
+    report: &mut Report,
+    progress: &dyn Progress,
+) -> Result<Mapped> {
+    let triangles_in = mesh.n_triangles();
+    let mut mesh = mesh;
+    let mut levels = 0usize;
+    if let Refine::Levels(n) = options.refine {
+        let n = n as usize;
+        if triangles_in.saturating_mul(4usize.pow(n as u32)) > REFINE_HARD_LIMIT {
+            return Err(Error::bad_input(
+                Some(&options.mesh),
+                format!(
+                    "--refine {n} would make {} triangles from {triangles_in} (limit {REFINE_HARD_LIMIT}); \
+                     use a smaller level or --refine auto",
+                    triangles_in.saturating_mul(4usize.pow(n as u32))
+                ),
+            ));
+        }
+        for _ in 0..n {
+            mesh = report.stage(progress, "refine", || refine_once(&mesh));
+            levels += 1;
+        }
+    }
+    let auto = options.refine == Refine::Auto && !options.quasi_isometric;
+    let mut by_level = Vec::new();
+    loop {
+        let (comps, warnings) = map_once(&mesh, options, report, progress, levels)?;
+        let worst = comps
+            .iter()
+            .filter_map(ConformalComponent::angle_mean_away)
+            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
+        by_level.push(worst);
+        let coarse = worst.is_some_and(|w| w > REFINE_ABOVE);
+        let room = mesh.n_triangles().saturating_mul(4) <= REFINE_MAX_TRIANGLES;
+        if !(auto && coarse && room && levels < REFINE_MAX_LEVELS) {
+            let summary = RefinementSummary {
+                mode: options.refine,
+                levels,
+                triangles_in,
+                triangles: mesh.n_triangles(),
+                angle_mean_away_by_level: by_level,
+                method: "midpoint subdivision (1→4 per level; same surface)",
+            };
+            return Ok(Mapped { mesh, comps, warnings, summary });
+        }
+        crate::outputs::check_cancelled(progress)?;
+        mesh = report.stage(progress, "refine", || refine_once(&mesh));
+        levels += 1;
+    }
+}
+
+/// One level of midpoint subdivision, with vertex normals carried (area-weighted ones
+/// computed first when the mesh has none, as `model.glb` would get).
+fn refine_once(mesh: &TriMesh) -> TriMesh {
+    if mesh.vertex_normals.is_some() {
+        return subdivide_midpoint(mesh);
+    }
+    let mut with_normals = mesh.clone();
+    with_normals.vertex_normals = Some(vertex_normals(mesh, NormalWeighting::Area).0);
+    subdivide_midpoint(&with_normals)
+}
+
+/// The global conformal map of every component of `mesh`, polished unless
+/// `options.polish` is off or the run is quasi-isometric. Stages are timed as
+/// `conformal-map` / `conformal-polish`, with `-refined-N` after `N` refinements.
+fn map_once(
+    mesh: &TriMesh,
+    options: &ConformalOptions,
+    report: &mut Report,
+    progress: &dyn Progress,
+    levels: usize,
+) -> Result<(Vec<ConformalComponent>, Vec<Warning>)> {
+    let suffix = if levels == 0 { String::new() } else { format!("-refined-{levels}") };
+    let (mut comps, warnings) = report
+        .stage(progress, &format!("conformal-map{suffix}"), || {
+            // Quasi-isometric relaxation wants the freedom of more charts: no spanning cut.
+            let layout =
+                LayoutOptions { spanning_cut: !options.quasi_isometric, ..Default::default() };
+            let map = MapOptions { protrusion_slits: options.protrusion_slits, layout };
+            global_conformal_with(mesh, &map, progress)
+        })
+        .map_err(|e| Error::classify(&e, None, "conformal map"))?;
+    crate::outputs::check_cancelled(progress)?;
+    if options.polish && !options.quasi_isometric {
+        report.stage(progress, &format!("conformal-polish{suffix}"), || {
+            for c in comps.iter_mut() {
+                c.polish_conformal(&PolishOptions::default());
+            }
+        });
+    }
+    Ok((comps, warnings))
+}
