@@ -310,3 +310,72 @@ fn a_coarse_mesh_is_refined_until_the_map_is_conformal() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--refine 3"));
 }
+
+/// `auto` weighs components by area: a smooth torus (9 216 triangles, 1.027 away from
+/// singularities) beside a small box split into 192 triangles (a slit cylinder at 1.22)
+/// is not refined, although the box alone is far above the threshold.
+#[test]
+fn a_small_distorted_part_does_not_refine_the_scene() {
+    let d = tmp("scene-refine");
+    let mut text = torus_obj(96, 48, false);
+    let base = 96 * 48;
+    // A box of side 0.3 at x = 3, each face a 4 × 4 grid of quads; shared vertices by
+    // their rounded coordinates.
+    let (k, side) = (4usize, 0.3f64);
+    let mut ids: std::collections::BTreeMap<[i64; 3], usize> = Default::default();
+    let mut verts: Vec<[f64; 3]> = Vec::new();
+    let mut id = |p: [f64; 3]| -> usize {
+        let key = p.map(|c| (c * 1e6).round() as i64);
+        *ids.entry(key).or_insert_with(|| {
+            verts.push(p);
+            verts.len() - 1
+        })
+    };
+    let mut faces = Vec::new();
+    for axis in 0..3 {
+        for s in [0.0, 1.0] {
+            for i in 0..k {
+                for j in 0..k {
+                    let mut at = |a: usize, b: usize| {
+                        let mut q = [0.0; 3];
+                        q[axis] = s * side;
+                        q[(axis + 1) % 3] = a as f64 * side / k as f64;
+                        q[(axis + 2) % 3] = b as f64 * side / k as f64;
+                        id([q[0] + 3.0, q[1], q[2]])
+                    };
+                    let (a, b, c, e) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                    if s == 0.0 {
+                        faces.extend([[a, c, b], [a, e, c]]);
+                    } else {
+                        faces.extend([[a, b, c], [a, c, e]]);
+                    }
+                }
+            }
+        }
+    }
+    for p in &verts {
+        text += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for f in &faces {
+        text += &format!("f {} {} {}\n", f[0] + base + 1, f[1] + base + 1, f[2] + base + 1);
+    }
+    let mesh = d.join("scene.obj");
+    std::fs::write(&mesh, text).unwrap();
+    let o = d.join("o");
+    let out = conformal(&mesh, &pebbles(), &o, &["--size", "256", "--quiet"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&o);
+    let comps = r["metrics"]["components"].as_array().unwrap();
+    let away = |c: &serde_json::Value| {
+        c["distortion"]["angle_mean_away_from_singularities"].as_f64().unwrap()
+    };
+    assert_eq!(comps.len(), 2);
+    let (torus, bx) =
+        if comps[0]["triangles"] == 192 { (&comps[1], &comps[0]) } else { (&comps[0], &comps[1]) };
+    assert_eq!(bx["triangles"], 192, "{bx}");
+    assert!(away(bx) > 1.1 && away(torus) < fieldtex::REFINE_ABOVE, "{comps:?}");
+    let refinement = &r["metrics"]["refinement"];
+    assert_eq!(refinement["levels"], 0, "{refinement}");
+    let mean = refinement["angle_mean_away_by_level"][0].as_f64().unwrap();
+    assert!(mean > away(torus) && mean < fieldtex::REFINE_ABOVE, "{refinement}");
+}

@@ -230,7 +230,8 @@ pub fn conformal(
     Ok(report)
 }
 
-fn component_area(mesh: &TriMesh, c: &ConformalComponent) -> f64 {
+/// Surface area of `c`'s faces in `mesh`.
+pub(super) fn component_area(mesh: &TriMesh, c: &ConformalComponent) -> f64 {
     c.faces
         .iter()
         .map(|&f| {

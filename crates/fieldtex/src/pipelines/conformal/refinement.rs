@@ -13,8 +13,8 @@
 //! area-weighted ones when it has none) interpolated along the edges, so its shading
 //! matches the input's.
 //!
-//! `auto` (the default): map and polish; while a component's mean σ1/σ2 away from zero
-//! points and slits exceeds [`REFINE_ABOVE`] and the refined mesh stays within
+//! `auto` (the default): map and polish; while the mean σ1/σ2 away from zero points and
+//! slits (per component, averaged over the components by area) exceeds [`REFINE_ABOVE`] and the refined mesh stays within
 //! [`REFINE_MAX_TRIANGLES`], refine once more and map again, at most
 //! [`REFINE_MAX_LEVELS`] times. Not with the quasi-isometric relaxation, which trades
 //! angle distortion for area on purpose. `--refine N` refines exactly `N` times first.
@@ -83,7 +83,8 @@ pub(super) struct RefinementSummary {
     pub levels: usize,
     pub triangles_in: usize,
     pub triangles: usize,
-    /// Per mapped level: the largest component mean σ1/σ2 away from singularities.
+    /// Per mapped level: the components' mean σ1/σ2 away from singularities, weighted
+    /// by their areas (the value `auto` compares with [`REFINE_ABOVE`]).
     pub angle_mean_away_by_level: Vec<Option<f64>>,
     pub method: &'static str,
 }
@@ -128,12 +129,9 @@ pub(super) fn map_refined(
     let mut by_level = Vec::new();
     loop {
         let (comps, warnings) = map_once(&mesh, options, report, progress, levels)?;
-        let worst = comps
-            .iter()
-            .filter_map(ConformalComponent::angle_mean_away)
-            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
-        by_level.push(worst);
-        let coarse = worst.is_some_and(|w| w > REFINE_ABOVE);
+        let angle = area_weighted_angle(&mesh, &comps);
+        by_level.push(angle);
+        let coarse = angle.is_some_and(|w| w > REFINE_ABOVE);
         let room = mesh.n_triangles().saturating_mul(4) <= REFINE_MAX_TRIANGLES;
         if !(auto && coarse && room && levels < REFINE_MAX_LEVELS) {
             let summary = RefinementSummary {
@@ -150,6 +148,21 @@ pub(super) fn map_refined(
         mesh = report.stage(progress, "refine", || refine_once(&mesh));
         levels += 1;
     }
+}
+
+/// The components' mean σ1/σ2 away from singularities, weighted by their areas (so a
+/// small distorted part, e.g. a 12-triangle box beside a statue, does not refine the
+/// whole mesh); `None` when no component has a map.
+fn area_weighted_angle(mesh: &TriMesh, comps: &[ConformalComponent]) -> Option<f64> {
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for c in comps {
+        if let Some(a) = c.angle_mean_away() {
+            let area = super::component_area(mesh, c);
+            sum += a * area;
+            weight += area;
+        }
+    }
+    (weight > 0.0).then(|| sum / weight)
 }
 
 /// One level of midpoint subdivision, with vertex normals carried (area-weighted ones
