@@ -254,21 +254,10 @@ fn patch_orientation(patch: &[f32], k: usize) -> (f64, f64) {
     ((phi + 0.5 * PI).rem_euclid(PI), coherence)
 }
 
-/// Weighted quantile `q` of `(value, weight)` pairs (sorted by value here).
+/// Weighted quantile `q` of `(value, weight)` pairs (sorted by value here); NaN when
+/// there is no weight.
 fn weighted_quantile(pairs: &mut [(f64, f64)], q: f64) -> f64 {
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let total: f64 = pairs.iter().map(|p| p.1).sum();
-    if total.is_nan() || total <= 0.0 {
-        return f64::NAN;
-    }
-    let mut acc = 0.0;
-    for (v, w) in pairs.iter() {
-        acc += w;
-        if acc >= q * total {
-            return *v;
-        }
-    }
-    pairs.last().map_or(f64::NAN, |p| p.0)
+    fieldtex_linalg::stats::weighted_quantile(pairs, q).unwrap_or(f64::NAN)
 }
 
 /// Orientation error of a textured mesh against a tangent field, by tangent-plane

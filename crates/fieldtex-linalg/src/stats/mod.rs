@@ -17,6 +17,7 @@ mod kd_tree;
 mod kmeans;
 mod pearson;
 mod quantile_function;
+mod weighted_quantile;
 
 pub use cca::{Cca, CcaOptions, cca};
 pub use histogram_matching::{
@@ -27,6 +28,7 @@ pub use kd_tree::{KD_LEAF, KdScratch, KdTree};
 pub use kmeans::{KMeans, KMeansOptions, kmeans};
 pub use pearson::pearson;
 pub use quantile_function::QuantileFunction;
+pub use weighted_quantile::weighted_quantile;
 
 /// Rows per reduction chunk (fixed: the summation order does not depend on threads).
 pub(crate) const STATS_CHUNK: usize = 8192;

@@ -9,22 +9,7 @@ use fieldtex_param::distortion::triangle_jacobian;
 use serde::Serialize;
 use serde_json::json;
 
-/// Area-weighted quantile of `(value, weight)` pairs.
-pub(super) fn weighted_quantile(v: &mut [(f64, f64)], q: f64) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let total: f64 = v.iter().map(|x| x.1).sum();
-    let mut acc = 0.0;
-    for x in v.iter() {
-        acc += x.1;
-        if acc >= q * total {
-            return Some(x.0);
-        }
-    }
-    v.last().map(|x| x.0)
-}
+pub(super) use fieldtex_linalg::stats::weighted_quantile;
 
 #[derive(Serialize)]
 pub(super) struct TexelDensity {
