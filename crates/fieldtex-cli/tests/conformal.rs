@@ -287,6 +287,9 @@ fn a_coarse_mesh_is_refined_until_the_map_is_conformal() {
     let glb = fieldtex::crates::io::read_mesh(&d.join("model.glb")).unwrap().mesh;
     assert_eq!(glb.n_triangles() as u64, 4 * n_in);
     assert!(glb.vertex_normals.is_some());
+    // The user is told why the output has more triangles.
+    let told = r["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "conformal-refined");
+    assert!(told, "{}", r["warnings"]);
 
     let d0 = tmp("koala-refine-0");
     let out = conformal(&mesh, &pebbles(), &d0, &["--size", "256", "--quiet", "--refine", "0"]);
@@ -378,4 +381,40 @@ fn a_small_distorted_part_does_not_refine_the_scene() {
     assert_eq!(refinement["levels"], 0, "{refinement}");
     let mean = refinement["angle_mean_away_by_level"][0].as_f64().unwrap();
     assert!(mean > away(torus) && mean < fieldtex::REFINE_ABOVE, "{refinement}");
+}
+
+/// `auto` also refines where components have no valid map on the input's triangles: the
+/// painted stool (676 triangles in 13 parts, eight of them 8-triangle boxes whose map has
+/// nothing to solve and a seat whose map folds) keeps less of its surface on the
+/// fallback atlas after refinement.
+#[test]
+fn unmapped_parts_are_refined_until_they_map() {
+    let mesh = shared().join("textured/painted_wooden_stool/painted_wooden_stool_1k.gltf");
+    let d = tmp("stool-refine");
+    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&d);
+    let refinement = &r["metrics"]["refinement"];
+    let levels = refinement["levels"].as_u64().unwrap() as usize;
+    assert!(levels >= 1, "{refinement}");
+    let unmapped: Vec<f64> = refinement["unmapped_area_share_by_level"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(unmapped[0] > 0.1 && unmapped[levels] < unmapped[0] - 0.1, "{refinement}");
+    let failed = |r: &serde_json::Value| {
+        r["metrics"]["components"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["method"] == "failed")
+            .count()
+    };
+    let d0 = tmp("stool-refine-0");
+    let out = conformal(&mesh, &pebbles(), &d0, &["--size", "256", "--quiet", "--refine", "0"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(failed(&r) < failed(&report(&d0)));
+    assert_eq!(r["metrics"]["distortion_all_faces"]["flipped_triangles"], 0);
 }

@@ -14,10 +14,13 @@
 //! matches the input's.
 //!
 //! `auto` (the default): map and polish; while the mean σ1/σ2 away from zero points and
-//! slits (per component, averaged over the components by area) exceeds [`REFINE_ABOVE`] and the refined mesh stays within
-//! [`REFINE_MAX_TRIANGLES`], refine once more and map again, at most
-//! [`REFINE_MAX_LEVELS`] times. Not with the quasi-isometric relaxation, which trades
-//! angle distortion for area on purpose. `--refine N` refines exactly `N` times first.
+//! slits (per component, averaged over the components by area) exceeds [`REFINE_ABOVE`]
+//! or more than [`REFINE_FAILED_SHARE`] of the surface has no valid map, and the refined
+//! mesh stays within [`REFINE_MAX_TRIANGLES`], refine once more and map again, at most
+//! [`REFINE_MAX_LEVELS`] times; a level that is not better than the one before (less
+//! unmapped area, or a lower angle distortion) is dropped and the coarser one kept. Not
+//! with the quasi-isometric relaxation, which trades angle distortion for area on
+//! purpose. `--refine N` refines exactly `N` times first.
 //! Face `f` of the input is faces `4f … 4f + 3` after one level (so face ids in the
 //! report refer to the refined mesh); vertex ids of the input are kept.
 
@@ -27,6 +30,7 @@ use fieldtex_core::Warning;
 use fieldtex_mesh::{NormalWeighting, TriMesh, primitives::subdivide_midpoint, vertex_normals};
 use fieldtex_param::conformal::conformal_polish::PolishOptions;
 use fieldtex_param::conformal::holomorphic_map::LayoutOptions;
+use fieldtex_param::conformal::mass_spring::map_distortion;
 use fieldtex_param::conformal::{ConformalComponent, MapOptions, global_conformal_with};
 use serde::{Serialize, Serializer};
 
@@ -37,6 +41,10 @@ pub const REFINE_ABOVE: f64 = 1.04;
 /// `auto` never refines past this many triangles (the 388K-triangle horse ×4 took
 /// 18.8 s and 1 GB; 160K keeps a run of the armadillo, 29K → 117K, near 5 s).
 pub const REFINE_MAX_TRIANGLES: usize = 160_000;
+
+/// `auto` also refines while more than this share of the surface is in components
+/// without a valid map (they would go to the chart atlas).
+pub const REFINE_FAILED_SHARE: f64 = 0.005;
 
 /// `auto` refines at most this many times (×16 triangles).
 pub const REFINE_MAX_LEVELS: usize = 2;
@@ -83,9 +91,13 @@ pub(super) struct RefinementSummary {
     pub levels: usize,
     pub triangles_in: usize,
     pub triangles: usize,
-    /// Per mapped level: the components' mean σ1/σ2 away from singularities, weighted
-    /// by their areas (the value `auto` compares with [`REFINE_ABOVE`]).
+    /// Per mapped level (including a last one that was dropped for not being better):
+    /// the components' mean σ1/σ2 away from singularities, weighted by their areas (the
+    /// value `auto` compares with [`REFINE_ABOVE`]).
     pub angle_mean_away_by_level: Vec<Option<f64>>,
+    /// Per mapped level: the share of the surface in components without a map
+    /// (compared with [`REFINE_FAILED_SHARE`]).
+    pub unmapped_area_share_by_level: Vec<f64>,
     pub method: &'static str,
 }
 
@@ -127,42 +139,140 @@ pub(super) fn map_refined(
     }
     let auto = options.refine == Refine::Auto && !options.quasi_isometric;
     let mut by_level = Vec::new();
+    let mut failed_by_level = Vec::new();
+    // The best level so far: (levels, mesh, components, warnings, angle, unmapped share).
+    let mut best: Option<BestLevel> = None;
     loop {
         let (comps, warnings) = map_once(&mesh, options, report, progress, levels)?;
-        let angle = area_weighted_angle(&mesh, &comps);
+        let (angle, failed) = coarseness(&mesh, &comps);
         by_level.push(angle);
-        let coarse = angle.is_some_and(|w| w > REFINE_ABOVE);
-        let room = mesh.n_triangles().saturating_mul(4) <= REFINE_MAX_TRIANGLES;
-        if !(auto && coarse && room && levels < REFINE_MAX_LEVELS) {
-            let summary = RefinementSummary {
-                mode: options.refine,
-                levels,
-                triangles_in,
-                triangles: mesh.n_triangles(),
-                angle_mean_away_by_level: by_level,
-                method: "midpoint subdivision (1→4 per level; same surface)",
-            };
-            return Ok(Mapped { mesh, comps, warnings, summary });
+        failed_by_level.push(failed);
+        let current = BestLevel { levels, mesh, comps, warnings, angle, failed };
+        if best.as_ref().is_some_and(|b| !current.improves_on(b)) {
+            // Refining did not help (e.g. a CAD part whose map folds at any level):
+            // keep the coarser level.
+            break;
         }
-        crate::outputs::check_cancelled(progress)?;
-        mesh = report.stage(progress, "refine", || refine_once(&mesh));
-        levels += 1;
+        let coarse = angle.is_some_and(|w| w > REFINE_ABOVE) || failed > REFINE_FAILED_SHARE;
+        let room = current.mesh.n_triangles().saturating_mul(4) <= REFINE_MAX_TRIANGLES;
+        let go_on = auto && coarse && room && levels < REFINE_MAX_LEVELS;
+        let next = go_on.then(|| report.stage(progress, "refine", || refine_once(&current.mesh)));
+        best = Some(current);
+        match next {
+            Some(m) => {
+                crate::outputs::check_cancelled(progress)?;
+                mesh = m;
+                levels += 1;
+            }
+            None => break,
+        }
+    }
+    let BestLevel { levels, mesh, comps, mut warnings, .. } =
+        best.ok_or_else(|| Error::internal("conformal map", "no level was mapped"))?;
+    if levels > 0 {
+        warnings.push(refined_warning(
+            levels,
+            triangles_in,
+            mesh.n_triangles(),
+            &by_level[..=levels],
+            &failed_by_level[..=levels],
+        ));
+    }
+    let summary = RefinementSummary {
+        mode: options.refine,
+        levels,
+        triangles_in,
+        triangles: mesh.n_triangles(),
+        angle_mean_away_by_level: by_level,
+        unmapped_area_share_by_level: failed_by_level,
+        method: "midpoint subdivision (1→4 per level; same surface)",
+    };
+    Ok(Mapped { mesh, comps, warnings, summary })
+}
+
+/// One mapped level of [`map_refined`].
+struct BestLevel {
+    levels: usize,
+    mesh: TriMesh,
+    comps: Vec<ConformalComponent>,
+    warnings: Vec<Warning>,
+    angle: Option<f64>,
+    failed: f64,
+}
+
+impl BestLevel {
+    /// Whether this (finer) level is worth its triangles against `coarser`: less of the
+    /// surface without a map (by more than half a percent), or as much and a mean angle
+    /// distortion lower by more than 0.002.
+    fn improves_on(&self, coarser: &BestLevel) -> bool {
+        let angle = |l: &BestLevel| l.angle.unwrap_or(f64::INFINITY);
+        self.failed < coarser.failed - REFINE_FAILED_SHARE
+            || (self.failed <= coarser.failed + REFINE_FAILED_SHARE
+                && angle(self) < angle(coarser) - 0.002)
     }
 }
 
-/// The components' mean σ1/σ2 away from singularities, weighted by their areas (so a
-/// small distorted part, e.g. a 12-triangle box beside a statue, does not refine the
-/// whole mesh); `None` when no component has a map.
-fn area_weighted_angle(mesh: &TriMesh, comps: &[ConformalComponent]) -> Option<f64> {
-    let (mut sum, mut weight) = (0.0, 0.0);
+/// How coarse the mapped mesh is: the components' mean σ1/σ2 away from singularities
+/// (over all non-slit faces for a component small enough that every face is near a
+/// singularity), weighted by their areas, so a small distorted part (a 12-triangle box
+/// beside a statue) does not refine the whole mesh; and the share of the area in
+/// components without a map (a discrete map that folds or fails on a coarse
+/// triangulation goes to the chart atlas; refined, it often maps). `None` for the mean
+/// when no component has a map.
+fn coarseness(mesh: &TriMesh, comps: &[ConformalComponent]) -> (Option<f64>, f64) {
+    let (mut sum, mut weight, mut unmapped, mut total) = (0.0, 0.0, 0.0, 0.0);
     for c in comps {
-        if let Some(a) = c.angle_mean_away() {
-            let area = super::component_area(mesh, c);
+        let area = super::component_area(mesh, c);
+        total += area;
+        if !c.has_uv() {
+            unmapped += area;
+            continue;
+        }
+        let angle = c.angle_mean_away().filter(|a| a.is_finite()).or_else(|| {
+            let slit = &c.slit;
+            let all = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &|f| slit[f]);
+            all.angle_mean.is_finite().then_some(all.angle_mean)
+        });
+        if let Some(a) = angle {
             sum += a * area;
             weight += area;
         }
     }
-    (weight > 0.0).then(|| sum / weight)
+    let mean = (weight > 0.0).then(|| sum / weight);
+    (mean, if total > 0.0 { unmapped / total } else { 0.0 })
+}
+
+/// The warning that says the output has more triangles than the input, and why.
+fn refined_warning(
+    levels: usize,
+    triangles_in: usize,
+    triangles: usize,
+    angle: &[Option<f64>],
+    unmapped: &[f64],
+) -> Warning {
+    let why = match (angle.first().copied().flatten(), unmapped.first().copied()) {
+        (_, Some(u)) if u > REFINE_FAILED_SHARE => format!(
+            "{:.0} % of its area had no valid conformal map on the input's triangles",
+            100.0 * u
+        ),
+        (Some(a), _) => format!(
+            "the conformal map's mean angle distortion on the input's triangles was {a:.3} \
+             (above {REFINE_ABOVE})"
+        ),
+        _ => "the map needed it".to_string(),
+    };
+    let after = match angle.last().copied().flatten() {
+        Some(a) => format!(", {a:.3} after"),
+        None => String::new(),
+    };
+    Warning::new(
+        "conformal-refined",
+        format!(
+            "the mesh was refined {levels}× by midpoint subdivision ({triangles_in} → {triangles} \
+             triangles, same surface; model.glb holds the refined mesh) because {why}{after}; \
+             --refine 0 keeps the input's triangles"
+        ),
+    )
 }
 
 /// One level of midpoint subdivision, with vertex normals carried (area-weighted ones
