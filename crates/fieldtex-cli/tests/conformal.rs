@@ -386,7 +386,7 @@ fn a_small_distorted_part_does_not_refine_the_scene() {
 /// `auto` also refines where components have no valid map on the input's triangles: the
 /// painted stool (676 triangles in 13 parts, eight of them 8-triangle boxes whose map has
 /// nothing to solve and a seat whose map folds) keeps less of its surface on the
-/// fallback atlas after refinement.
+/// fallback atlas after refinement, and that atlas's seams are continued.
 #[test]
 fn unmapped_parts_are_refined_until_they_map() {
     let mesh = shared().join("textured/painted_wooden_stool/painted_wooden_stool_1k.gltf");
@@ -417,4 +417,13 @@ fn unmapped_parts_are_refined_until_they_map() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(failed(&r) < failed(&report(&d0)));
     assert_eq!(r["metrics"]["distortion_all_faces"]["flipped_triangles"], 0);
+    // The seat that still has no map is textured through a chart atlas whose seams'
+    // margins are linked like the patches' (one more component), so the colour jump
+    // across seams stays within the target (3.1× before the margins were linked).
+    let comps = r["metrics"]["components"].as_array().unwrap();
+    let atlas: Vec<_> = comps.iter().filter(|c| c["method"] == "chart-atlas").collect();
+    assert_eq!(atlas.len(), 1, "{comps:?}");
+    assert!(atlas[0]["margin_links"].as_u64().unwrap() > 0, "{}", atlas[0]);
+    let jump = r["metrics"]["seams"]["ratio"].as_f64().unwrap();
+    assert!(jump < 1.5, "seam colour jump ratio {jump}");
 }

@@ -19,6 +19,7 @@
 //! fundamental domain by one lattice translation; corners may stick out of the domain by
 //! up to one triangle, which is why texture images get margins (Wang et al. §4.2).
 
+pub mod atlas_charts;
 pub mod conformal_polish;
 pub mod cotan_system;
 pub mod critical_trajectories;
@@ -83,6 +84,9 @@ pub enum ConformalMethod {
     HolomorphicBasisOnly,
     /// The construction failed (see the note); no UVs.
     Failed,
+    /// Not a conformal map: the LSCM chart atlas of the faces whose component has none,
+    /// with linked margins ([`atlas_charts`]).
+    ChartAtlas,
 }
 
 /// What one construction returns, on the capped component mesh.

@@ -1,5 +1,5 @@
-//! Texture blocks of the `conformal` pipeline: the fallback chart atlas, the stacking of
-//! blocks into one texture, and the `--keep` artefacts.
+//! Texture blocks of the `conformal` pipeline: the fallback chart atlas (as a component
+//! of its own), the stacking of blocks into one texture, and the `--keep` artefacts.
 
 use super::Block;
 use crate::{Error, Progress, Result};
@@ -8,22 +8,16 @@ use fieldtex_mesh::{CornerUvs, TriMesh};
 use fieldtex_param::conformal::ConformalComponent;
 use std::path::Path;
 
-/// The fallback texture block: an LSCM chart atlas of the given faces.
-pub(super) struct FallbackAtlas {
-    pub(super) width: usize,
-    pub(super) height: usize,
-    pub(super) tau: Vec<f32>,
-    pub(super) faces: Vec<(u32, [[f64; 2]; 3])>,
-    pub(super) face_lambda: Vec<f64>,
-    pub(super) face_area: Vec<f64>,
-}
-
+/// The faces without a conformal map as one more component: their LSCM chart atlas
+/// laid out with linked margins (`fieldtex_param::conformal::atlas_charts`), so the
+/// quilting continues the texture across its seams. `component` is its id.
 pub(super) fn fallback_atlas(
     mesh: &TriMesh,
     faces: &[u32],
     size: usize,
+    component: usize,
     progress: &dyn Progress,
-) -> Result<FallbackAtlas> {
+) -> Result<ConformalComponent> {
     let sub = TriMesh::new(
         mesh.positions.clone(),
         faces.iter().map(|&f| mesh.triangles[f as usize]).collect(),
@@ -37,42 +31,15 @@ pub(super) fn fallback_atlas(
         .uvs
         .as_ref()
         .ok_or_else(|| Error::Internal("fallback atlas has no UVs".into()))?;
-    let map = fieldtex_param::build_texel_map(&atlas.mesh, size, size, 4)
-        .map_err(|e| Error::Internal(format!("fallback texel map: {e}")))?;
-    let s = size as f64;
-    let mut out_faces = Vec::with_capacity(faces.len());
-    let mut face_lambda = Vec::with_capacity(faces.len());
-    let mut face_area = Vec::with_capacity(faces.len());
-    for (k, &f) in faces.iter().enumerate() {
-        let idx = uvs.indices[k];
-        let c = idx.map(|i| {
-            let uv = uvs.values[i as usize];
-            [uv[0] * s, (1.0 - uv[1]) * s]
-        });
-        let p = atlas.mesh.triangle_positions(k);
-        let a3 = 0.5
-            * fieldtex_core::vec3::norm(fieldtex_core::vec3::cross(
-                fieldtex_core::vec3::sub(p[1], p[0]),
-                fieldtex_core::vec3::sub(p[2], p[0]),
-            ));
-        let at = 0.5
-            * ((c[1][0] - c[0][0]) * (c[2][1] - c[0][1])
-                - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]))
-                .abs();
-        face_lambda.push(if at > 0.0 { (a3 / at).sqrt() } else { f64::NAN });
-        face_area.push(a3);
-        out_faces.push((f, c));
-    }
-    let tau = (0..size * size)
-        .map(|t| match map.entries[t] {
-            Some(e) => {
-                let l = face_lambda[e.triangle as usize];
-                if l.is_finite() && l > 0.0 { (1.0 / l) as f32 } else { f32::NAN }
-            }
-            None => f32::NAN,
-        })
-        .collect();
-    Ok(FallbackAtlas { width: size, height: size, tau, faces: out_faces, face_lambda, face_area })
+    let corners: Vec<[[f64; 2]; 3]> =
+        uvs.indices.iter().map(|idx| idx.map(|i| uvs.values[i as usize])).collect();
+    Ok(fieldtex_param::conformal::atlas_charts::atlas_component(
+        mesh,
+        faces,
+        &atlas.chart_of_triangle,
+        &corners,
+        component,
+    ))
 }
 
 /// Stacks the blocks into one texture (rows follow increasing canvas y, top to bottom)

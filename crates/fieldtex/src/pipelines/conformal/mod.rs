@@ -8,8 +8,9 @@
 //! (`fieldtex_synth::quilt`) → images stacked into one texture → `model.glb`,
 //! `preview.png`, `report.json` (+ `--keep` artefacts). A genus ≥ 2 component's image
 //! holds its critical-trajectory patches, linked across the cuts by ghost margins.
-//! Failed components fall back to a chart atlas (LSCM charts) synthesised the same way
-//! without partners; the report says so. Report pieces live in `report.rs`, texture
+//! Failed components fall back to a chart atlas (LSCM charts), laid out as one more
+//! component whose seams' margins are linked by similarity ghosts and synthesised the
+//! same way; the report says so. Report pieces live in `report.rs`, texture
 //! blocks and `--keep` artefacts in `blocks.rs`.
 
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
@@ -168,7 +169,17 @@ pub fn conformal(
             }
         });
     }
-    // 3. Geometry images and their τ maps; components without a map go to the atlas.
+    // 3. Components without a map go to a chart atlas with linked margins (one more
+    // component); geometry images and their τ maps.
+    let fallback_faces: Vec<u32> =
+        comps.iter().filter(|c| !c.has_uv()).flat_map(|c| c.faces.iter().copied()).collect();
+    if !fallback_faces.is_empty() {
+        let id = comps.len();
+        let atlas = report.stage(progress, "fallback-atlas", || {
+            fallback_atlas(&mesh, &fallback_faces, options.size, id, progress)
+        })?;
+        comps.push(atlas);
+    }
     let total_area: Vec<f64> = comps.iter().map(|c| component_area(&mesh, c)).collect();
     let max_area = total_area.iter().cloned().fold(0.0, f64::max);
     let images: Vec<Option<GeometryImage>> = report.stage(progress, "geometry-images", || {
@@ -184,21 +195,12 @@ pub fn conformal(
             })
             .collect()
     });
-    let fallback_faces: Vec<u32> =
-        comps.iter().filter(|c| !c.has_uv()).flat_map(|c| c.faces.iter().copied()).collect();
-    let fallback = if fallback_faces.is_empty() {
-        None
-    } else {
-        Some(report.stage(progress, "fallback-atlas", || {
-            fallback_atlas(&mesh, &fallback_faces, options.size, progress)
-        })?)
-    };
     // 4. τ reference and exemplar levels (global, so features match across images).
-    let lv = exemplar_levels(&mut report, progress, options, &exemplar, &images, fallback.as_ref());
+    let lv = exemplar_levels(&mut report, progress, options, &exemplar, &images);
     // 5. Quilting per geometry image (and the fallback atlas).
     let quilting = fieldtex_core::StageGuard::begin(progress, "quilting", 0);
     let (blocks, quilt_stats, split_spread) =
-        quilt_blocks(progress, options, &comps, &images, fallback.as_ref(), &lv)?;
+        quilt_blocks(progress, options, &comps, &images, &lv)?;
     report.timings_ms.push(("quilting".into(), quilting.elapsed_ms()));
     drop(quilting);
     crate::outputs::check_cancelled(progress)?;

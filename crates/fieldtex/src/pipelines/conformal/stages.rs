@@ -1,13 +1,12 @@
 //! The stages of `conformal` that are more than a call: option checks, the exemplar
 //! levels from the `τ` distribution, quilting every geometry image, and the metrics.
 
-use super::blocks::FallbackAtlas;
 use super::report::{component_json, texel_density, weighted_quantile};
 use super::{Block, ConformalOptions, PATCH_SPLIT_SPREAD, SEAM_FEATHER_BAND};
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::{Image, stream_seed};
 use fieldtex_mesh::TriMesh;
-use fieldtex_param::conformal::{ConformalComponent, GeometryImage};
+use fieldtex_param::conformal::{ConformalComponent, ConformalMethod, GeometryImage};
 use fieldtex_synth::exemplar_scales::{resample, scale_levels};
 use fieldtex_synth::{QuiltTarget, QuiltingOptions, quilt};
 use serde_json::json;
@@ -83,18 +82,10 @@ pub(super) fn exemplar_levels(
     options: &ConformalOptions,
     exemplar: &Image,
     images: &[Option<GeometryImage>],
-    fallback: Option<&FallbackAtlas>,
 ) -> ExemplarLevels {
     let mut tau_w: Vec<(f64, f64)> = Vec::new();
     for img in images.iter().flatten() {
         for (l, a) in img.face_lambda.iter().zip(&img.face_area) {
-            if l.is_finite() && *l > 0.0 {
-                tau_w.push((1.0 / l, *a));
-            }
-        }
-    }
-    if let Some(fb) = fallback {
-        for (l, a) in fb.face_lambda.iter().zip(&fb.face_area) {
             if l.is_finite() && *l > 0.0 {
                 tau_w.push((1.0 / l, *a));
             }
@@ -131,15 +122,14 @@ pub(super) fn exemplar_levels(
     ExemplarLevels { tau_w, tau_ref, q05, q95, scales, level_names, levels }
 }
 
-/// Quilts every geometry image (margins copied to their partners afterwards) and the
-/// fallback atlas: the texture blocks, the per-image statistics and the patch-split
+/// Quilts every geometry image (margins copied to their partners afterwards; the
+/// fallback atlas is one of them): the texture blocks, the per-image statistics and the patch-split
 /// spread used.
 pub(super) fn quilt_blocks(
     progress: &dyn Progress,
     options: &ConformalOptions,
     comps: &[ConformalComponent],
     images: &[Option<GeometryImage>],
-    fallback: Option<&FallbackAtlas>,
     lv: &ExemplarLevels,
 ) -> Result<(Vec<Block>, Vec<serde_json::Value>, f64)> {
     let qbase = QuiltingOptions {
@@ -195,26 +185,11 @@ pub(super) fn quilt_blocks(
             image,
             faces,
             tau: img.tau.clone(),
-            label: format!("component{}", c.component),
-        });
-    }
-    if let Some(fb) = fallback {
-        let none = |_: usize, _: usize, _: &mut Vec<(usize, usize)>| {};
-        let target = QuiltTarget {
-            width: fb.width,
-            height: fb.height,
-            tau: &fb.tau,
-            level_for: &level_for,
-            partners: &none,
-        };
-        let q = QuiltingOptions { seed: stream_seed(options.seed, "conformal-atlas", 0), ..qbase };
-        let (image, st) = quilt(&lv.levels, &target, &q, progress);
-        quilt_stats.push(json!({"component": "fallback-atlas", "stats": st}));
-        blocks.push(Block {
-            image,
-            faces: fb.faces.clone(),
-            tau: fb.tau.clone(),
-            label: "fallback_atlas".into(),
+            label: if c.method == ConformalMethod::ChartAtlas {
+                "fallback_atlas".into()
+            } else {
+                format!("component{}", c.component)
+            },
         });
     }
     Ok((blocks, quilt_stats, qbase.split_spread))
