@@ -5,6 +5,8 @@
 # Every timed run also records CPU time (user + sys, GNU time) and the load average, so
 # numbers taken on a busy machine can be judged.
 # Usage: bench/conformal_bench.sh [--runs N] [--exemplar NAME] [--meshes "bunny torus ..."]
+#   (a mesh is a name in ../shared/data/meshes or a path under ../shared/data without
+#   its extension, e.g. textured/painted_wooden_stool/painted_wooden_stool_1k)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -24,8 +26,12 @@ bin=target/release/fieldtex
 ex="../shared/data/exemplars/$exemplar.png"
 out=out/conformal-bench
 mkdir -p "$out"
-for m in $meshes; do
-  f=$(ls ../shared/data/meshes/$m.* | head -1)
+for name in $meshes; do
+  # A shared mesh by name, or a path under ../shared/data without its extension
+  # (e.g. textured/spot/spot_triangulated).
+  f=$(ls ../shared/data/meshes/$name.* 2>/dev/null | head -1)
+  [ -n "$f" ] || f=$(ls ../shared/data/$name.* | head -1)
+  m=$(basename "$name")
   walls=()
   for r in $(seq 1 "$runs"); do
     /usr/bin/time -f '%e %U %S' -o "$out/$m.time" \

@@ -13,7 +13,11 @@ for c in met["components"]:
     print(f"   component {c['component']}: genus {c['genus']} boundaries {c['boundaries']} method {c['method']} "
           f"zero points {c['zero_points']} patches {c['patches']} flips {d.get('flipped')} "
           f"angle(away) {d.get('angle_mean_away_from_singularities')} log-area std {d.get('log_area_std')} "
-          f"conj.res {c['conjugate_residual']:.3g} (wedge system {c.get('conjugate_residual_wedge_system')})")
+          f"conj.res {c.get('conjugate_residual')} (wedge system {c.get('conjugate_residual_wedge_system')})")
+rf = met.get("refinement")
+if rf:
+    print(f"   refinement: {rf['levels']} level(s), {rf['triangles_in']} -> {rf['triangles']} triangles; "
+          f"angle(away) per level {rf['angle_mean_away_by_level']}, unmapped share per level {rf.get('unmapped_area_share_by_level')}")
 fs, fn = met["feature_size"], n["metrics"]["feature_size"]
 if fs and fn:
     print(f"   feature-size CV multiscale {fs['cv']:.3f}  no-multiscale {fn['cv']:.3f}  ratio {fs['cv'] / fn['cv']:.2f} (target <= 0.5)")

@@ -1,6 +1,7 @@
 //! Statistics on dense data for texture transfer (paper B, Mertens et al. 2006):
 //! canonical correlation analysis, k-means, 1-D and n-D histogram matching,
-//! weighted quantile functions and a kd-tree for (approximate) nearest neighbours.
+//! weighted quantile functions, the weighted quantile and a kd-tree for (approximate)
+//! nearest neighbours.
 //! One algorithm per file.
 //!
 //! Conventions: samples are row-major `N × dim` `f64` slices; every reduction over
