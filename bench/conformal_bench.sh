@@ -29,8 +29,13 @@ mkdir -p "$out"
 for name in $meshes; do
   # A shared mesh by name, or a path under ../shared/data without its extension
   # (e.g. textured/spot/spot_triangulated).
-  f=$(ls ../shared/data/meshes/$name.* 2>/dev/null | head -1)
-  [ -n "$f" ] || f=$(ls ../shared/data/$name.* | head -1)
+  f=""
+  for base in "../shared/data/meshes/$name" "../shared/data/$name"; do
+    for ext in obj ply stl gltf glb; do
+      if [ -z "$f" ] && [ -f "$base.$ext" ]; then f="$base.$ext"; fi
+    done
+  done
+  [ -n "$f" ] || { echo "conformal_bench: no mesh $name" >&2; exit 2; }
   m=$(basename "$name")
   walls=()
   for r in $(seq 1 "$runs"); do

@@ -427,3 +427,27 @@ fn unmapped_parts_are_refined_until_they_map() {
     let jump = r["metrics"]["seams"]["ratio"].as_f64().unwrap();
     assert!(jump < 1.5, "seam colour jump ratio {jump}");
 }
+
+/// A finer level whose layout has much longer seams is dropped: blub's one refinement
+/// lowers σ1/σ2 (1.059 → 1.035) but cuts its surface into patches with 1.7× the seam
+/// length, so `auto` keeps its triangles and reports both levels.
+#[test]
+fn refinement_that_lengthens_the_seams_is_dropped() {
+    let mesh = shared().join("textured/blub/blub.obj");
+    let d = tmp("blub-refine");
+    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&d);
+    let refinement = &r["metrics"]["refinement"];
+    let nums = |k: &str| -> Vec<f64> {
+        refinement[k].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let (angle, seam) = (nums("angle_mean_away_by_level"), nums("seam_length_by_level"));
+    assert_eq!((angle.len(), seam.len()), (2, 2), "{refinement}");
+    assert!(angle[1] < angle[0] - 0.002, "{refinement}");
+    assert!(seam[1] > fieldtex::REFINE_SEAM_GROWTH * seam[0], "{refinement}");
+    assert_eq!(refinement["levels"], 0, "{refinement}");
+    assert_eq!(refinement["triangles"], r["input"]["triangles"]);
+    let told = r["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "conformal-refined");
+    assert!(!told);
+}

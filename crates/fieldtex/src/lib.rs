@@ -30,7 +30,8 @@ pub use outputs::{guard_output, write_text};
 pub use pipelines::align::{AlignOptions, align, align_in_memory};
 pub use pipelines::atlas::{AtlasCommandOptions, atlas_file};
 pub use pipelines::conformal::{
-    ConformalOptions, REFINE_ABOVE, REFINE_MAX_LEVELS, REFINE_MAX_TRIANGLES, Refine, conformal,
+    ConformalOptions, REFINE_ABOVE, REFINE_MAX_LEVELS, REFINE_MAX_TRIANGLES, REFINE_SEAM_GROWTH,
+    Refine, conformal,
 };
 pub use pipelines::crest::{CrestCommandOptions, CrestSummary, crest_file};
 pub use pipelines::demo::{DemoOptions, demo};

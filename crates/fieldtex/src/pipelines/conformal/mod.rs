@@ -25,7 +25,9 @@ mod refinement;
 mod report;
 mod stages;
 use blocks::{assemble, fallback_atlas, write_keep};
-pub use refinement::{REFINE_ABOVE, REFINE_MAX_LEVELS, REFINE_MAX_TRIANGLES, Refine};
+pub use refinement::{
+    REFINE_ABOVE, REFINE_MAX_LEVELS, REFINE_MAX_TRIANGLES, REFINE_SEAM_GROWTH, Refine,
+};
 use report::add_notes;
 use serde_json::json;
 use stages::{RunParts, check_options, conformal_metrics, exemplar_levels, quilt_blocks};

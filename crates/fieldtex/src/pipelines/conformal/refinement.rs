@@ -18,7 +18,8 @@
 //! or more than [`REFINE_FAILED_SHARE`] of the surface has no valid map, and the refined
 //! mesh stays within [`REFINE_MAX_TRIANGLES`], refine once more and map again, at most
 //! [`REFINE_MAX_LEVELS`] times; a level that is not better than the one before (less
-//! unmapped area, or a lower angle distortion) is dropped and the coarser one kept. Not
+//! unmapped area, or a lower angle distortion without seams longer by more than
+//! [`REFINE_SEAM_GROWTH`]) is dropped and the coarser one kept. Not
 //! with the quasi-isometric relaxation, which trades angle distortion for area on
 //! purpose. `--refine N` refines exactly `N` times first.
 //! Face `f` of the input is faces `4f … 4f + 3` after one level (so face ids in the
@@ -45,6 +46,10 @@ pub const REFINE_MAX_TRIANGLES: usize = 160_000;
 /// `auto` also refines while more than this share of the surface is in components
 /// without a valid map (they would go to the chart atlas).
 pub const REFINE_FAILED_SHARE: f64 = 0.005;
+
+/// `auto` keeps a finer level only if its seams are at most this many times as long as
+/// the coarser level's (unless it maps more of the surface).
+pub const REFINE_SEAM_GROWTH: f64 = 1.25;
 
 /// `auto` refines at most this many times (×16 triangles).
 pub const REFINE_MAX_LEVELS: usize = 2;
@@ -98,6 +103,9 @@ pub(super) struct RefinementSummary {
     /// Per mapped level: the share of the surface in components without a map
     /// (compared with [`REFINE_FAILED_SHARE`]).
     pub unmapped_area_share_by_level: Vec<f64>,
+    /// Per mapped level: the 3-D length of the map's seams (compared with
+    /// [`REFINE_SEAM_GROWTH`]).
+    pub seam_length_by_level: Vec<f64>,
     pub method: &'static str,
 }
 
@@ -140,14 +148,17 @@ pub(super) fn map_refined(
     let auto = options.refine == Refine::Auto && !options.quasi_isometric;
     let mut by_level = Vec::new();
     let mut failed_by_level = Vec::new();
+    let mut seam_by_level = Vec::new();
     // The best level so far: (levels, mesh, components, warnings, angle, unmapped share).
     let mut best: Option<BestLevel> = None;
     loop {
         let (comps, warnings) = map_once(&mesh, options, report, progress, levels)?;
         let (angle, failed) = coarseness(&mesh, &comps);
+        let seam = seam_length(&mesh, &comps);
         by_level.push(angle);
         failed_by_level.push(failed);
-        let current = BestLevel { levels, mesh, comps, warnings, angle, failed };
+        seam_by_level.push(seam);
+        let current = BestLevel { levels, mesh, comps, warnings, angle, failed, seam };
         if best.as_ref().is_some_and(|b| !current.improves_on(b)) {
             // Refining did not help (e.g. a CAD part whose map folds at any level):
             // keep the coarser level.
@@ -185,6 +196,7 @@ pub(super) fn map_refined(
         triangles: mesh.n_triangles(),
         angle_mean_away_by_level: by_level,
         unmapped_area_share_by_level: failed_by_level,
+        seam_length_by_level: seam_by_level,
         method: "midpoint subdivision (1→4 per level; same surface)",
     };
     Ok(Mapped { mesh, comps, warnings, summary })
@@ -198,17 +210,21 @@ struct BestLevel {
     warnings: Vec<Warning>,
     angle: Option<f64>,
     failed: f64,
+    seam: f64,
 }
 
 impl BestLevel {
     /// Whether this (finer) level is worth its triangles against `coarser`: less of the
-    /// surface without a map (by more than half a percent), or as much and a mean angle
-    /// distortion lower by more than 0.002.
+    /// surface without a map (by more than half a percent), or as much, a mean angle
+    /// distortion lower by more than 0.002 and seams at most [`REFINE_SEAM_GROWTH`]
+    /// times as long (the layout of a finer mesh can differ: the avocado's second level
+    /// cut it into patches with 6× the seams, blub's first 1.7×).
     fn improves_on(&self, coarser: &BestLevel) -> bool {
         let angle = |l: &BestLevel| l.angle.unwrap_or(f64::INFINITY);
         self.failed < coarser.failed - REFINE_FAILED_SHARE
             || (self.failed <= coarser.failed + REFINE_FAILED_SHARE
-                && angle(self) < angle(coarser) - 0.002)
+                && angle(self) < angle(coarser) - 0.002
+                && self.seam <= REFINE_SEAM_GROWTH * coarser.seam)
     }
 }
 
@@ -240,6 +256,54 @@ fn coarseness(mesh: &TriMesh, comps: &[ConformalComponent]) -> (Option<f64>, f64
     }
     let mean = (weight > 0.0).then(|| sum / weight);
     (mean, if total > 0.0 { unmapped / total } else { 0.0 })
+}
+
+/// 3-D length of the mapped components' seams: mesh edges whose two faces belong to the
+/// same component and disagree on the UVs of the edge's ends (slits included; the
+/// chart atlas of unmapped parts is made later and not counted).
+fn seam_length(mesh: &TriMesh, comps: &[ConformalComponent]) -> f64 {
+    let nf = mesh.n_triangles();
+    let mut owner = vec![u32::MAX; nf];
+    let mut corner = vec![[[0.0f64; 2]; 3]; nf];
+    let mut extent = 0.0f64;
+    for (ci, c) in comps.iter().enumerate() {
+        if !c.has_uv() {
+            continue;
+        }
+        for (k, &f) in c.faces.iter().enumerate() {
+            if let (Some(o), Some(uv)) = (owner.get_mut(f as usize), c.corner_uv.get(k)) {
+                *o = ci as u32;
+                corner[f as usize] = *uv;
+                extent = uv.iter().fold(extent, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+            }
+        }
+    }
+    let tol = 1e-9 * extent.max(1e-300);
+    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
+    let uv_at = |f: usize, v: u32| {
+        let k = mesh.triangles[f].iter().position(|&w| w == v)?;
+        Some(corner[f][k])
+    };
+    let mut length = 0.0;
+    for (e, ends) in topo.edges.iter().enumerate() {
+        let faces = topo.edge_faces(e);
+        if faces.len() != 2 {
+            continue;
+        }
+        let (f, g) = (faces[0] as usize, faces[1] as usize);
+        if owner[f] == u32::MAX || owner[f] != owner[g] {
+            continue;
+        }
+        let differs = ends.iter().any(|&v| match (uv_at(f, v), uv_at(g, v)) {
+            (Some(a), Some(b)) => (a[0] - b[0]).abs() > tol || (a[1] - b[1]).abs() > tol,
+            _ => false,
+        });
+        if differs {
+            let (a, b) = (mesh.positions[ends[0] as usize], mesh.positions[ends[1] as usize]);
+            length += fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(a, b));
+        }
+    }
+    length
 }
 
 /// The warning that says the output has more triangles than the input, and why.
