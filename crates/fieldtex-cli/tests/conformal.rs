@@ -426,6 +426,15 @@ fn unmapped_parts_are_refined_until_they_map() {
     assert!(atlas[0]["margin_links"].as_u64().unwrap() > 0, "{}", atlas[0]);
     let jump = r["metrics"]["seams"]["ratio"].as_f64().unwrap();
     assert!(jump < 1.5, "seam colour jump ratio {jump}");
+    // Refinement and the linked atlas give the same bytes on one thread.
+    let d1 = tmp("stool-refine-1-thread");
+    let out = conformal(&mesh, &pebbles(), &d1, &["--size", "256", "--quiet", "--threads", "1"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        std::fs::read(d.join("model.glb")).unwrap(),
+        std::fs::read(d1.join("model.glb")).unwrap(),
+        "model.glb differs between thread counts"
+    );
 }
 
 /// A finer level whose layout has much longer seams is dropped: blub's one refinement
