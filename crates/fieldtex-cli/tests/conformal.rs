@@ -66,6 +66,17 @@ fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
 }
 
+/// `conformal` on `mesh` with pebbles at `--size 256` (plus `extra`) into scratch folder
+/// `name`, which must succeed: the folder and its report.
+fn run_256(mesh: &Path, name: &str, extra: &[&str]) -> (PathBuf, serde_json::Value) {
+    let d = tmp(name);
+    let args: Vec<&str> = ["--size", "256", "--quiet"].iter().chain(extra).copied().collect();
+    let out = conformal(mesh, &pebbles(), &d, &args);
+    assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+    let r = report(&d);
+    (d, r)
+}
+
 #[test]
 fn torus_and_tube_end_to_end_deterministic() {
     let (d, mesh) = torus_in("torus", 48, 24);
@@ -267,10 +278,7 @@ fn fandisk_is_polished_within_the_angle_target() {
 #[test]
 fn a_coarse_mesh_is_refined_until_the_map_is_conformal() {
     let mesh = shared().join("meshes/koala-lowres.obj");
-    let d = tmp("koala-refine");
-    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let r = report(&d);
+    let (d, r) = run_256(&mesh, "koala-refine", &[]);
     let refinement = &r["metrics"]["refinement"];
     let n_in = r["input"]["triangles"].as_u64().unwrap();
     assert_eq!(refinement["mode"], "auto");
@@ -291,10 +299,7 @@ fn a_coarse_mesh_is_refined_until_the_map_is_conformal() {
     let told = r["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "conformal-refined");
     assert!(told, "{}", r["warnings"]);
 
-    let d0 = tmp("koala-refine-0");
-    let out = conformal(&mesh, &pebbles(), &d0, &["--size", "256", "--quiet", "--refine", "0"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let r0 = report(&d0);
+    let (_, r0) = run_256(&mesh, "koala-refine-0", &["--refine", "0"]);
     assert_eq!(r0["metrics"]["refinement"]["levels"], 0);
     assert_eq!(r0["metrics"]["components"][0]["triangles"].as_u64(), Some(n_in));
     let away0 = r0["metrics"]["components"][0]["distortion"]["angle_mean_away_from_singularities"]
@@ -364,10 +369,7 @@ fn a_small_distorted_part_does_not_refine_the_scene() {
     }
     let mesh = d.join("scene.obj");
     std::fs::write(&mesh, text).unwrap();
-    let o = d.join("o");
-    let out = conformal(&mesh, &pebbles(), &o, &["--size", "256", "--quiet"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let r = report(&o);
+    let (_, r) = run_256(&mesh, "scene-refine-out", &[]);
     let comps = r["metrics"]["components"].as_array().unwrap();
     let away = |c: &serde_json::Value| {
         c["distortion"]["angle_mean_away_from_singularities"].as_f64().unwrap()
@@ -390,10 +392,7 @@ fn a_small_distorted_part_does_not_refine_the_scene() {
 #[test]
 fn unmapped_parts_are_refined_until_they_map() {
     let mesh = shared().join("textured/painted_wooden_stool/painted_wooden_stool_1k.gltf");
-    let d = tmp("stool-refine");
-    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let r = report(&d);
+    let (d, r) = run_256(&mesh, "stool-refine", &[]);
     let refinement = &r["metrics"]["refinement"];
     let levels = refinement["levels"].as_u64().unwrap() as usize;
     assert!(levels >= 1, "{refinement}");
@@ -412,10 +411,8 @@ fn unmapped_parts_are_refined_until_they_map() {
             .filter(|c| c["method"] == "failed")
             .count()
     };
-    let d0 = tmp("stool-refine-0");
-    let out = conformal(&mesh, &pebbles(), &d0, &["--size", "256", "--quiet", "--refine", "0"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(failed(&r) < failed(&report(&d0)));
+    let (_, r0) = run_256(&mesh, "stool-refine-0", &["--refine", "0"]);
+    assert!(failed(&r) < failed(&r0));
     assert_eq!(r["metrics"]["distortion_all_faces"]["flipped_triangles"], 0);
     // The seat that still has no map is textured through a chart atlas whose seams'
     // margins are linked like the patches' (one more component), so the colour jump
@@ -427,9 +424,7 @@ fn unmapped_parts_are_refined_until_they_map() {
     let jump = r["metrics"]["seams"]["ratio"].as_f64().unwrap();
     assert!(jump < 1.5, "seam colour jump ratio {jump}");
     // Refinement and the linked atlas give the same bytes on one thread.
-    let d1 = tmp("stool-refine-1-thread");
-    let out = conformal(&mesh, &pebbles(), &d1, &["--size", "256", "--quiet", "--threads", "1"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (d1, _) = run_256(&mesh, "stool-refine-1-thread", &["--threads", "1"]);
     assert_eq!(
         std::fs::read(d.join("model.glb")).unwrap(),
         std::fs::read(d1.join("model.glb")).unwrap(),
@@ -442,11 +437,7 @@ fn unmapped_parts_are_refined_until_they_map() {
 /// length, so `auto` keeps its triangles and reports both levels.
 #[test]
 fn refinement_that_lengthens_the_seams_is_dropped() {
-    let mesh = shared().join("textured/blub/blub.obj");
-    let d = tmp("blub-refine");
-    let out = conformal(&mesh, &pebbles(), &d, &["--size", "256", "--quiet"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let r = report(&d);
+    let (_, r) = run_256(&shared().join("textured/blub/blub.obj"), "blub-refine", &[]);
     let refinement = &r["metrics"]["refinement"];
     let nums = |k: &str| -> Vec<f64> {
         refinement[k].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
