@@ -183,9 +183,9 @@ pub fn subdivide_midpoint(mesh: &TriMesh) -> TriMesh {
         let mut all = n.clone();
         all.extend(topo.edges.iter().map(|e| {
             let (a, b) = (n[e[0] as usize], n[e[1] as usize]);
-            let m = [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
-            let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
-            if len > 0.0 && len.is_finite() { m.map(|x| x / len) } else { a }
+            let m = fieldtex_core::vec3::add(a, b);
+            let len = fieldtex_core::vec3::norm(m);
+            if len > 0.0 && len.is_finite() { fieldtex_core::vec3::scale(m, 1.0 / len) } else { a }
         }));
         all
     });

@@ -12,9 +12,8 @@
 //! across it (§4.2, as for the conformal patches).
 
 use super::patch_relaxation::repack_with_similarity_ghosts;
-use super::periodic_uv::Lattice;
+use super::periodic_uv::{Lattice, signed_area};
 use super::{ComponentMap, ConformalComponent, ConformalMethod};
-use fieldtex_core::vec3;
 use fieldtex_mesh::TriMesh;
 
 /// A component made of the global faces `faces` of `mesh`, laid out by the chart atlas
@@ -48,16 +47,9 @@ pub fn atlas_component(
     let positions = local_to_global.iter().map(|&v| mesh.positions[v as usize]).collect();
     let local_mesh = TriMesh::new(positions, triangles);
     // One common scale: UV area = surface area.
-    let (mut a3, mut a2) = (0.0, 0.0);
-    for (k, c) in corner_uv[..n].iter().enumerate() {
-        let p = local_mesh.triangle_positions(k);
-        a3 += 0.5 * vec3::norm(vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0])));
-        let s =
-            (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]);
-        if s.is_finite() {
-            a2 += 0.5 * s.abs();
-        }
-    }
+    let a3 = fieldtex_mesh::total_area(&local_mesh);
+    let a2: f64 =
+        corner_uv[..n].iter().map(|c| signed_area(c).abs()).filter(|a| a.is_finite()).sum();
     let scale = if a2 > 0.0 && a3 > 0.0 { (a3 / a2).sqrt() } else { 1.0 };
     let corners: Vec<[[f64; 2]; 3]> =
         corner_uv[..n].iter().map(|c| c.map(|p| [p[0] * scale, p[1] * scale])).collect();
@@ -112,8 +104,8 @@ pub fn atlas_component(
 
 #[cfg(test)]
 mod tests {
-    use super::super::periodic_uv::signed_area;
     use super::*;
+    use fieldtex_core::vec3;
     use fieldtex_mesh::primitives::cube;
 
     /// A cube cut into its six faces as six charts (each face's square in its own
@@ -141,12 +133,7 @@ mod tests {
         assert_eq!(c.faces.len(), m.n_triangles());
         assert!(c.has_uv());
         assert_eq!(c.map.n_patches(), 6);
-        let area3: f64 = (0..m.n_triangles())
-            .map(|f| {
-                let p = m.triangle_positions(f);
-                0.5 * vec3::norm(vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0])))
-            })
-            .sum();
+        let area3 = fieldtex_mesh::total_area(&m);
         let area2: f64 = c.corner_uv.iter().map(signed_area).sum();
         assert!((area2 / area3 - 1.0).abs() < 1e-9, "{area2} vs {area3}");
         assert!(c.corner_uv.iter().all(|q| signed_area(q) > 0.0));

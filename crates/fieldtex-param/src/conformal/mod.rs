@@ -38,6 +38,7 @@ pub mod patch_relaxation;
 pub mod periodic_uv;
 pub mod protrusion_slits;
 mod rigid_triangles;
+pub mod seam_length;
 pub mod seam_placement;
 pub mod similarity_ghosts;
 pub mod slit_cylinder;
@@ -217,20 +218,25 @@ impl ConformalComponent {
         !self.corner_uv.is_empty()
     }
 
+    /// Distortion of the map over its faces that `skip` does not mark; `None` without
+    /// a map.
+    fn distortion_without(&self, skip: &[bool]) -> Option<mass_spring::MapDistortion> {
+        self.has_uv().then(|| {
+            mass_spring::map_distortion(&self.local_mesh, self.faces.len(), &self.corner_uv, &|f| {
+                skip[f]
+            })
+        })
+    }
+
+    /// Distortion of the map over its non-slit faces; `None` without a map.
+    pub fn distortion_non_slit(&self) -> Option<mass_spring::MapDistortion> {
+        self.distortion_without(&self.slit)
+    }
+
     /// Area-weighted mean σ1/σ2 of the map away from zero points and slits (the faces
     /// of [`Self::near_singularity`] skipped); `None` without a map.
     pub fn angle_mean_away(&self) -> Option<f64> {
-        if !self.has_uv() {
-            return None;
-        }
-        let near = &self.near_singularity;
-        let d = mass_spring::map_distortion(
-            &self.local_mesh,
-            self.faces.len(),
-            &self.corner_uv,
-            &|f| near[f],
-        );
-        Some(d.angle_mean)
+        self.distortion_without(&self.near_singularity).map(|d| d.angle_mean)
     }
 
     /// Recomputes `corner_uv`, `slit` and `domain` from `map` (after relaxation).

@@ -305,22 +305,7 @@ fn genus_two_is_cut_into_patches_along_critical_trajectories() {
 
 /// 3-D length of the edges whose two faces disagree on a shared corner.
 fn seam_length(mesh: &fieldtex_mesh::TriMesh, corner: &[[[f64; 2]; 3]]) -> f64 {
-    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let uv = |f: usize, v: u32| corner[f][(0..3).find(|&k| mesh.triangles[f][k] == v).unwrap()];
-    let mut len = 0.0;
-    for e in 0..topo.n_edges() {
-        let fs = topo.edge_faces(e);
-        let [a, b] = topo.edges[e];
-        let (f, g) = (fs[0] as usize, fs[1] as usize);
-        let d = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
-        if d(uv(f, a), uv(g, a)) + d(uv(f, b), uv(g, b)) > 1e-9 {
-            len += fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(
-                mesh.positions[b as usize],
-                mesh.positions[a as usize],
-            ));
-        }
-    }
-    len
+    super::seam_length::seam_length(mesh, corner, &|_, _| true)
 }
 
 #[test]

@@ -19,9 +19,9 @@
 //! mesh stays within [`REFINE_MAX_TRIANGLES`], refine once more and map again, at most
 //! [`REFINE_MAX_LEVELS`] times; a level that is not better than the one before (less
 //! unmapped area, or a lower angle distortion without seams longer by more than
-//! [`REFINE_SEAM_GROWTH`]) is dropped and the coarser one kept. Not
-//! with the quasi-isometric relaxation, which trades angle distortion for area on
-//! purpose. `--refine N` refines exactly `N` times first.
+//! [`REFINE_SEAM_GROWTH`]) is dropped and the coarser one kept. Not with the
+//! quasi-isometric relaxation, which trades angle distortion for area on purpose.
+//! `--refine N` refines exactly `N` times first.
 //! Face `f` of the input is faces `4f … 4f + 3` after one level (so face ids in the
 //! report refer to the refined mesh); vertex ids of the input are kept.
 
@@ -31,12 +31,12 @@ use fieldtex_core::Warning;
 use fieldtex_mesh::{NormalWeighting, TriMesh, primitives::subdivide_midpoint, vertex_normals};
 use fieldtex_param::conformal::conformal_polish::PolishOptions;
 use fieldtex_param::conformal::holomorphic_map::LayoutOptions;
-use fieldtex_param::conformal::mass_spring::map_distortion;
 use fieldtex_param::conformal::{ConformalComponent, MapOptions, global_conformal_with};
 use serde::{Serialize, Serializer};
 
-/// `auto` refines while a component's mean σ1/σ2 away from singularities is above this
-/// (the target is 1.05; the polish threshold is the same 1.04).
+/// `auto` refines while the components' area-weighted mean σ1/σ2 away from
+/// singularities is above this (the target is 1.05; the polish threshold is the
+/// same 1.04).
 pub const REFINE_ABOVE: f64 = 1.04;
 
 /// `auto` never refines past this many triangles (the 388K-triangle horse ×4 took
@@ -153,7 +153,6 @@ pub(super) fn map_refined(
     let mut by_level = Vec::new();
     let mut failed_by_level = Vec::new();
     let mut seam_by_level = Vec::new();
-    // The best level so far: (levels, mesh, components, warnings, angle, unmapped share).
     let mut best: Option<BestLevel> = None;
     loop {
         let (comps, warnings) = map_once(&mesh, options, report, progress, levels)?;
@@ -248,11 +247,10 @@ fn coarseness(mesh: &TriMesh, comps: &[ConformalComponent]) -> (Option<f64>, f64
             unmapped += area;
             continue;
         }
-        let angle = c.angle_mean_away().filter(|a| a.is_finite()).or_else(|| {
-            let slit = &c.slit;
-            let all = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &|f| slit[f]);
-            all.angle_mean.is_finite().then_some(all.angle_mean)
-        });
+        let angle = c
+            .angle_mean_away()
+            .filter(|a| a.is_finite())
+            .or_else(|| c.distortion_non_slit().map(|d| d.angle_mean).filter(|a| a.is_finite()));
         if let Some(a) = angle {
             sum += a * area;
             weight += area;
@@ -262,52 +260,22 @@ fn coarseness(mesh: &TriMesh, comps: &[ConformalComponent]) -> (Option<f64>, f64
     (mean, if total > 0.0 { unmapped / total } else { 0.0 })
 }
 
-/// 3-D length of the mapped components' seams: mesh edges whose two faces belong to the
-/// same component and disagree on the UVs of the edge's ends (slits included; the
-/// chart atlas of unmapped parts is made later and not counted).
+/// 3-D length of the mapped components' seams (`fieldtex_param::conformal::seam_length`
+/// over the edges inside one component; slits included; the chart atlas of unmapped
+/// parts is made later and not counted).
 fn seam_length(mesh: &TriMesh, comps: &[ConformalComponent]) -> f64 {
     let nf = mesh.n_triangles();
     let mut owner = vec![u32::MAX; nf];
     let mut corner = vec![[[0.0f64; 2]; 3]; nf];
-    let mut extent = 0.0f64;
-    for (ci, c) in comps.iter().enumerate() {
-        if !c.has_uv() {
-            continue;
-        }
-        for (k, &f) in c.faces.iter().enumerate() {
-            if let (Some(o), Some(uv)) = (owner.get_mut(f as usize), c.corner_uv.get(k)) {
-                *o = ci as u32;
-                corner[f as usize] = *uv;
-                extent = uv.iter().fold(extent, |m, p| m.max(p[0].abs()).max(p[1].abs()));
-            }
+    for (ci, c) in comps.iter().enumerate().filter(|(_, c)| c.has_uv()) {
+        for (&f, uv) in c.faces.iter().zip(&c.corner_uv) {
+            owner[f as usize] = ci as u32;
+            corner[f as usize] = *uv;
         }
     }
-    let tol = 1e-9 * extent.max(1e-300);
-    let topo = fieldtex_mesh::Topology::build(mesh.n_vertices(), &mesh.triangles);
-    let uv_at = |f: usize, v: u32| {
-        let k = mesh.triangles[f].iter().position(|&w| w == v)?;
-        Some(corner[f][k])
-    };
-    let mut length = 0.0;
-    for (e, ends) in topo.edges.iter().enumerate() {
-        let faces = topo.edge_faces(e);
-        if faces.len() != 2 {
-            continue;
-        }
-        let (f, g) = (faces[0] as usize, faces[1] as usize);
-        if owner[f] == u32::MAX || owner[f] != owner[g] {
-            continue;
-        }
-        let differs = ends.iter().any(|&v| match (uv_at(f, v), uv_at(g, v)) {
-            (Some(a), Some(b)) => (a[0] - b[0]).abs() > tol || (a[1] - b[1]).abs() > tol,
-            _ => false,
-        });
-        if differs {
-            let (a, b) = (mesh.positions[ends[0] as usize], mesh.positions[ends[1] as usize]);
-            length += fieldtex_core::vec3::norm(fieldtex_core::vec3::sub(a, b));
-        }
-    }
-    length
+    fieldtex_param::conformal::seam_length::seam_length(mesh, &corner, &|f, g| {
+        owner[f] != u32::MAX && owner[f] == owner[g]
+    })
 }
 
 /// The warning that says the output has more triangles than the input, and why.

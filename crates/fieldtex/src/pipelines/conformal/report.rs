@@ -3,7 +3,6 @@
 
 use super::ConformalOptions;
 use crate::Report;
-use fieldtex_param::conformal::mass_spring::map_distortion;
 use fieldtex_param::conformal::{ConformalComponent, ConformalMethod, GeometryImage};
 use fieldtex_param::distortion::triangle_jacobian;
 use serde::Serialize;
@@ -59,9 +58,7 @@ pub(super) fn component_json(
         "polish": c.polish,
         "note": c.note,
     });
-    if c.has_uv() {
-        let slit = c.slit.clone();
-        let all = map_distortion(&c.local_mesh, c.faces.len(), &c.corner_uv, &move |f| slit[f]);
+    if let Some(all) = c.distortion_non_slit() {
         let away = c.angle_mean_away();
         v["patches"] = json!(c.map.n_patches());
         if c.method == ConformalMethod::CriticalTrajectoryPatches {

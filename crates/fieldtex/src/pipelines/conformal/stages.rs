@@ -123,8 +123,8 @@ pub(super) fn exemplar_levels(
 }
 
 /// Quilts every geometry image (margins copied to their partners afterwards; the
-/// fallback atlas is one of them): the texture blocks, the per-image statistics and the patch-split
-/// spread used.
+/// fallback atlas is one of them): the texture blocks, the per-image statistics and the
+/// patch-split spread used.
 pub(super) fn quilt_blocks(
     progress: &dyn Progress,
     options: &ConformalOptions,
