@@ -119,6 +119,13 @@ enum Command {
         /// Disable the 2-RoSy fix of paper D §4 (ablation).
         #[arg(long)]
         no_rosy_fix: bool,
+        /// Start from the exemplar carried along the field (least-squares integral of the
+        /// field's frames) instead of random patches: stripes and weaves then flow
+        /// without stripe endings on designs without singularities (e.g. the arch
+        /// preset); near singularities, and with irregular exemplars (wood, stone), the
+        /// default start is better.
+        #[arg(long)]
+        integrated_init: bool,
         /// Skip the image metrics of report.json (coherence, orientation error, defects);
         /// timings and the designed singularities are kept.
         #[arg(long)]
@@ -420,6 +427,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             grid,
             scale,
             no_rosy_fix,
+            integrated_init,
             no_metrics,
             exact_metrics,
             search_completeness,
@@ -443,6 +451,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             opts.grid = grid;
             opts.scale = scale;
             opts.rosy_fix = !no_rosy_fix;
+            opts.integrated_init = integrated_init;
             opts.metrics = !no_metrics;
             opts.exact_metrics = exact_metrics;
             opts.search_completeness = search_completeness;

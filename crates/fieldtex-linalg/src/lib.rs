@@ -31,6 +31,7 @@
 mod blocked_update;
 mod cholesky;
 mod cholesky_update;
+mod conjugate_gradients;
 mod dense;
 mod grid_nested_dissection;
 mod least_squares;
@@ -46,6 +47,7 @@ mod test_support;
 
 pub use cholesky::{Cholesky, CholeskyOptions, FactorLayout, SymbolicCholesky};
 pub use cholesky_update::UpdateSign;
+pub use conjugate_gradients::conjugate_gradients;
 pub use dense::{Pca, symmetric_eigen};
 pub use grid_nested_dissection::grid_nested_dissection;
 pub use least_squares::least_squares;

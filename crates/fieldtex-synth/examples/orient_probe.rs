@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p fieldtex-synth --example orient_probe -- EXEMPLAR.png
 //!  [DIR…] [--const DEG…] [--ideal DEG…] [--prerotate DEG… [--residual R] [--copy-scale F]] [--tileable | --detect-tileable] [--margin-divisor D] [--wrap-metric | --no-wrap-metric] [--both] [--no-rosy-fix] [--free-flips]
-//!  [--no-comb] [--nearest] [--no-snap] [--no-trapezoid] [--warp | --no-warp]
+//!  [--no-comb] [--nearest] [--no-snap] [--integrated-init] [--no-trapezoid] [--warp | --no-warp]
 //!  [--passes N] [--finest-passes N] [--coarse-passes N] [--jitter X] [--unjittered N] [--k K] [--no-own]
 //!  [--seed S] [--stride N] [--runs R] [--png DIR] [--scan N] [--radius R] [--analysis-k K]
 //!  [--no-metrics]`
@@ -122,6 +122,9 @@ fn main() {
             "--no-metrics" => no_metrics = true,
             "--no-comb" => opts.comb_flips = false,
             "--no-snap" => opts.snap_coordinates = false,
+            "--integrated-init" => opts.integrated_init = true,
+            "--integrated-trust" => opts.integrated_trust = num(args.next(), &a),
+            "--integrated-free" => opts.integrated_free_levels = num(args.next(), &a),
             "--ideal" => ideal.push(num::<f32>(args.next(), &a)),
             "--scan" => aopts.coherence_scan = num(args.next(), &a),
             "--radius" => aopts.coherence_radius = num(args.next(), &a),

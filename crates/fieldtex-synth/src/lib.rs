@@ -58,6 +58,7 @@ pub mod flip_combing;
 pub mod gaussian_stack;
 pub mod graph_cut;
 pub mod image_quilting;
+mod integrated_coordinates;
 pub mod k_coherence;
 pub mod lattice_domain;
 mod level_tables;

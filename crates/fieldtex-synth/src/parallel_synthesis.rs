@@ -73,6 +73,9 @@ use crate::color_lookup::color_lookup;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
 use crate::exemplar_level::{ExemplarLevel, NV, NvEntry, dist_nv};
 use crate::flip_combing::comb_flips;
+use crate::integrated_coordinates::{
+    Integrated, integrated_coordinates, refine_integrated_coordinates, trusted,
+};
 use crate::lattice_domain::{
     Dim, LatticeDomain, PlanarDomain, Stencil, frobenius, mat_vec, mean, negated,
 };
@@ -82,6 +85,10 @@ use crate::synthesis_options::{MAX_K, validate};
 use crate::synthesis_subset::SubsetPlan;
 use crate::warped_neighbourhood::{corner_map, inverse_frame, warped_corner};
 use crate::{SynthError, SynthesisDomain};
+
+/// Conjugate-gradient steps per level of the integrated initialisation's cascade
+/// ([`SynthesisOptions::integrated_init`]).
+const INTEGRATED_LEVEL_ITERATIONS: usize = 40;
 
 /// Result of [`synthesize`]: per finest-level sample (row-major over
 /// [`SynthesisDomain::output_size`]).
@@ -473,10 +480,22 @@ where
     let (wf, hf) = (w as f32, h as f32);
     progress.stage("parallel synthesis", levels as u64);
 
-    // Initialisation level: random coordinates, no flips.
+    // Initialisation level: combed flips; random coordinates, or the frames integrated.
     let mut parent_tables = tabulate::<D, S>(domain, levels, options.scale, 1, false)?;
     let n_init = domain.sample_count(levels);
     let m = analysis.level(levels - 1).margin.min(w.min(h) / 2) as f64;
+    let mut fl = if options.rosy_fix && options.comb_flips {
+        comb_flips(&parent_tables.nbr, &parent_tables.jac, <Dim<D> as Stencil<D, S>>::AXES)
+    } else {
+        vec![false; n_init]
+    };
+    if options.integrated_init && requested.is_some() {
+        return Err(SynthError::InvalidOption {
+            name: "integrated_init",
+            value: 1.0,
+            reason: "needs the whole domain (not a subset synthesis)",
+        });
+    }
     let mut s: Vec<[f32; 2]> = (0..n_init)
         .map(|i| {
             let i = i as u64;
@@ -488,11 +507,27 @@ where
             [(ux as f32).min(wf.next_down()), (uy as f32).min(hf.next_down())]
         })
         .collect();
-    let mut fl = if options.rosy_fix && options.comb_flips {
-        comb_flips(&parent_tables.nbr, &parent_tables.jac, <Dim<D> as Stencil<D, S>>::AXES)
-    } else {
-        vec![false; n_init]
-    };
+    // The integrated coordinates of the parent level (with the integrated initialisation).
+    let mut integrated: Option<Integrated> = None;
+    if options.integrated_init {
+        // The frames integrated over the initialisation level (spacing: twice the
+        // coarsest synthesised level's), placed by one seeded offset; samples where the
+        // integral does not fit the frames keep their random coordinates.
+        let h_init = 2.0 * analysis.level(levels - 1).spacing as f32;
+        let r = integrated_coordinates::<D, S>(&parent_tables.nbr, &parent_tables.jac, &fl, h_init);
+        let trust = trusted(&parent_tables.nbr, &r.misfit, options.integrated_trust);
+        let o = [
+            hash_unit(options.seed, "synthesis-init-offset", 0) * w as f64,
+            hash_unit(options.seed, "synthesis-init-offset", 1) * h as f64,
+        ];
+        for ((si, v), _) in s.iter_mut().zip(&r.u).zip(&trust).filter(|(_, t)| **t) {
+            let x = (v[0] + o[0]).rem_euclid(w as f64);
+            let y = (v[1] + o[1]).rem_euclid(h as f64);
+            let (x, y) = if options.snap_coordinates { (x.floor(), y.floor()) } else { (x, y) };
+            *si = [(x as f32).min(wf.next_down()), (y as f32).min(hf.next_down())];
+        }
+        integrated = Some(r);
+    }
     let mut level_timings_ms = Vec::with_capacity(levels);
     let passes_of = |level: usize| {
         if level == 0 {
@@ -533,13 +568,14 @@ where
         let rosy = options.rosy_fix;
         let snap = options.snap_coordinates;
         let trapezoid = rosy && options.trapezoid_frames;
-        let (mut ns, mut nf): (Vec<[f32; 2]>, Vec<bool>) = (0..n)
+        // Per sample: the upsampling offset `h F o`, the jitter and the flip.
+        let up: Vec<([f32; 2], [f32; 2], bool)> = (0..n)
             .into_par_iter()
             .map(|i| {
                 if let Some(m) = start_mask
                     && !m[i]
                 {
-                    return ([0.0; 2], false);
+                    return ([0.0; 2], [0.0; 2], false);
                 }
                 let (par, off) = tables.parent[i];
                 let par = par as usize;
@@ -561,11 +597,63 @@ where
                 if snap {
                     (jx, jy) = (jx.round(), jy.round());
                 }
-                let u = ex.wrap([ps[par][0] + o[0] + jx, ps[par][1] + o[1] + jy]);
                 let flip = rosy && (flip_par ^ (frobenius(&jpar, &tables.jac[i]) < 0.0));
-                (u, flip)
+                (o, [jx, jy], flip)
             })
-            .unzip();
+            .collect();
+        let mut nf: Vec<bool> = up.iter().map(|v| v.2).collect();
+        // With the integrated initialisation the step of a trusted child from its parent
+        // is the difference of the integrated coordinates (the parents' carried down,
+        // then smoothed on this level) instead of `h F o`, without jitter; trusted
+        // samples are corrected only on the finest levels.
+        let mut trust: Option<Vec<bool>> = None;
+        let steps: Option<Vec<Option<[f32; 2]>>> = integrated.take().map(|par_int| {
+            let u_par = &par_int.u;
+            let start: Vec<[f64; 2]> = (0..n)
+                .map(|i| {
+                    let par = tables.parent[i].0 as usize;
+                    let o = up[i].0;
+                    [u_par[par][0] + o[0] as f64, u_par[par][1] + o[1] as f64]
+                })
+                .collect();
+            let r = refine_integrated_coordinates::<D, S>(
+                &tables.nbr,
+                &tables.jac,
+                &nf,
+                spacing,
+                start,
+                INTEGRATED_LEVEL_ITERATIONS,
+            );
+            let t = trusted(&tables.nbr, &r.misfit, options.integrated_trust);
+            let st = (0..n)
+                .map(|i| {
+                    let par = tables.parent[i].0 as usize;
+                    t[i].then(|| {
+                        [(r.u[i][0] - u_par[par][0]) as f32, (r.u[i][1] - u_par[par][1]) as f32]
+                    })
+                })
+                .collect();
+            trust = Some(t);
+            integrated = Some(r);
+            st
+        });
+        let mut ns: Vec<[f32; 2]> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                if let Some(m) = start_mask
+                    && !m[i]
+                {
+                    return [0.0; 2];
+                }
+                let par = tables.parent[i].0 as usize;
+                let (o, j, _) = up[i];
+                let (o, j) = match steps.as_ref().and_then(|st| st[i]) {
+                    Some(step) => (step, [0.0; 2]),
+                    None => (o, j),
+                };
+                ex.wrap([ps[par][0] + o[0] + j[0], ps[par][1] + o[1] + j[1]])
+            })
+            .collect();
         // 3. Correction passes with subpasses.
         let pass = Pass::<D, S, C> {
             ex,
@@ -583,12 +671,14 @@ where
             }),
         };
         let n_classes = tables.classes.len();
+        let skip = trust.as_ref().filter(|_| level >= options.integrated_free_levels);
         for pass_index in 0..passes_of(level) {
             for (c, class) in tables.classes.iter().enumerate() {
                 let step = plan.as_ref().map(|p| &p.steps[level][pass_index * n_classes + c]);
                 let updates: Vec<(u32, ([f32; 2], bool))> = class
                     .par_iter()
                     .filter(|&&p| step.is_none_or(|m| m[p as usize]))
+                    .filter(|&&p| skip.is_none_or(|t| !t[p as usize]))
                     .map(|&p| (p, pass.correct(p as usize, &ns, &nf)))
                     .collect();
                 for (p, (u, f)) in updates {

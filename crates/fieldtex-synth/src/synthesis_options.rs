@@ -121,6 +121,23 @@ pub struct SynthesisOptions {
     /// .000039); `examples/orient_probe`, stride 16, seed 1, load ≈ 2.
     #[serde(default = "default_true")]
     pub snap_coordinates: bool,
+    /// Initial coordinates integrated from the effective frames over the
+    /// initialisation level (least squares, [`mod@crate::integrated_coordinates`]) plus
+    /// one seeded offset, instead of an independent random coordinate per sample
+    /// (Lefebvre & Hoppe 2005 §3.1). Default false.
+    #[serde(default)]
+    pub integrated_init: bool,
+    /// With [`Self::integrated_init`]: the largest relative misfit of the integral
+    /// (`|U(q) − U(p) − h F̄ δ| / |h F̄ δ|`) at which a sample, and all its neighbours,
+    /// follow it. Default `f32::MAX` (no bound; finite so that it serialises): every sample follows the integral except those next
+    /// to a forced seam (measured: a finite bound, 0.1 or 0.25, made the arch preset
+    /// worse and the designs with singularities no better; docs/real-exemplars.md).
+    #[serde(default = "default_integrated_trust")]
+    pub integrated_trust: f32,
+    /// With [`Self::integrated_init`]: the finest levels on which the trusted samples
+    /// are corrected too (coarser levels correct only the others). Default 1.
+    #[serde(default = "default_one")]
+    pub integrated_free_levels: usize,
 }
 
 impl Default for SynthesisOptions {
@@ -143,6 +160,9 @@ impl Default for SynthesisOptions {
             keep_flips: true,
             color_filter: ColorFilter::Cubic,
             snap_coordinates: true,
+            integrated_init: false,
+            integrated_trust: default_integrated_trust(),
+            integrated_free_levels: 1,
         }
     }
 }
@@ -153,6 +173,14 @@ fn default_finest_passes() -> Option<usize> {
 
 fn default_coarse_passes() -> Option<usize> {
     Some(12)
+}
+
+fn default_integrated_trust() -> f32 {
+    f32::MAX
+}
+
+fn default_one() -> usize {
+    1
 }
 
 fn default_true() -> bool {

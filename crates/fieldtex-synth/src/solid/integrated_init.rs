@@ -16,6 +16,8 @@
 //! it exactly; elsewhere the misfit is spread smoothly instead of growing with the
 //! distance from a pivot. Sequential and deterministic; a few thousand unknowns.
 
+use fieldtex_linalg::conjugate_gradients;
+
 use super::voxel_lattice::{FrameSource, VoxelLattice};
 
 /// `U` over a box of coarsest-level voxels (see the module docs).
@@ -112,42 +114,6 @@ impl IntegratedInit {
         }
         Some(self.u[(i[2] * self.dims[1] + i[1]) * self.dims[0] + i[0]])
     }
-}
-
-/// Conjugate gradients for the symmetric positive definite operator `apply` (sequential,
-/// so the result does not depend on the thread count).
-fn conjugate_gradients(
-    apply: &dyn Fn(&[f64], &mut [f64]),
-    rhs: &[f64],
-    max_iterations: usize,
-    tolerance: f64,
-) -> Vec<f64> {
-    let n = rhs.len();
-    let mut x = vec![0.0; n];
-    let mut r = rhs.to_vec();
-    let mut p = r.clone();
-    let mut ap = vec![0.0; n];
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-    let mut rr = dot(&r, &r);
-    let stop = tolerance * tolerance * rr.max(f64::MIN_POSITIVE);
-    for _ in 0..max_iterations {
-        if rr <= stop {
-            break;
-        }
-        apply(&p, &mut ap);
-        let alpha = rr / dot(&p, &ap);
-        for i in 0..n {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * ap[i];
-        }
-        let next = dot(&r, &r);
-        let beta = next / rr;
-        rr = next;
-        for i in 0..n {
-            p[i] = r[i] + beta * p[i];
-        }
-    }
-    x
 }
 
 #[cfg(test)]

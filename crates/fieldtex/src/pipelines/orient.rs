@@ -14,7 +14,7 @@
 use crate::outputs::{begin_command, begin_outputs, commit_outputs};
 use crate::pipelines::eval::image_metrics;
 use crate::{Error, Progress, Report, Result};
-use fieldtex_core::Image;
+use fieldtex_core::{Image, Warning};
 use fieldtex_fields::{DesignFile, SingularityKind};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -47,6 +47,11 @@ pub struct OrientOptions {
     pub scale: f64,
     /// The 2-RoSy fix of paper D §4 (off only for the ablation). Default true.
     pub rosy_fix: bool,
+    /// Start the synthesis from the exemplar carried along the field by the least-squares
+    /// integral of its frames (`--integrated-init`, `fieldtex_synth::SynthesisOptions::
+    /// integrated_init`): for periodic exemplars (stripes, weaves) on designs without
+    /// singularities. Default false.
+    pub integrated_init: bool,
     pub seed: u64,
     /// A disk-topology mesh patch to texture (`--mesh`); `None` = the plane. Default None.
     pub mesh: Option<PathBuf>,
@@ -97,6 +102,16 @@ impl OrientOptions {
         (fitted, per_pixel)
     }
 
+    /// The synthesis options of these orient options.
+    pub(crate) fn synthesis_options(&self) -> fieldtex_synth::SynthesisOptions {
+        fieldtex_synth::SynthesisOptions {
+            seed: self.seed,
+            rosy_fix: self.rosy_fix,
+            integrated_init: self.integrated_init,
+            ..Default::default()
+        }
+    }
+
     pub fn new(source: FieldSource, exemplar: PathBuf) -> Self {
         Self {
             source,
@@ -105,6 +120,7 @@ impl OrientOptions {
             grid: 128,
             scale: 1.0,
             rosy_fix: true,
+            integrated_init: false,
             seed: 1,
             mesh: None,
             patch: None,
@@ -170,7 +186,7 @@ fn build_field(
         .map_err(|e| Error::internal("field sampling", e))?;
     // Design coordinates → pixels.
     let (sx, sy) = (n as f64 / grid.width, n as f64 / grid.height);
-    let designed = fd
+    let designed: Vec<DesignedSingularity> = fd
         .singularities()
         .into_iter()
         .map(|(_, s)| DesignedSingularity {
@@ -180,6 +196,17 @@ fn build_field(
         })
         .collect();
     report.warnings.extend(fd.warnings().iter().cloned());
+    if options.integrated_init && !designed.is_empty() {
+        report.warnings.push(Warning::new(
+            "integrated-init-singularities",
+            format!(
+                "--integrated-init on a design with {} singularities: around them the \
+                 exemplar cannot follow the field without stretching, and the default start \
+                 usually scores better there (docs/real-exemplars.md)",
+                designed.len()
+            ),
+        ));
+    }
     Ok((pixels, designed))
 }
 

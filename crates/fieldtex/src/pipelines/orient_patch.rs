@@ -60,7 +60,7 @@ use fieldtex_fields::design_file::DomainKind;
 use fieldtex_fields::{DesignFile, FieldDesign, SingularityKind};
 use fieldtex_mesh::TriMesh;
 use fieldtex_param::TexelMap;
-use fieldtex_synth::{ImageDomain, SynthesisOptions, synthesize};
+use fieldtex_synth::{ImageDomain, synthesize};
 use patch_parameterization::{Patch, check_disk, cut_ball, parameterize};
 use plane_design_mapping::{build_mesh_design, map_plane_design};
 use serde::Serialize;
@@ -156,8 +156,7 @@ pub(crate) fn orient_patch(
         .map_err(|e| Error::classify(&e, Some(&options.exemplar), "exemplar"))?;
     report.metric("analysis_cached", cached);
     let domain = ImageDomain::new(n, n, jac).map_err(|e| Error::internal("synthesis domain", e))?;
-    let sopts =
-        SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };
+    let sopts = options.synthesis_options();
     let texture = report
         .stage(progress, "synthesis", || synthesize(&analysis, &domain, &sopts, progress))
         .map_err(|e| Error::internal("synthesis", e))?

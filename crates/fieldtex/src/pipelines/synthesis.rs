@@ -4,9 +4,7 @@
 use super::orient::OrientOptions;
 use crate::{Error, Progress, Report, Result};
 use fieldtex_core::Image;
-use fieldtex_synth::{
-    AnalysisOptions, ExemplarAnalysis, ImageDomain, SynthesisOptions, synthesize,
-};
+use fieldtex_synth::{AnalysisOptions, ExemplarAnalysis, ImageDomain, synthesize};
 use std::sync::{Arc, Mutex};
 
 /// A cache of the most recent exemplar analysis, keyed by a hash of the exemplar pixels
@@ -128,8 +126,7 @@ pub(crate) fn synthesize_analysed(
     let flat: Vec<f32> = field.iter().flat_map(|v| [v[0], v[1]]).collect();
     let domain = ImageDomain::from_direction_field(width, height, &flat, per_pixel as f32)
         .map_err(|e| Error::internal("synthesis domain", e))?;
-    let sopts =
-        SynthesisOptions { seed: options.seed, rosy_fix: options.rosy_fix, ..Default::default() };
+    let sopts = options.synthesis_options();
     let result = report
         .stage(progress, "synthesis", || synthesize(analysis, &domain, &sopts, progress))
         .map_err(|e| Error::internal("synthesis", e))?;
