@@ -33,6 +33,21 @@ fn synthesize_2d(
         .unwrap()
 }
 
+/// [`synthesize`] on one and on two threads.
+fn on_one_and_two_threads(
+    an: &ExemplarAnalysis,
+    dom: &ImageDomain,
+    opts: &SynthesisOptions,
+) -> Vec<SynthesisResult> {
+    [1, 2]
+        .into_iter()
+        .map(|threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| synthesize(an, dom, opts, &NoProgress).unwrap())
+        })
+        .collect()
+}
+
 fn coord_bits(c: &[[f32; 2]]) -> Vec<[u32; 2]> {
     c.iter().map(|u| u.map(f32::to_bits)).collect()
 }
@@ -191,13 +206,7 @@ fn warped_corners_change_only_curved_fields_and_stay_deterministic() {
 
     let curved = wedge_domain(48);
     let off = synthesize(&an, &curved, &plain, &NoProgress).unwrap();
-    let runs: Vec<SynthesisResult> = [1, 2]
-        .into_iter()
-        .map(|threads| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| synthesize(&an, &curved, &warped, &NoProgress).unwrap())
-        })
-        .collect();
+    let runs = on_one_and_two_threads(&an, &curved, &warped);
     assert_eq!(coord_bits(&runs[0].coords), coord_bits(&runs[1].coords));
     assert_eq!(runs[0].flips, runs[1].flips);
     assert_ne!(coord_bits(&off.coords), coord_bits(&runs[0].coords));
@@ -268,13 +277,7 @@ fn integrated_init_keeps_a_bent_field_coherent() {
     let plain = SynthesisOptions { seed: 5, ..Default::default() };
     let integrated = SynthesisOptions { integrated_init: true, ..plain.clone() };
     let a = synthesize(&an, &dom, &plain, &NoProgress).unwrap();
-    let runs: Vec<SynthesisResult> = [1, 2]
-        .into_iter()
-        .map(|threads| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| synthesize(&an, &dom, &integrated, &NoProgress).unwrap())
-        })
-        .collect();
+    let runs = on_one_and_two_threads(&an, &dom, &integrated);
     assert_eq!(coord_bits(&runs[0].coords), coord_bits(&runs[1].coords));
     let (ca, cb) = (
         coherent_share(&dom, &a.coords, (ex.width, ex.height)),
