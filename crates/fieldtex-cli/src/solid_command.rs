@@ -83,6 +83,12 @@ pub struct SolidArgs {
     /// along the field (paper E §4.3); the finer ones span it with the voxel's frame.
     #[arg(long, default_value_t = 2)]
     integrate_levels: usize,
+    /// Start from the exemplar carried along the sketched field (least-squares integral
+    /// of its frames) and correct only the finest level: layers such as stripes or wood
+    /// rings then follow the sketch without breaks. The default start suits irregular
+    /// exemplars (stone, marble) better.
+    #[arg(long)]
+    integrated_init: bool,
     /// Synthesis levels.
     #[arg(long, default_value_t = 5)]
     levels: usize,
@@ -182,6 +188,7 @@ pub fn run_solid(
     opts.synthesis.seed = seed;
     opts.synthesis.trilinear_levels = a.trilinear_levels;
     opts.synthesis.integrate_levels = a.integrate_levels;
+    opts.synthesis.integrated_init = a.integrated_init;
     opts.analysis.levels = a.levels;
     opts.analysis.neighbourhood = a.neighbourhood;
     opts.analysis.feature_weight = a.feature_weight;

@@ -25,23 +25,23 @@ pub(crate) struct IntegratedInit {
     lo: [i32; 3],
     dims: [usize; 3],
     u: Vec<[f64; 3]>,
+    /// The level `U` lives on.
+    level: usize,
 }
 
-/// Voxels added around the grid on every side (blocks read a halo beyond it).
-const PAD: i32 = 3;
-
 impl IntegratedInit {
-    /// `U` on level `c` of `lattice` over the coarsest voxels covering the finest grid
-    /// `[0, extent)` plus a margin.
+    /// `U` on level `c` of `lattice` over the level-`c` voxels covering the finest grid
+    /// `[0, extent)` plus `pad` voxels on every side (blocks read a halo beyond it).
     pub(crate) fn new(
         lattice: &VoxelLattice,
         frames: &dyn FrameSource,
         c: usize,
         extent: [usize; 3],
+        pad: i32,
     ) -> Self {
-        let lo = [-PAD; 3];
+        let lo = [-pad; 3];
         let dims: [usize; 3] =
-            std::array::from_fn(|a| (extent[a].div_ceil(1usize << c)) + 2 * PAD as usize);
+            std::array::from_fn(|a| (extent[a].div_ceil(1usize << c)) + 2 * pad as usize);
         let n = dims[0] * dims[1] * dims[2];
         let idx = |i: [usize; 3]| (i[2] * dims[1] + i[1]) * dims[0] + i[0];
         let voxel = |i: [usize; 3]| -> [i32; 3] { std::array::from_fn(|a| lo[a] + i[a] as i32) };
@@ -99,10 +99,55 @@ impl IntegratedInit {
                 ui[d] = xi;
             }
         }
-        Self { lo, dims, u }
+        Self { lo, dims, u, level: c }
+    }
+
+    /// `U` trilinearly interpolated at the centre of voxel `v` of level `c` (in voxels of
+    /// `U`'s level, as [`Self::get`]), or `None` where the
+    /// interpolation would leave the box. A function of the position alone, so every
+    /// level reads one smooth warp.
+    pub(crate) fn interpolated(&self, c: usize, v: [i32; 3]) -> Option<[f64; 3]> {
+        let (sc, sm) = ((1i64 << c) as f64, (1i64 << self.level) as f64);
+        let mut i0 = [0usize; 3];
+        let mut t = [0.0f64; 3];
+        for a in 0..3 {
+            // Finest-voxel position of the centre, then index units of U's level.
+            let x =
+                (sc * v[a] as f64 + 0.5 * (sc - 1.0) - 0.5 * (sm - 1.0)) / sm - self.lo[a] as f64;
+            let f = x.floor();
+            if f < 0.0 || f as usize + 1 >= self.dims[a] {
+                return None;
+            }
+            i0[a] = f as usize;
+            t[a] = x - f;
+        }
+        let mut acc = [0.0f64; 3];
+        for corner in 0..8 {
+            let mut w = 1.0;
+            let mut idx = [0usize; 3];
+            for a in 0..3 {
+                let bit = (corner >> a) & 1;
+                idx[a] = i0[a] + bit;
+                w *= if bit == 1 { t[a] } else { 1.0 - t[a] };
+            }
+            let u = self.u[(idx[2] * self.dims[1] + idx[1]) * self.dims[0] + idx[0]];
+            for d in 0..3 {
+                acc[d] += w * u[d];
+            }
+        }
+        Some(acc)
+    }
+
+    /// The exemplar-pixel offset `R = round(2^g U)` of voxel `v` of level `c` on the warp
+    /// (`g` the level `U` lives on; `U` interpolated at the voxel's centre), so a child's
+    /// step from its parent telescopes between neighbours on every level.
+    pub(crate) fn offset(&self, c: usize, v: [i32; 3]) -> Option<[i32; 3]> {
+        let h = (1i64 << self.level) as f64;
+        self.interpolated(c, v).map(|u| u.map(|x| (h * x).round() as i32))
     }
 
     /// `U(v)`, or `None` outside the box.
+    #[cfg(test)]
     pub(crate) fn get(&self, v: [i32; 3]) -> Option<[f64; 3]> {
         let mut i = [0usize; 3];
         for a in 0..3 {
@@ -126,7 +171,7 @@ mod tests {
         // Frame turned 90° about z: local x = world y, local y = −world x.
         let r = [0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
         let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
-        let init = IntegratedInit::new(&lattice, &ConstantFrame(r), 2, [20, 16, 12]);
+        let init = IntegratedInit::new(&lattice, &ConstantFrame(r), 2, [20, 16, 12], 3);
         let (a, b) = (init.get([1, 1, 1]).unwrap(), init.get([2, 1, 1]).unwrap());
         // One voxel along world x is Rᵀ e_x = (0, −1, 0) in local coordinates.
         let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];

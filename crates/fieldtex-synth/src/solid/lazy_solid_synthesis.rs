@@ -59,6 +59,10 @@ use std::time::Instant;
 
 mod block_regions;
 use super::integrated_init::IntegratedInit;
+
+/// Largest grid of the integrated initialisation's solve
+/// ([`SolidSynthesisOptions::integrated_init`]).
+const INTEGRATED_NODES: usize = 500_000;
 mod voxel_correction;
 use block_regions::{BlockCursor, for_box, local_index, region_of};
 
@@ -97,9 +101,16 @@ pub struct SolidSynthesisOptions {
     /// bits): on the bent stripes box (docs/solid.md, session 13) it was neutral within
     /// the seed-to-seed spread, so it stays opt-in.
     pub projected_predictions: bool,
-    /// Initial slab coordinates integrated from the frame field over the grid's coarsest
-    /// voxels ([`super::integrated_init`]) instead of one pivot per subpart; takes effect
-    /// once the grid is known ([`SolidSynthesizer::with_extent`]). Default false.
+    /// Start from one warp of the exemplar along the frame field: the least-squares
+    /// integral `U` of the frames ([`super::integrated_init`], on the finest level whose
+    /// grid has at most 500 000 voxels) moves one seeded anchor triple per subpart on the
+    /// coarsest level, and every upsampling step follows `U` (interpolated at the voxel
+    /// centres, rounded so that steps telescope) instead of eq. 3–4 in the parent's
+    /// frame. Unless [`Self::level_passes`] says otherwise only the finest level is
+    /// then corrected. For layered exemplars (stripes, wood rings) whose layers should
+    /// follow the sketch without breaks. Takes effect once the grid is known
+    /// ([`SolidSynthesizer::with_extent`]; voxels off the grid keep the default path).
+    /// Default false.
     pub integrated_init: bool,
     pub seed: u64,
 }
@@ -253,8 +264,17 @@ impl<'a> SolidSynthesizer<'a> {
     /// any request and give every synthesizer that shares a cache the same extent.
     pub fn with_extent(mut self, extent: [usize; 3]) -> Self {
         if self.options.integrated_init {
-            let c = self.cache.len().saturating_sub(1);
-            self.init = Some(IntegratedInit::new(&self.lattice, self.frames, c, extent));
+            // The finest level whose grid stays within INTEGRATED_NODES voxels (the
+            // coarser, the more a turning field is cut into facets), at most the coarsest.
+            let coarsest = self.cache.len().saturating_sub(1);
+            // Padding in level-g voxels: the finest correction reads `halo` voxels
+            // beyond the grid; voxels off the box fall back to eq. 3–4.
+            let pad = |_g: usize| self.halo() + 2;
+            let nodes = |g: usize| -> usize {
+                extent.iter().map(|&e| e.div_ceil(1 << g) + 2 * pad(g) as usize).product()
+            };
+            let g = (0..=coarsest).find(|&g| nodes(g) <= INTEGRATED_NODES).unwrap_or(coarsest);
+            self.init = Some(IntegratedInit::new(&self.lattice, self.frames, g, extent, pad(g)));
         }
         self
     }
@@ -464,13 +484,31 @@ impl<'a> SolidSynthesizer<'a> {
         let o: [f64; 3] = std::array::from_fn(|a| (s[a] * k) as f64 + 0.5 * (k - 1) as f64);
         let rm = self.frames.frame(self.lattice.centre(c, v));
         let d: [f64; 3] = std::array::from_fn(|a| v[a] as f64 - o[a]);
+        // With the integrated initialisation: one seeded anchor triple per subpart moved
+        // by the warp's offset on all three planes, so the xy, yz and zx coordinates
+        // stay coherent across voxels (eq. 3–4's mapping of a 3-vector to the planes).
+        if let Some(r) = self.init.as_ref().and_then(|u| u.offset(c, v)) {
+            let key = fieldtex_core::rng::mix64(
+                (s[0] as u32 as u64) ^ ((s[1] as u32 as u64) << 21) ^ ((s[2] as u32 as u64) << 42),
+            );
+            let e0 = &self.exemplar.planes[0];
+            let ox = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-anchor-x", key)
+                * e0.width as f64) as i32;
+            let oy = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-anchor-y", key)
+                * e0.height as f64) as i32;
+            let mut tr = *self.exemplar.triples[c][0].get(ox, oy, 0);
+            tr[0][0] += r[0];
+            tr[0][1] += r[1];
+            tr[1][0] += r[1];
+            tr[1][1] += r[2];
+            tr[2][0] += r[2];
+            tr[2][1] += r[0];
+            return self.wrap(tr);
+        }
         // Local coordinates Rᵀ d.
-        let w: [i32; 3] = match self.init.as_ref().and_then(|u| u.get(v)) {
-            Some(u) => u.map(round_f64_i32),
-            None => std::array::from_fn(|col| {
-                round_f64_i32(rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2])
-            }),
-        };
+        let w: [i32; 3] = std::array::from_fn(|col| {
+            round_f64_i32(rm[col] * d[0] + rm[3 + col] * d[1] + rm[6 + col] * d[2])
+        });
         let layer = floor_div(w[2], n);
         let t = w[2] - layer * n - n / 2;
         let key = fieldtex_core::rng::mix64(
@@ -499,11 +537,19 @@ impl<'a> SolidSynthesizer<'a> {
         rm: &[f64; 9],
     ) -> Triple {
         let h = 1i32 << c;
-        let delta: [f64; 3] = std::array::from_fn(|a| (h * (v[a] - 2 * pv[a])) as f64);
-        let d: [f64; 3] = std::array::from_fn(|col| {
-            rm[col] * delta[0] + rm[3 + col] * delta[1] + rm[6 + col] * delta[2]
-        });
-        let di: [i32; 3] = d.map(round_f64_i32);
+        // With the integrated initialisation the step follows the one warp `U` of every
+        // level (telescoping between neighbours); elsewhere eq. 3–4 in the parent's frame.
+        let warp = self.init.as_ref().and_then(|u| Some((u.offset(c, v)?, u.offset(c + 1, pv)?)));
+        let di: [i32; 3] = match warp {
+            Some((a, b)) => std::array::from_fn(|k| a[k] - b[k]),
+            None => {
+                let delta: [f64; 3] = std::array::from_fn(|a| (h * (v[a] - 2 * pv[a])) as f64);
+                let d: [f64; 3] = std::array::from_fn(|col| {
+                    rm[col] * delta[0] + rm[3 + col] * delta[1] + rm[6 + col] * delta[2]
+                });
+                d.map(round_f64_i32)
+            }
+        };
         let mut tr = parent;
         tr[0][0] += di[0];
         tr[0][1] += di[1];
@@ -557,6 +603,11 @@ impl<'a> SolidSynthesizer<'a> {
     fn level_passes(&self, c: usize) -> usize {
         if let Some(&p) = self.options.level_passes.get(c) {
             p
+        } else if self.init.is_some() {
+            // The integrated start is corrected on the finest level only: on the coarse
+            // levels the stack has blurred thin layers away and corrections break the
+            // warp's phase (docs/solid.md, session 18).
+            if c == 0 { self.options.passes } else { 0 }
         } else if c + 1 == self.cache.len() {
             self.options.coarse_passes
         } else {

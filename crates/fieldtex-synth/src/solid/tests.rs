@@ -390,3 +390,38 @@ fn integrated_initialisation_keeps_the_on_demand_equality() {
         assert_eq!(run(true, &voxels[i..i + 1])[0], integrated[i], "voxel {:?}", voxels[i]);
     }
 }
+
+/// With the integrated start the xy coordinates of neighbouring voxels follow the bent
+/// field's step (one warp) far more often than from the default slabs.
+#[test]
+fn integrated_start_follows_a_bent_field() {
+    let img = exemplar();
+    let (ao, so) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let n = 24;
+    let slice: Vec<[i32; 3]> = (0..n * n).map(|i| [i % n, i / n, 5]).collect();
+    let share = |integrated_init: bool| {
+        let o = SolidSynthesisOptions { integrated_init, ..so.clone() };
+        let t = SolidSynthesizer::new(&ex, lattice, &Bent, o)
+            .unwrap()
+            .with_extent([n as usize, n as usize, 12])
+            .triples(&slice, &NoProgress)
+            .0;
+        let mut ok = 0;
+        for y in 0..n {
+            for x in 0..n - 1 {
+                let (a, b) = (t[(y * n + x) as usize][0], t[(y * n + x + 1) as usize][0]);
+                let r = Bent.frame(lattice.centre(0, [x, y, 5]));
+                // One voxel along world x moves the local coordinates by Rᵀ e_x.
+                let wrap = |d: i32| (d + 16).rem_euclid(32) - 16;
+                let e = [wrap(b[0] - a[0]) as f64 - r[0], wrap(b[1] - a[1]) as f64 - r[1]];
+                ok += (e[0].hypot(e[1]) <= 1.0) as usize;
+            }
+        }
+        ok as f64 / (n * (n - 1)) as f64
+    };
+    let (plain, integrated) = (share(false), share(true));
+    eprintln!("coherent steps: default {plain:.3}, integrated {integrated:.3}");
+    assert!(integrated > plain + 0.1, "default {plain:.3}, integrated {integrated:.3}");
+}
