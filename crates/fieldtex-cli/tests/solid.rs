@@ -36,7 +36,7 @@ const SKETCH: &str = r#"{"curves": [
 
 /// Runs the torus (axis y) at a small resolution with a y cut through the voxel
 /// centres of slice `k`.
-fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
+fn torus_run(dir: &Path, threads: &str, k: usize, more: &[&str]) -> Output {
     let sketch = dir.join("sketch.json");
     std::fs::write(&sketch, SKETCH).unwrap();
     // The grid: longest side 2.5 (x, z), 40 voxels, spacing 0.0625; y extent 0.5
@@ -47,7 +47,7 @@ fn torus_run(dir: &Path, threads: &str, k: usize) -> Output {
     let sketch = sketch.to_str().unwrap();
     let extra =
         ["--sketch", sketch, "--cut", &cut, "--volume", "--keep", "--threads", threads, "--quiet"];
-    small_torus(&woodgrain(), &out, "40", &extra)
+    small_torus(&woodgrain(), &out, "40", &[&extra[..], more].concat())
 }
 
 fn weld_closed(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
@@ -71,29 +71,9 @@ fn weld_closed(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
     half.iter().all(|(&(a, b), &c)| c == 1 && half.get(&(b, a)) == Some(&1))
 }
 
-#[test]
-fn solid_outputs_cut_slice_and_determinism() {
-    let d1 = tmp("torus-1");
-    let o = torus_run(&d1, "1", 4);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let out = d1.join("out");
-    for f in [
-        "model.glb",
-        "preview.png",
-        "report.json",
-        "cut-1.glb",
-        "cut-1.png",
-        "volume.nrrd",
-        "frames.ply",
-    ] {
-        assert!(out.join(f).exists(), "{f} missing");
-    }
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
-    let err = report["metrics"]["frame_field"]["alignment_error_max_deg"].as_f64().unwrap();
-    assert!(err <= 5.0, "frame-field alignment error {err}°");
-    assert_eq!(report["metrics"]["cuts"][0]["grid_slice"], true);
-    // The cut image equals the volume's slice where opaque.
+/// Asserts that `cut-1.png` of the torus run in `out` equals slice `k` (along y) of
+/// `volume.nrrd` where opaque, with enough of both; returns the volume.
+fn cut_equals_volume_slice(out: &Path, k: usize) -> fieldtex::crates::io::RgbVolume {
     let vol = fieldtex::crates::io::decode_nrrd_rgb(
         &std::fs::read(out.join("volume.nrrd")).unwrap(),
         "volume",
@@ -113,11 +93,38 @@ fn solid_outputs_cut_slice_and_determinism() {
                 continue;
             }
             opaque += 1;
-            let i = 3 * (x + nx * (4 + ny * z));
+            let i = 3 * (x + nx * (k + ny * z));
             assert_eq!(&p[..3], &vol.data[i..i + 3], "pixel ({x}, {z})");
         }
     }
     assert!(opaque > 100 && transparent > 100, "opaque {opaque}, transparent {transparent}");
+    vol
+}
+
+#[test]
+fn solid_outputs_cut_slice_and_determinism() {
+    let d1 = tmp("torus-1");
+    let o = torus_run(&d1, "1", 4, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = d1.join("out");
+    for f in [
+        "model.glb",
+        "preview.png",
+        "report.json",
+        "cut-1.glb",
+        "cut-1.png",
+        "volume.nrrd",
+        "frames.ply",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let err = report["metrics"]["frame_field"]["alignment_error_max_deg"].as_f64().unwrap();
+    assert!(err <= 5.0, "frame-field alignment error {err}°");
+    assert_eq!(report["metrics"]["cuts"][0]["grid_slice"], true);
+    // The cut image equals the volume's slice where opaque.
+    let vol = cut_equals_volume_slice(&out, 4);
     // The solid is textured, not flat: the red channel varies (woodgrain's own standard
     // deviation is 7.2; an earlier version that averaged three incompatible planes gave 1.1).
     let red: Vec<f64> = vol.data.iter().step_by(3).map(|&v| v as f64).collect();
@@ -129,7 +136,7 @@ fn solid_outputs_cut_slice_and_determinism() {
     assert!(weld_closed(&cut.positions, &cut.triangles), "cut-1.glb is not closed");
     // Two threads: the same bytes.
     let d2 = tmp("torus-2");
-    let o = torus_run(&d2, "2", 4);
+    let o = torus_run(&d2, "2", 4, &[]);
     assert!(o.status.success());
     for f in ["model.glb", "cut-1.png", "volume.nrrd", "frames.ply"] {
         assert_eq!(
@@ -248,4 +255,29 @@ fn feature_mask_is_used_and_a_wrong_size_is_an_error() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let report = std::fs::read_to_string(out.join("report.json")).unwrap();
     assert!(report.contains("--feature-mask: the mask"), "the notes name the feature channel");
+}
+
+/// `--integrated-init`: the cut still equals the volume's slice byte for byte (on-demand
+/// equality with the new start), two threads give the same bytes, and the solid differs
+/// from the default start.
+#[test]
+fn integrated_init_keeps_cut_equality_and_determinism() {
+    let d1 = tmp("torus-int-1");
+    let d2 = tmp("torus-int-2");
+    for (d, threads) in [(&d1, "1"), (&d2, "2")] {
+        let o = torus_run(d, threads, 4, &["--integrated-init"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let out = d1.join("out");
+    cut_equals_volume_slice(&out, 4);
+    for f in ["model.glb", "cut-1.png", "volume.nrrd"] {
+        assert_eq!(
+            std::fs::read(out.join(f)).unwrap(),
+            std::fs::read(d2.join("out").join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["options"]["synthesis"]["integrated_init"], true, "{}", report["options"]);
 }
