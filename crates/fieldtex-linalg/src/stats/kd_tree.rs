@@ -166,22 +166,43 @@ impl KdTree {
         max_checks: usize,
         scratch: &mut KdScratch,
     ) -> Option<(usize, f32)> {
+        let mut best = Vec::with_capacity(2);
+        self.k_nearest(query, 1, max_checks, scratch, &mut best);
+        best.first().copied()
+    }
+
+    /// The `k` nearest points to `query` into `out` (cleared first), nearest first, as
+    /// `(index, squared distance)`, ties to the smaller index; examining at most
+    /// `max_checks` points once `k` are found (`usize::MAX`: exact). With `k = 1` this is
+    /// [`Self::nearest`]. Fewer than `k` only when the tree holds fewer points.
+    pub fn k_nearest(
+        &self,
+        query: &[f32],
+        k: usize,
+        max_checks: usize,
+        scratch: &mut KdScratch,
+        out: &mut Vec<(usize, f32)>,
+    ) {
         assert_eq!(query.len(), self.dim, "KdTree::nearest: query of the tree's dimension");
-        if self.nodes.is_empty() {
-            return None;
+        out.clear();
+        if self.nodes.is_empty() || k == 0 {
+            return;
         }
         let heap = &mut scratch.heap;
         heap.clear();
         heap.push(Pending { bound: 0.0, lower: 0.0, node: 0 });
         let exact = max_checks == usize::MAX;
-        let mut best = (usize::MAX, f32::INFINITY);
+        // The k-th distance so far (infinite until k are found).
+        let kth =
+            |out: &Vec<(usize, f32)>| if out.len() < k { f32::INFINITY } else { out[k - 1].1 };
         let mut checked = 0usize;
         while let Some(Pending { bound, lower, node }) = heap.pop() {
+            let worst = kth(out);
             if exact {
-                if lower > best.1 {
+                if lower > worst {
                     continue;
                 }
-            } else if bound > best.1 || (checked >= max_checks && best.0 != usize::MAX) {
+            } else if bound > worst || (checked >= max_checks && out.len() >= k) {
                 break;
             }
             // Descend to a leaf, queueing the far sides with their bounds.
@@ -191,8 +212,14 @@ impl KdTree {
                     Node::Leaf { start, end } => {
                         for &i in &self.order[start as usize..end as usize] {
                             let d2 = self.dist2(i as usize, query);
-                            if d2 < best.1 || (d2 == best.1 && (i as usize) < best.0) {
-                                best = (i as usize, d2);
+                            let i = i as usize;
+                            if out.len() < k
+                                || d2 < out[k - 1].1
+                                || (d2 == out[k - 1].1 && i < out[k - 1].0)
+                            {
+                                let at = out.partition_point(|&(j, e)| (e, j) <= (d2, i));
+                                out.insert(at, (i, d2));
+                                out.truncate(k);
                             }
                             checked += 1;
                         }
@@ -203,7 +230,7 @@ impl KdTree {
                         let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
                         let far_bound = bound + diff * diff;
                         let far_lower = lower.max(diff * diff);
-                        if (if exact { far_lower } else { far_bound }) <= best.1 {
+                        if (if exact { far_lower } else { far_bound }) <= kth(out) {
                             heap.push(Pending { bound: far_bound, lower: far_lower, node: far });
                         }
                         id = near;
@@ -211,7 +238,6 @@ impl KdTree {
                 }
             }
         }
-        (best.0 != usize::MAX).then_some(best)
     }
 }
 
@@ -229,6 +255,34 @@ mod tests {
             }
         }
         best
+    }
+
+    #[test]
+    fn exact_k_nearest_equals_brute_force() {
+        let d = 5;
+        let n = 2000;
+        let pts: Vec<f32> = (0..n * d).map(|i| hash_unit(5, "kdk", i as u64) as f32).collect();
+        let tree = KdTree::build(&pts, d);
+        let mut sc = KdScratch::default();
+        let mut out = Vec::new();
+        for q in 0..50 {
+            let query: Vec<f32> =
+                (0..d).map(|k| hash_unit(6, "kdkq", (q * d + k) as u64) as f32).collect();
+            let mut all: Vec<(usize, f32)> = pts
+                .chunks_exact(d)
+                .enumerate()
+                .map(|(i, r)| (i, r.iter().zip(&query).map(|(a, b)| (a - b) * (a - b)).sum()))
+                .collect();
+            all.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+            tree.k_nearest(&query, 8, usize::MAX, &mut sc, &mut out);
+            let want: Vec<usize> = all[..8].iter().map(|p| p.0).collect();
+            assert_eq!(out.iter().map(|p| p.0).collect::<Vec<_>>(), want);
+            // Approximate: true points, sorted, never closer than the exact k-th.
+            tree.k_nearest(&query, 8, 64, &mut sc, &mut out);
+            assert_eq!(out.len(), 8);
+            assert!(out.windows(2).all(|w| w[0].1 <= w[1].1));
+            assert!(out[7].1 >= all[7].1);
+        }
     }
 
     #[test]

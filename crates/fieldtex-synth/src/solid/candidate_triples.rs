@@ -25,9 +25,18 @@
 //! consistent with a neighbouring pixel's triple is not applied.
 
 use super::solid_exemplar::{PlaneExemplar, SolidAnalysisOptions};
+use fieldtex_linalg::stats::{KdScratch, KdTree};
 use rayon::prelude::*;
 
 const K1: usize = 8;
+
+/// Pool strides above which the partners come from a kd-tree instead (large exemplars:
+/// the refinement cells grow with the stride squared, so the pool search costs about
+/// `W H √(W H)` per plane; at 512² it took minutes).
+const TREE_ABOVE_STRIDE: usize = 4;
+
+/// Points a kd-tree partner search examines (best-bin-first, after the `K₁` first).
+pub(crate) const TREE_CHECKS: usize = 128;
 
 /// Exemplar pixel coordinates, one per plane (xy, yz, zx).
 pub type Triple = [[i32; 2]; 3];
@@ -167,9 +176,80 @@ fn pool_sticks(sticks: &[f32], len: usize, pool: &[usize]) -> Vec<f32> {
     out
 }
 
+/// Per-thread scratch of [`nearest`]: the pool distances and, per exemplar pixel, the
+/// query that last visited it (so the refinement cells are deduplicated without
+/// sorting).
+#[derive(Default)]
+struct Scratch {
+    dists: Vec<f32>,
+    visited: Vec<u32>,
+    query: u32,
+    kd: KdScratch,
+    found: Vec<(usize, f32)>,
+}
+
+/// Where the `K₁` partners of a stick are searched: the pool and its cells, or (large
+/// exemplars) a kd-tree over every pixel's stick.
+enum PartnerSearch {
+    Pool { pooled: Vec<f32>, pool: (Vec<usize>, usize) },
+    Tree(KdTree),
+}
+
+impl PartnerSearch {
+    fn new(sticks: &[f32], len: usize, w: usize, hgt: usize, pool_size: usize) -> Self {
+        let pool = pool(w, hgt, pool_size);
+        if pool.1 > TREE_ABOVE_STRIDE {
+            PartnerSearch::Tree(KdTree::build(sticks, len))
+        } else {
+            PartnerSearch::Pool { pooled: pool_sticks(sticks, len, &pool.0), pool }
+        }
+    }
+
+    /// The `K₁` nearest sticks to `query` (by distance, then index).
+    #[allow(clippy::too_many_arguments)]
+    fn nearest(
+        &self,
+        query: &[f32],
+        sticks: &[f32],
+        len: usize,
+        w: usize,
+        hgt: usize,
+        scratch: &mut Scratch,
+    ) -> Vec<(f32, usize)> {
+        match self {
+            PartnerSearch::Pool { pooled, pool } => {
+                nearest(query, sticks, pooled, len, pool, w, hgt, scratch)
+            }
+            PartnerSearch::Tree(tree) => {
+                tree.k_nearest(query, K1, TREE_CHECKS, &mut scratch.kd, &mut scratch.found);
+                scratch.found.iter().map(|&(q, d)| (d, q)).collect()
+            }
+        }
+    }
+}
+
+/// `dist2(a, b)` if it is at most `bound`, else some value above `bound`: the same
+/// sequential sum as [`dist2`], abandoned once it exceeds `bound` (partial distance
+/// search), so an accepted distance has the same bits.
+#[inline]
+fn dist2_within(a: &[f32], b: &[f32], bound: f32) -> f32 {
+    let mut acc = 0.0f32;
+    for (ca, cb) in a.chunks(4).zip(b.chunks(4)) {
+        for (x, y) in ca.iter().zip(cb) {
+            acc += (x - y) * (x - y);
+        }
+        if acc > bound {
+            return acc;
+        }
+    }
+    acc
+}
+
 /// The `K₁` pixels whose `stick(q)` is nearest `query`: the best of the pool, then the
 /// best of the full-resolution `stride × stride` cells around those (module docs).
-/// `pooled` is [`pool_sticks`] of `sticks` over the pool; `dists` is scratch.
+/// `pooled` is [`pool_sticks`] of `sticks` over the pool. The result depends on the
+/// set of pixels scored only ([`keep`] orders by distance, then index), so the cells are
+/// visited in any order, each once.
 #[allow(clippy::too_many_arguments)]
 fn nearest(
     query: &[f32],
@@ -179,9 +259,10 @@ fn nearest(
     pool: &(Vec<usize>, usize),
     w: usize,
     hgt: usize,
-    dists: &mut Vec<f32>,
+    scratch: &mut Scratch,
 ) -> Vec<(f32, usize)> {
     let (pool, stride) = (&pool.0, pool.1);
+    let dists = &mut scratch.dists;
     dists.clear();
     dists.resize(pool.len(), 0.0);
     for (&a, row) in query.iter().zip(pooled.chunks_exact(pool.len())) {
@@ -197,24 +278,34 @@ fn nearest(
     if stride <= 1 {
         return coarse;
     }
-    let mut cells: Vec<usize> = Vec::with_capacity(coarse.len() * stride * stride);
+    if scratch.visited.len() != w * hgt || scratch.query == u32::MAX {
+        scratch.visited.clear();
+        scratch.visited.resize(w * hgt, 0);
+        scratch.query = 0;
+    }
+    scratch.query += 1;
+    let stamp = scratch.query;
     let lo = -((stride / 2) as i64);
     let hi = lo + stride as i64;
+    let mut best: Vec<(f32, usize)> = Vec::with_capacity(K1 + 1);
     for &(_, q) in &coarse {
         let (qx, qy) = ((q % w) as i64, (q / w) as i64);
         for dy in lo..hi {
+            let y = (qy + dy).rem_euclid(hgt as i64) as usize;
             for dx in lo..hi {
                 let x = (qx + dx).rem_euclid(w as i64) as usize;
-                let y = (qy + dy).rem_euclid(hgt as i64) as usize;
-                cells.push(y * w + x);
+                let c = y * w + x;
+                if scratch.visited[c] == stamp {
+                    continue;
+                }
+                scratch.visited[c] = stamp;
+                let bound = if best.len() < K1 { f32::INFINITY } else { best[K1 - 1].0 };
+                let d = dist2_within(query, &sticks[c * len..(c + 1) * len], bound);
+                if d <= bound {
+                    keep(&mut best, d, c);
+                }
             }
         }
-    }
-    cells.sort_unstable();
-    cells.dedup();
-    let mut best: Vec<(f32, usize)> = Vec::with_capacity(K1 + 1);
-    for q in cells {
-        keep(&mut best, dist2(query, &sticks[q * len..(q + 1) * len]), q);
     }
     best
 }
@@ -238,8 +329,6 @@ pub fn candidate_triples(
         .collect();
     let (i, j, k) = (plane, (plane + 1) % 3, (plane + 2) % 3);
     let (ei, ej, ek) = (planes[i], planes[j], planes[k]);
-    let pool_j = pool(ej.width, ej.height, options.pool);
-    let pool_k = pool(ek.width, ek.height, options.pool);
     let (dj, dk) = ((ej.width, ej.height), (ek.width, ek.height));
     let len = st[0].len;
     let n_t = options.triples;
@@ -249,16 +338,18 @@ pub fn candidate_triples(
     let w = options.plane_weights;
     let (wij, wik, wjk) = (w[i] * w[j], w[i] * w[k], w[j] * w[k]);
     let coord = |e: &PlaneExemplar, p: usize| [(p % e.width) as i32, (p / e.width) as i32];
-    let (pooled_j, pooled_k) =
-        (pool_sticks(&st[j].rows, len, &pool_j.0), pool_sticks(&st[k].cols, len, &pool_k.0));
+    let (search_j, search_k) = (
+        PartnerSearch::new(&st[j].rows, len, dj.0, dj.1, options.pool),
+        PartnerSearch::new(&st[k].cols, len, dk.0, dk.1, options.pool),
+    );
     let mut triples = vec![[[0i32; 2]; 3]; ei.width * ei.height * n_t];
-    triples.par_chunks_mut(n_t).enumerate().for_each_init(Vec::new, |dists, (p, out)| {
+    triples.par_chunks_mut(n_t).enumerate().for_each_init(Scratch::default, |scratch, (p, out)| {
         // Column of plane i ↔ row of plane j; row of plane i ↔ column of plane k;
         // column of plane j ↔ row of plane k.
         let (col_i, row_i) =
             (&st[i].cols[p * len..(p + 1) * len], &st[i].rows[p * len..(p + 1) * len]);
-        let qs = nearest(col_i, &st[j].rows, &pooled_j, len, &pool_j, dj.0, dj.1, dists);
-        let rs = nearest(row_i, &st[k].cols, &pooled_k, len, &pool_k, dk.0, dk.1, dists);
+        let qs = search_j.nearest(col_i, &st[j].rows, len, dj.0, dj.1, scratch);
+        let rs = search_k.nearest(row_i, &st[k].cols, len, dk.0, dk.1, scratch);
         let mut scored: Vec<(f32, usize, usize)> = Vec::with_capacity(qs.len() * rs.len());
         for &(eq, q) in &qs {
             for &(er, r) in &rs {
@@ -297,9 +388,9 @@ mod layout_tests {
         let pool = pool(w, h, 64);
         assert!(pool.1 > 1);
         let pooled = pool_sticks(&sticks, len, &pool.0);
-        let mut dists = Vec::new();
+        let mut scratch = Scratch::default();
         for query in queries.chunks_exact(len) {
-            let got = nearest(query, &sticks, &pooled, len, &pool, w, h, &mut dists);
+            let got = nearest(query, &sticks, &pooled, len, &pool, w, h, &mut scratch);
             // The scalar reference: the pool by `dist2`, then the cells around its hits.
             let mut coarse = Vec::new();
             for &q in &pool.0 {
@@ -327,6 +418,48 @@ mod layout_tests {
                 |v: &[(f32, usize)]| v.iter().map(|(d, q)| (d.to_bits(), *q)).collect::<Vec<_>>();
             assert_eq!(bits(&got), bits(&want));
         }
+    }
+
+    /// Large exemplars search their partners in a kd-tree: on smooth sticks (a blurred
+    /// random image, like real neighbourhoods) its `K₁` partners are about as near as
+    /// the exhaustive ones and no farther than the pool search's.
+    #[test]
+    fn large_exemplars_find_near_partners_in_a_tree() {
+        let (w, h, len) = (160, 160, 15);
+        // Sticks: 15 consecutive values of a smooth periodic signal plus noise.
+        let f = |x: usize, y: usize, k: usize| {
+            let (x, y) = (x as f32, (y + k) as f32);
+            (0.13 * x + 0.07 * y).sin()
+                + (0.05 * x - 0.11 * y).cos()
+                + 0.1
+                    * fieldtex_core::rng::hash_unit(9, "s", (y as usize * w + x as usize) as u64)
+                        as f32
+        };
+        let sticks: Vec<f32> =
+            (0..w * h).flat_map(|p| (0..len).map(move |k| f(p % w, p / w, k))).collect();
+        let search = PartnerSearch::new(&sticks, len, w, h, 1024);
+        assert!(matches!(search, PartnerSearch::Tree(_)));
+        let pool_search = {
+            let pool = pool(w, h, 1024);
+            PartnerSearch::Pool { pooled: pool_sticks(&sticks, len, &pool.0), pool }
+        };
+        let mut scratch = Scratch::default();
+        let (mut tree_sum, mut pool_sum, mut exact_sum) = (0.0f64, 0.0f64, 0.0f64);
+        for q in (0..w * h).step_by(397) {
+            let query: Vec<f32> =
+                (0..len).map(|k| f((q * 7) % w, (q / w + 3) % h, k) + 0.05).collect();
+            let t = search.nearest(&query, &sticks, len, w, h, &mut scratch);
+            let p = pool_search.nearest(&query, &sticks, len, w, h, &mut scratch);
+            let mut all: Vec<f32> = sticks.chunks_exact(len).map(|c| dist2(&query, c)).collect();
+            all.sort_by(f32::total_cmp);
+            assert_eq!(t.len(), K1);
+            tree_sum += t.iter().map(|v| v.0 as f64).sum::<f64>();
+            pool_sum += p.iter().map(|v| v.0 as f64).sum::<f64>();
+            exact_sum += all[..K1].iter().map(|&v| v as f64).sum::<f64>();
+        }
+        eprintln!("K1 distance sums: exact {exact_sum:.3}, tree {tree_sum:.3}, pool {pool_sum:.3}");
+        assert!(tree_sum <= 1.5 * exact_sum, "tree {tree_sum}, exact {exact_sum}");
+        assert!(tree_sum <= 1.05 * pool_sum, "tree {tree_sum}, pool {pool_sum}");
     }
 
     #[test]
