@@ -118,19 +118,20 @@ where
         }
     };
     let mut u = start;
-    let mut x0 = vec![0.0; n];
-    let mut ax0 = vec![0.0; n];
-    for c in 0..2 {
+    // The two coordinates are independent solves (each sequential, so the result does
+    // not depend on the thread count): side by side.
+    let solve = |c: usize| {
         // Solve A (x0 + e) = b for the correction e from zero.
-        for (x, v) in x0.iter_mut().zip(&u) {
-            *x = v[c];
-        }
+        let x0: Vec<f64> = u.iter().map(|v| v[c]).collect();
+        let mut ax0 = vec![0.0; n];
         apply(&x0, &mut ax0);
         let rhs: Vec<f64> = b.iter().zip(&ax0).map(|(v, a)| v[c] - a).collect();
-        let e = conjugate_gradients(&apply, &rhs, iterations, 1e-10);
-        for (ui, ei) in u.iter_mut().zip(e) {
-            ui[c] += ei;
-        }
+        conjugate_gradients(&apply, &rhs, iterations, 1e-10)
+    };
+    let (ex, ey) = rayon::join(|| solve(0), || solve(1));
+    for ((ui, x), y) in u.iter_mut().zip(ex).zip(ey) {
+        ui[0] += x;
+        ui[1] += y;
     }
     for (&(p, q), g) in edges.iter().zip(&steps) {
         let (p, q) = (p as usize, q as usize);
