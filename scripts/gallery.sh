@@ -55,6 +55,10 @@ for p in arch tented-arch left-loop right-loop whorl; do
   "$bin" orient --preset "$p" --exemplar "$ex/stripes_Fabric071.png" --size 384 --out "out/gallery/orient-$p" --quiet --no-metrics
   cp "out/gallery/orient-$p/preview.png" "docs/gallery/orient-$p.png"
 done
+# The arch preset started from the exemplar carried along the field (--integrated-init).
+"$bin" orient --preset arch --integrated-init --exemplar "$ex/stripes_Fabric071.png" --size 384 \
+  --out out/gallery/orient-arch-integrated --quiet --no-metrics
+cp out/gallery/orient-arch-integrated/preview.png docs/gallery/orient-arch-integrated.png
 [ "$only" = orient ] && { echo "gallery (orient) written to docs/gallery/"; exit 0; }
 "$bin" demo --out out/gallery/demo --quiet
 cp out/gallery/demo/preview.png docs/gallery/demo-cube.png
