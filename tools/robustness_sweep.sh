@@ -238,6 +238,21 @@ for v in NaN inf -1 0 1e30; do
 done
 case_ solid_feature_mask_wrong_size 2 "${S[@]}" --out o_s --exemplar $E --feature-mask ex2x2.png
 case_ solid_sketch_field_cells_0 02 "${S[@]}" --out o_s --exemplar $E --sketch sk_ok.json --field-cells 0
+# The integrated start (session 18): odd exemplars, sketches, interior and level passes.
+case_ solid_integrated_ok 0 "${S[@]}" --out o_s --exemplar $E --sketch sk_ok.json --integrated-init
+for e in ex2x2 ex64x8 exflat exgreyalpha; do
+  case_ solid_integrated_$e 02 "${S[@]}" --out o_s --exemplar $e.png --sketch sk_ok.json --integrated-init
+done
+for k in sk_same_points sk_far sk_huge; do
+  case_ solid_integrated_$k 02 "${S[@]}" --out o_s --exemplar $E --sketch $k.json --integrated-init
+done
+case_ solid_integrated_interior 0 "${S[@]}" --out o_s --exemplar $E --integrated-init --interior ex64.png
+case_ solid_integrated_level_passes 0 "${S[@]}" --out o_s --exemplar $E --integrated-init --level-passes 0,0
+# orient --integrated-init on odd exemplars and sizes.
+for e in ex2x2 ex64x8 exflat exgreyalpha; do
+  case_ orient_integrated_$e 02 orient --preset whorl --integrated-init --size 32 --out o_o --exemplar $e.png
+done
+case_ orient_integrated_ok 0 orient --preset arch --integrated-init --size 32 --out o_o --exemplar $E
 case_ solid_sketch_field_cells_100000 02 "${S[@]}" --out o_s --exemplar $E --sketch sk_ok.json --field-cells 100000
 for o in "--field-cells 0" "--field-cells 100000" "--passes 0" "--passes 100000" "--block 0" "--block 1" \
   "--neighbourhood 0" "--neighbourhood 4" "--neighbourhood 99" "--trilinear-levels 99" "--integrate-levels 99" \
