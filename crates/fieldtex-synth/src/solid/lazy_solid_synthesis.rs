@@ -496,14 +496,7 @@ impl<'a> SolidSynthesizer<'a> {
                 * e0.width as f64) as i32;
             let oy = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-anchor-y", key)
                 * e0.height as f64) as i32;
-            let mut tr = *self.exemplar.triples[c][0].get(ox, oy, 0);
-            tr[0][0] += r[0];
-            tr[0][1] += r[1];
-            tr[1][0] += r[1];
-            tr[1][1] += r[2];
-            tr[2][0] += r[2];
-            tr[2][1] += r[0];
-            return self.wrap(tr);
+            return self.wrap(moved(*self.exemplar.triples[c][0].get(ox, oy, 0), r));
         }
         // Local coordinates Rᵀ d.
         let w: [i32; 3] = std::array::from_fn(|col| {
@@ -550,14 +543,7 @@ impl<'a> SolidSynthesizer<'a> {
                 d.map(round_f64_i32)
             }
         };
-        let mut tr = parent;
-        tr[0][0] += di[0];
-        tr[0][1] += di[1];
-        tr[1][0] += di[1];
-        tr[1][1] += di[2];
-        tr[2][0] += di[2];
-        tr[2][1] += di[0];
-        self.wrap(tr)
+        self.wrap(moved(parent, di))
     }
 
     fn primary_block(&self, c: usize, b: [i32; 3]) -> (Vec<Triple>, Counts) {
@@ -630,6 +616,18 @@ impl<'a> SolidSynthesizer<'a> {
 #[inline]
 fn round_i32(x: f32) -> i32 {
     round_f64_i32(x as f64)
+}
+
+/// Triple `t` moved by the local 3-vector `d` (eq. 3–4's mapping to the planes: xy by
+/// `(d_x, d_y)`, yz by `(d_y, d_z)`, zx by `(d_z, d_x)`), not wrapped.
+fn moved(mut t: Triple, d: [i32; 3]) -> Triple {
+    t[0][0] += d[0];
+    t[0][1] += d[1];
+    t[1][0] += d[1];
+    t[1][1] += d[2];
+    t[2][0] += d[2];
+    t[2][1] += d[0];
+    t
 }
 
 /// `x` rounded to the nearest integer, halves away from zero (as `f64::round` for
