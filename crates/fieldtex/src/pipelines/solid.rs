@@ -520,7 +520,7 @@ fn preview_with_curves(
 
 fn notes(options: &SolidOptions) -> Vec<String> {
     let mut n = vec![
-        "candidate triples: the partners of each pixel are searched coarse to fine (brute force over a regular sub-grid pool of the other exemplars, SolidAnalysisOptions::pool, then every pixel of the pool cells around the best hits), not Dong 2008's exhaustive search; Dong's neighbour-consistency test is not applied".to_string(),
+        "candidate triples: the partners of each pixel are searched coarse to fine (brute force over a regular sub-grid pool of the other exemplars, SolidAnalysisOptions::pool, then every pixel of the pool cells around the best hits; for exemplars above about 128² pixels a kd-tree over every pixel's stick, best-bin-first with 128 points examined, instead), not Dong 2008's exhaustive search; Dong's neighbour-consistency test is not applied".to_string(),
         format!(
             "correction neighbourhoods are sampled by trilinear interpolation on the {} coarsest levels and at the nearest voxel below them, as the paper; on the {} coarsest levels the sample positions are integrated along the field (unit Euler steps), below them the centre voxel's frame spans the neighbourhood",
             options.synthesis.trilinear_levels, options.synthesis.integrate_levels
