@@ -113,4 +113,31 @@ fn integrated_init_follows_a_design_without_singularities() {
     let codes: Vec<&str> =
         r["warnings"].as_array().unwrap().iter().filter_map(|w| w["code"].as_str()).collect();
     assert!(codes.contains(&"integrated-init-singularities"), "{codes:?}");
+
+    // An irregular exemplar that does not tile (woodgrain) is warned about; the stripes
+    // (periodic) were not, above.
+    let wood = tmp("arch-wood-integrated");
+    let ex = shared().join("exemplars/woodgrain_Wood022.png");
+    let args = [
+        "orient",
+        "--preset",
+        "arch",
+        "--integrated-init",
+        "--no-metrics",
+        "--size",
+        "64",
+        "--grid",
+        "16",
+        "--quiet",
+        "--exemplar",
+        ex.to_str().unwrap(),
+        "--out",
+        wood.to_str().unwrap(),
+    ];
+    let o = run_limited(&args, LIMIT);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let r = read_json(&wood.join("report.json"));
+    let codes: Vec<&str> =
+        r["warnings"].as_array().unwrap().iter().filter_map(|w| w["code"].as_str()).collect();
+    assert!(codes.contains(&"integrated-init-irregular-exemplar"), "{codes:?}");
 }

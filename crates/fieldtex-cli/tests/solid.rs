@@ -280,4 +280,8 @@ fn integrated_init_keeps_cut_equality_and_determinism() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["options"]["synthesis"]["integrated_init"], true, "{}", report["options"]);
+    // Woodgrain neither tiles nor repeats along its axes: the report warns.
+    let codes: Vec<&str> =
+        report["warnings"].as_array().unwrap().iter().filter_map(|w| w["code"].as_str()).collect();
+    assert!(codes.contains(&"integrated-init-irregular-exemplar"), "{codes:?}");
 }

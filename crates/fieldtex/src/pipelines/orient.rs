@@ -267,6 +267,9 @@ pub fn orient(out_dir: &Path, options: &OrientOptions, progress: &dyn Progress) 
         Report::new("orient", options.seed, serde_json::to_value(options).unwrap_or_default());
     let (fitted, per_pixel) = options.read_exemplar(&mut report, progress)?;
     let exemplar = fitted.image;
+    if options.integrated_init {
+        report.warnings.extend(integrated_start_warning(&exemplar));
+    }
     report.input = serde_json::json!({
         "exemplar": options.exemplar.display().to_string(),
         "exemplar_size": [exemplar.width * fitted.factor, exemplar.height * fitted.factor],
@@ -491,6 +494,30 @@ pub(crate) struct ExemplarOrientation {
     /// reproducing the exemplar's local structure cannot go below. A wavy exemplar (e.g.
     /// curved bands) scores tens of degrees here, and its guided outputs about as much.
     pub self_error_deg: f64,
+}
+
+/// The warning for an integrated start (`--integrated-init` of `orient` and `solid`)
+/// on an exemplar that neither tiles ([`fieldtex_synth::exemplar_tiling`]) nor shows a
+/// period along its axes ([`fieldtex_synth::characteristic_scale`]): carried along the
+/// field as one warp, such an exemplar shows its repeats and its wrap seams (measured
+/// on woodgrain, docs/real-exemplars.md and docs/solid.md, session 18). `None` for
+/// tiling or periodic exemplars (stripes, weaves, bricks).
+pub(crate) fn integrated_start_warning(exemplar: &Image) -> Option<Warning> {
+    let tiling = fieldtex_synth::exemplar_tiling(exemplar);
+    let scale = fieldtex_synth::characteristic_scale(exemplar);
+    let periodic = scale.directions[0].1 || scale.directions[2].1;
+    (!tiling.tiles && !periodic).then(|| {
+        Warning::new(
+            "integrated-init-irregular-exemplar",
+            format!(
+                "--integrated-init with an exemplar that neither tiles (wrap-jump ratio {:.2} \
+                 / {:.2}) nor repeats along its axes: the exemplar carried along the field \
+                 may show its repeats and its wrap seams; the default start suits irregular \
+                 exemplars (wood, stone) better",
+                tiling.jump_ratio[0], tiling.jump_ratio[1]
+            ),
+        )
+    })
 }
 
 /// [`ExemplarOrientation`] of an exemplar; `None` when it has no measurable orientation.

@@ -193,6 +193,9 @@ pub fn solid(out_dir: &Path, options: &SolidOptions, progress: &dyn Progress) ->
     if let Some(own) = super::orient::exemplar_orientation(&exemplars[0]) {
         report.metric("exemplar_orientation", own);
     }
+    if options.synthesis.integrated_init {
+        report.warnings.extend(super::orient::integrated_start_warning(&exemplars[0]));
+    }
     let mut analysis = options.analysis.clone();
     if single {
         analysis.plane_weights = [1.0, 1.0, 0.0];
