@@ -52,6 +52,8 @@ pub struct KdTree {
 #[derive(Debug, Default)]
 pub struct KdScratch {
     heap: BinaryHeap<Pending>,
+    /// The single-nearest result buffer of [`KdTree::nearest`] (no allocation per query).
+    best: Vec<(usize, f32)>,
 }
 
 #[derive(Debug, PartialEq)]
@@ -166,8 +168,8 @@ impl KdTree {
         max_checks: usize,
         scratch: &mut KdScratch,
     ) -> Option<(usize, f32)> {
-        let mut best = Vec::with_capacity(2);
-        self.k_nearest(query, 1, max_checks, scratch, &mut best);
+        let KdScratch { heap, best } = scratch;
+        self.search(query, 1, max_checks, heap, best);
         best.first().copied()
     }
 
@@ -183,12 +185,23 @@ impl KdTree {
         scratch: &mut KdScratch,
         out: &mut Vec<(usize, f32)>,
     ) {
+        self.search(query, k, max_checks, &mut scratch.heap, out);
+    }
+
+    /// [`Self::k_nearest`] with the heap and the result buffer given separately.
+    fn search(
+        &self,
+        query: &[f32],
+        k: usize,
+        max_checks: usize,
+        heap: &mut BinaryHeap<Pending>,
+        out: &mut Vec<(usize, f32)>,
+    ) {
         assert_eq!(query.len(), self.dim, "KdTree::nearest: query of the tree's dimension");
         out.clear();
         if self.nodes.is_empty() || k == 0 {
             return;
         }
-        let heap = &mut scratch.heap;
         heap.clear();
         heap.push(Pending { bound: 0.0, lower: 0.0, node: 0 });
         let exact = max_checks == usize::MAX;
