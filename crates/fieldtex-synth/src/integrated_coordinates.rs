@@ -153,6 +153,94 @@ pub(crate) fn trusted<const S: usize>(nbr: &[[u32; S]], misfit: &[f32], tau: f32
         .collect()
 }
 
+/// Conjugate-gradient steps per finer level of the cascade.
+const LEVEL_ITERATIONS: usize = 40;
+
+/// The integrated start of the parallel synthesis
+/// ([`crate::SynthesisOptions::integrated_init`]): the parent level's `U`, carried from
+/// the initialisation level down to the finest.
+pub(crate) struct IntegratedStart {
+    parent: Integrated,
+    tau: f32,
+}
+
+impl IntegratedStart {
+    /// `U` of the initialisation level (`nbr`, `jac`, `flips`, lattice spacing
+    /// `spacing`); the coordinates `s` of its trusted samples (misfit below `tau`,
+    /// [`trusted`]) become `U + offset` wrapped into the exemplar of `size` pixels
+    /// (floored with `snap`), the others keep theirs.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn begin<const D: usize, const S: usize>(
+        nbr: &[[u32; S]],
+        jac: &[Jacobian<D>],
+        flips: &[bool],
+        spacing: f32,
+        tau: f32,
+        offset: [f64; 2],
+        size: (usize, usize),
+        snap: bool,
+        s: &mut [[f32; 2]],
+    ) -> Self
+    where
+        Dim<D>: Stencil<D, S>,
+    {
+        let r = integrated_coordinates::<D, S>(nbr, jac, flips, spacing);
+        let (w, h) = (size.0 as f64, size.1 as f64);
+        for ((si, v), _) in s.iter_mut().zip(&r.u).zip(trusted(nbr, &r.misfit, tau)).filter(|x| x.1)
+        {
+            let x = (v[0] + offset[0]).rem_euclid(w);
+            let y = (v[1] + offset[1]).rem_euclid(h);
+            let (x, y) = if snap { (x.floor(), y.floor()) } else { (x, y) };
+            *si = [(x as f32).min((w as f32).next_down()), (y as f32).min((h as f32).next_down())];
+        }
+        Self { parent: r, tau }
+    }
+
+    /// One finer level: `U` carried down from the parents (`parent[i].0`, the child's
+    /// upsampling offset `h F o` from `offset(i)`) and smoothed on this level; per
+    /// sample its step from the parent (`None`: the default path, for untrusted samples)
+    /// and whether it is trusted. This level's `U` becomes the next level's parent.
+    pub(crate) fn level<const D: usize, const S: usize>(
+        &mut self,
+        nbr: &[[u32; S]],
+        jac: &[Jacobian<D>],
+        flips: &[bool],
+        parent: &[(u32, [f32; D])],
+        offset: impl Fn(usize) -> [f32; 2],
+        spacing: f32,
+    ) -> (Vec<Option<[f32; 2]>>, Vec<bool>)
+    where
+        Dim<D>: Stencil<D, S>,
+    {
+        let u_par = &self.parent.u;
+        let start: Vec<[f64; 2]> = (0..jac.len())
+            .map(|i| {
+                let (par, o) = (parent[i].0 as usize, offset(i));
+                [u_par[par][0] + o[0] as f64, u_par[par][1] + o[1] as f64]
+            })
+            .collect();
+        let r = refine_integrated_coordinates::<D, S>(
+            nbr,
+            jac,
+            flips,
+            spacing,
+            start,
+            LEVEL_ITERATIONS,
+        );
+        let trust = trusted(nbr, &r.misfit, self.tau);
+        let steps = (0..jac.len())
+            .map(|i| {
+                let par = parent[i].0 as usize;
+                trust[i].then(|| {
+                    [(r.u[i][0] - u_par[par][0]) as f32, (r.u[i][1] - u_par[par][1]) as f32]
+                })
+            })
+            .collect();
+        self.parent = r;
+        (steps, trust)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -73,9 +73,7 @@ use crate::color_lookup::color_lookup;
 use crate::exemplar_analysis::{APPEARANCE_DIMS, ExemplarAnalysis};
 use crate::exemplar_level::{ExemplarLevel, NV, NvEntry, dist_nv};
 use crate::flip_combing::comb_flips;
-use crate::integrated_coordinates::{
-    Integrated, integrated_coordinates, refine_integrated_coordinates, trusted,
-};
+use crate::integrated_coordinates::IntegratedStart;
 use crate::lattice_domain::{
     Dim, LatticeDomain, PlanarDomain, Stencil, frobenius, mat_vec, mean, negated,
 };
@@ -85,10 +83,6 @@ use crate::synthesis_options::{MAX_K, validate};
 use crate::synthesis_subset::SubsetPlan;
 use crate::warped_neighbourhood::{corner_map, inverse_frame, warped_corner};
 use crate::{SynthError, SynthesisDomain};
-
-/// Conjugate-gradient steps per level of the integrated initialisation's cascade
-/// ([`SynthesisOptions::integrated_init`]).
-const INTEGRATED_LEVEL_ITERATIONS: usize = 40;
 
 /// Result of [`synthesize`]: per finest-level sample (row-major over
 /// [`SynthesisDomain::output_size`]).
@@ -507,27 +501,25 @@ where
             [(ux as f32).min(wf.next_down()), (uy as f32).min(hf.next_down())]
         })
         .collect();
-    // The integrated coordinates of the parent level (with the integrated initialisation).
-    let mut integrated: Option<Integrated> = None;
-    if options.integrated_init {
-        // The frames integrated over the initialisation level (spacing: twice the
-        // coarsest synthesised level's), placed by one seeded offset; samples where the
-        // integral does not fit the frames keep their random coordinates.
-        let h_init = 2.0 * analysis.level(levels - 1).spacing as f32;
-        let r = integrated_coordinates::<D, S>(&parent_tables.nbr, &parent_tables.jac, &fl, h_init);
-        let trust = trusted(&parent_tables.nbr, &r.misfit, options.integrated_trust);
-        let o = [
+    // The integrated start: the frames integrated over the initialisation level
+    // (spacing: twice the coarsest synthesised level's), placed by one seeded offset.
+    let mut integrated = options.integrated_init.then(|| {
+        let offset = [
             hash_unit(options.seed, "synthesis-init-offset", 0) * w as f64,
             hash_unit(options.seed, "synthesis-init-offset", 1) * h as f64,
         ];
-        for ((si, v), _) in s.iter_mut().zip(&r.u).zip(&trust).filter(|(_, t)| **t) {
-            let x = (v[0] + o[0]).rem_euclid(w as f64);
-            let y = (v[1] + o[1]).rem_euclid(h as f64);
-            let (x, y) = if options.snap_coordinates { (x.floor(), y.floor()) } else { (x, y) };
-            *si = [(x as f32).min(wf.next_down()), (y as f32).min(hf.next_down())];
-        }
-        integrated = Some(r);
-    }
+        IntegratedStart::begin::<D, S>(
+            &parent_tables.nbr,
+            &parent_tables.jac,
+            &fl,
+            2.0 * analysis.level(levels - 1).spacing as f32,
+            options.integrated_trust,
+            offset,
+            (w, h),
+            options.snap_coordinates,
+            &mut s,
+        )
+    });
     let mut level_timings_ms = Vec::with_capacity(levels);
     let passes_of = |level: usize| {
         if level == 0 {
@@ -602,41 +594,23 @@ where
             })
             .collect();
         let mut nf: Vec<bool> = up.iter().map(|v| v.2).collect();
-        // With the integrated initialisation the step of a trusted child from its parent
-        // is the difference of the integrated coordinates (the parents' carried down,
-        // then smoothed on this level) instead of `h F o`, without jitter; trusted
-        // samples are corrected only on the finest levels.
-        let mut trust: Option<Vec<bool>> = None;
-        let steps: Option<Vec<Option<[f32; 2]>>> = integrated.take().map(|par_int| {
-            let u_par = &par_int.u;
-            let start: Vec<[f64; 2]> = (0..n)
-                .map(|i| {
-                    let par = tables.parent[i].0 as usize;
-                    let o = up[i].0;
-                    [u_par[par][0] + o[0] as f64, u_par[par][1] + o[1] as f64]
-                })
-                .collect();
-            let r = refine_integrated_coordinates::<D, S>(
-                &tables.nbr,
-                &tables.jac,
-                &nf,
-                spacing,
-                start,
-                INTEGRATED_LEVEL_ITERATIONS,
-            );
-            let t = trusted(&tables.nbr, &r.misfit, options.integrated_trust);
-            let st = (0..n)
-                .map(|i| {
-                    let par = tables.parent[i].0 as usize;
-                    t[i].then(|| {
-                        [(r.u[i][0] - u_par[par][0]) as f32, (r.u[i][1] - u_par[par][1]) as f32]
-                    })
-                })
-                .collect();
-            trust = Some(t);
-            integrated = Some(r);
-            st
-        });
+        // With the integrated start a trusted child steps from its parent by the
+        // difference of the integrated coordinates, without jitter, and is corrected only
+        // on the finest levels.
+        let (steps, trust) = match integrated.as_mut() {
+            Some(start) => {
+                let (st, t) = start.level::<D, S>(
+                    &tables.nbr,
+                    &tables.jac,
+                    &nf,
+                    &tables.parent,
+                    |i| up[i].0,
+                    spacing,
+                );
+                (Some(st), Some(t))
+            }
+            None => (None, None),
+        };
         let mut ns: Vec<[f32; 2]> = (0..n)
             .into_par_iter()
             .map(|i| {
