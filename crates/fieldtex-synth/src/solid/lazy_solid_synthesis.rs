@@ -269,12 +269,12 @@ impl<'a> SolidSynthesizer<'a> {
             let coarsest = self.cache.len().saturating_sub(1);
             // Padding in level-g voxels: the finest correction reads `halo` voxels
             // beyond the grid; voxels off the box fall back to eq. 3–4.
-            let pad = |_g: usize| self.halo() + 2;
+            let pad = self.halo() + 2;
             let nodes = |g: usize| -> usize {
-                extent.iter().map(|&e| e.div_ceil(1 << g) + 2 * pad(g) as usize).product()
+                extent.iter().map(|&e| e.div_ceil(1 << g) + 2 * pad as usize).product()
             };
             let g = (0..=coarsest).find(|&g| nodes(g) <= INTEGRATED_NODES).unwrap_or(coarsest);
-            self.init = Some(IntegratedInit::new(&self.lattice, self.frames, g, extent, pad(g)));
+            self.init = Some(IntegratedInit::new(&self.lattice, self.frames, g, extent, pad));
         }
         self
     }
@@ -488,9 +488,7 @@ impl<'a> SolidSynthesizer<'a> {
         // by the warp's offset on all three planes, so the xy, yz and zx coordinates
         // stay coherent across voxels (eq. 3–4's mapping of a 3-vector to the planes).
         if let Some(r) = self.init.as_ref().and_then(|u| u.offset(c, v)) {
-            let key = fieldtex_core::rng::mix64(
-                (s[0] as u32 as u64) ^ ((s[1] as u32 as u64) << 21) ^ ((s[2] as u32 as u64) << 42),
-            );
+            let key = subpart_key(s);
             let e0 = &self.exemplar.planes[0];
             let ox = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-anchor-x", key)
                 * e0.width as f64) as i32;
@@ -504,9 +502,7 @@ impl<'a> SolidSynthesizer<'a> {
         });
         let layer = floor_div(w[2], n);
         let t = w[2] - layer * n - n / 2;
-        let key = fieldtex_core::rng::mix64(
-            (s[0] as u32 as u64) ^ ((s[1] as u32 as u64) << 21) ^ ((s[2] as u32 as u64) << 42),
-        ) ^ (layer as u32 as u64);
+        let key = subpart_key(s) ^ (layer as u32 as u64);
         let e0 = &self.exemplar.planes[0];
         let ox = (fieldtex_core::rng::hash_unit(self.options.seed, "solid-slab-x", key)
             * e0.width as f64) as i32;
@@ -616,6 +612,13 @@ impl<'a> SolidSynthesizer<'a> {
 #[inline]
 fn round_i32(x: f32) -> i32 {
     round_f64_i32(x as f64)
+}
+
+/// The seed key of initialisation subpart `s`.
+fn subpart_key(s: [i32; 3]) -> u64 {
+    fieldtex_core::rng::mix64(
+        (s[0] as u32 as u64) ^ ((s[1] as u32 as u64) << 21) ^ ((s[2] as u32 as u64) << 42),
+    )
 }
 
 /// Triple `t` moved by the local 3-vector `d` (eq. 3–4's mapping to the planes: xy by
