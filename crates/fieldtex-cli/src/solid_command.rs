@@ -83,10 +83,13 @@ pub struct SolidArgs {
     /// along the field (paper E §4.3); the finer ones span it with the voxel's frame.
     #[arg(long, default_value_t = 2)]
     integrate_levels: usize,
-    /// Start from the exemplar carried along the sketched field (least-squares integral
-    /// of its frames) and correct only the finest level: layers such as stripes or wood
-    /// rings then follow the sketch without breaks. The default start suits irregular
-    /// exemplars (stone, marble) better.
+    /// Carry the exemplar along the sketched field (least-squares integral of its
+    /// frames) and leave it uncorrected, reading colours between pixels where the warp
+    /// falls: layers such as stripes or wood rings then follow the sketch smoothly and
+    /// without breaks (a substitute for the synthesis, not paper E's method;
+    /// --level-passes adds corrections, read at whole pixels). The default synthesis
+    /// suits irregular exemplars (stone, marble) better and hides a non-tiling
+    /// exemplar's wrap seam, which this start shows.
     #[arg(long)]
     integrated_init: bool,
     /// Synthesis levels.

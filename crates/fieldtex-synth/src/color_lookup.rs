@@ -42,7 +42,7 @@ pub enum ColorFilter {
 /// Keys (1981) cubic convolution weights (`a = −½`) of the four taps at offsets
 /// −1, 0, 1, 2 from the pixel left of a sample at fraction `t ∈ [0, 1)`.
 #[inline]
-fn keys_weights(t: f32) -> [f32; 4] {
+pub(crate) fn keys_weights(t: f32) -> [f32; 4] {
     let (t2, t3) = (t * t, t * t * t);
     [
         -0.5 * t3 + t2 - 0.5 * t,

@@ -27,6 +27,11 @@ pub(crate) struct IntegratedInit {
     u: Vec<[f64; 3]>,
     /// The level `U` lives on.
     level: usize,
+    /// `φ`, the fractional part of `2^g U` at the finest grid's first voxel, subtracted
+    /// before rounding ([`Self::offset`], [`Self::residual`]): `U`'s constant is
+    /// arbitrary, and a constant frame whose warp sits half-way between pixels would
+    /// otherwise round its neighbours apart by the last bit.
+    phase: [f64; 3],
 }
 
 impl IntegratedInit {
@@ -99,7 +104,12 @@ impl IntegratedInit {
                 ui[d] = xi;
             }
         }
-        Self { lo, dims, u, level: c }
+        let mut init = Self { lo, dims, u, level: c, phase: [0.0; 3] };
+        let h = (1i64 << c) as f64;
+        if let Some(u0) = init.interpolated(0, [0; 3]) {
+            init.phase = u0.map(|x| h * x - (h * x).floor());
+        }
+        init
     }
 
     /// `U` trilinearly interpolated at the centre of voxel `v` of level `c` (in voxels of
@@ -138,12 +148,26 @@ impl IntegratedInit {
         Some(acc)
     }
 
-    /// The exemplar-pixel offset `R = round(2^g U)` of voxel `v` of level `c` on the warp
-    /// (`g` the level `U` lives on; `U` interpolated at the voxel's centre), so a child's
-    /// step from its parent telescopes between neighbours on every level.
+    /// The exemplar-pixel offset `R = round(2^g U − φ)` of voxel `v` of level `c` on the
+    /// warp (`g` the level `U` lives on; `U` interpolated at the voxel's centre; `φ` the
+    /// grid's [`Self::phase`]), so a child's step from its parent telescopes between
+    /// neighbours on every level.
     pub(crate) fn offset(&self, c: usize, v: [i32; 3]) -> Option<[i32; 3]> {
         let h = (1i64 << self.level) as f64;
-        self.interpolated(c, v).map(|u| u.map(|x| (h * x).round() as i32))
+        let u = self.interpolated(c, v)?;
+        Some(std::array::from_fn(|a| (h * u[a] - self.phase[a]).round() as i32))
+    }
+
+    /// The sub-pixel part of the warp at finest voxel `v`, what [`Self::offset`] rounds
+    /// away on level 0: `2^g U − φ − R`, each in `[−½, ½]`; `None` off the grid. A
+    /// function of the position alone.
+    pub(crate) fn residual(&self, v: [i32; 3]) -> Option<[f64; 3]> {
+        let h = (1i64 << self.level) as f64;
+        let u = self.interpolated(0, v)?;
+        Some(std::array::from_fn(|a| {
+            let x = h * u[a] - self.phase[a];
+            x - x.round()
+        }))
     }
 
     /// `U(v)`, or `None` outside the box.

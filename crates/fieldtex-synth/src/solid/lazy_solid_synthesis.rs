@@ -59,6 +59,7 @@ use std::time::Instant;
 
 mod block_regions;
 use super::integrated_init::IntegratedInit;
+use crate::color_lookup::keys_weights;
 
 /// Largest grid of the integrated initialisation's solve
 /// ([`SolidSynthesisOptions::integrated_init`]).
@@ -106,9 +107,11 @@ pub struct SolidSynthesisOptions {
     /// grid has at most 500 000 voxels) moves one seeded anchor triple per subpart on the
     /// coarsest level, and every upsampling step follows `U` (interpolated at the voxel
     /// centres, rounded so that steps telescope) instead of eq. 3–4 in the parent's
-    /// frame. Unless [`Self::level_passes`] says otherwise only the finest level is
-    /// then corrected. For layered exemplars (stripes, wood rings) whose layers should
-    /// follow the sketch without breaks. Takes effect once the grid is known
+    /// frame. Unless [`Self::level_passes`] says otherwise no level is then corrected,
+    /// and colours are read by cubic convolution at each triple moved by the warp's
+    /// sub-pixel part ([`SolidSynthesizer::colors`]): a smooth warp of the exemplar,
+    /// not a synthesis (with corrections, whole pixels). For layered exemplars
+    /// (stripes, wood rings) whose layers should follow the sketch without breaks. Takes effect once the grid is known
     /// ([`SolidSynthesizer::with_extent`]; voxels off the grid keep the default path).
     /// Default false.
     pub integrated_init: bool,
@@ -173,6 +176,10 @@ pub struct SolidSynthesizer<'a> {
     bases: Vec<[Vec<f32>; 3]>,
     /// Integrated initial coordinates ([`SolidSynthesisOptions::integrated_init`]).
     init: Option<IntegratedInit>,
+    /// The integrated start is left uncorrected on every level, so every voxel sits on
+    /// the warp and its colour is read at the warp's sub-pixel position
+    /// ([`Self::warp_residual`]).
+    subpixel: bool,
 }
 
 /// The computed blocks of a [`SolidSynthesizer`], detached from its borrows
@@ -254,6 +261,7 @@ impl<'a> SolidSynthesizer<'a> {
             heads,
             bases,
             init: None,
+            subpixel: false,
         })
     }
 
@@ -275,6 +283,7 @@ impl<'a> SolidSynthesizer<'a> {
             };
             let g = (0..=coarsest).find(|&g| nodes(g) <= INTEGRATED_NODES).unwrap_or(coarsest);
             self.init = Some(IntegratedInit::new(&self.lattice, self.frames, g, extent, pad));
+            self.subpixel = (0..self.cache.len()).all(|c| self.level_passes(c) == 0);
         }
         self
     }
@@ -411,14 +420,94 @@ impl<'a> SolidSynthesizer<'a> {
     }
 
     /// Colours (RGB, sRGB-encoded as the exemplars) of `voxels`: the mean of the three
-    /// finest exemplar colours at each final triple.
+    /// finest exemplar colours at each final triple. With the integrated start
+    /// ([`SolidSynthesisOptions::integrated_init`]) each plane is read bilinearly at the
+    /// triple moved by the warp's sub-pixel part ([`Self::warp_residual`]), so coherent
+    /// regions sample the continuous warp instead of its whole-pixel steps.
     pub fn colors(
         &mut self,
         voxels: &[[i32; 3]],
         progress: &dyn Progress,
     ) -> (Vec<[f32; 3]>, Vec<LevelStats>) {
         let (t, stats) = self.triples(voxels, progress);
-        (t.iter().map(|t| self.triple_color(0, t)).collect(), stats)
+        let colours = t
+            .iter()
+            .zip(voxels)
+            .map(|(t, &v)| {
+                let m = self.voxel_matched(v, t);
+                [m[0], m[1], m[2]]
+            })
+            .collect();
+        (colours, stats)
+    }
+
+    /// The sub-pixel part of the integrated warp at finest voxel `v` (exemplar pixels per
+    /// axis, each in `[−½, ½]`): every triple of a coherent region is `round(2^g U) +` a
+    /// constant, so adding it gives the continuous warp `2^g U +` that constant. `None`
+    /// without the integrated start, off its grid, or where it is zero.
+    fn warp_residual(&self, v: [i32; 3]) -> Option<[f32; 3]> {
+        if !self.subpixel {
+            return None;
+        }
+        let r = self.init.as_ref()?.residual(v)?.map(|x| x as f32);
+        (r != [0.0; 3]).then_some(r)
+    }
+
+    /// The finest matched values ([`Self::triple_matched`]) of voxel `v` holding triple
+    /// `t`: with the uncorrected integrated start, every plane read at its pixel moved by
+    /// the warp's sub-pixel part ([`Self::warp_residual`], mapped to the planes as
+    /// [`moved`] does), so that the output shows the continuous warp. (Corrections, when
+    /// asked for, compare whole-pixel values: the sub-pixel read is only consistent for
+    /// voxels left on the warp.) A function of `v` and `t` alone (the on-demand
+    /// equality).
+    fn voxel_matched(&self, v: [i32; 3], t: &Triple) -> [f32; 4] {
+        let Some(r) = self.warp_residual(v) else {
+            return self.triple_matched(0, t);
+        };
+        let w = self.exemplar.options.plane_weights;
+        let ch = self.exemplar.channels();
+        let shift = [[r[0], r[1]], [r[1], r[2]], [r[2], r[0]]];
+        let mut acc = [0.0f32; 4];
+        for p in 0..3 {
+            if w[p] == 0.0 {
+                continue;
+            }
+            let m = self.cubic_matched(p, t[p], shift[p]);
+            for k in 0..ch {
+                acc[k] += w[p] * m[k];
+            }
+        }
+        let total = w[0] + w[1] + w[2];
+        acc.map(|v| v / total)
+    }
+
+    /// Finest matched values of plane `p` at pixel `xy` moved by `d` (`|d| ≤ 1` per
+    /// axis), by Keys cubic convolution over the 4 × 4 pixels around it (wrapped), each
+    /// channel clamped to the range of its taps (as `orient`'s colour lookup,
+    /// [`crate::color_lookup`]): exact at `d = 0`, sharper than bilinear between pixels.
+    fn cubic_matched(&self, p: usize, xy: [i32; 2], d: [f32; 2]) -> [f32; 4] {
+        let (fx, fy) = (d[0].floor(), d[1].floor());
+        let (x0, y0) = (xy[0] + fx as i32, xy[1] + fy as i32);
+        let (wx, wy) = (keys_weights(d[0] - fx), keys_weights(d[1] - fy));
+        let e = &self.exemplar;
+        let mut acc = [0.0f32; 4];
+        let mut lo = [f32::INFINITY; 4];
+        let mut hi = [f32::NEG_INFINITY; 4];
+        for (j, wyj) in wy.iter().enumerate() {
+            let mut row = [0.0f32; 4];
+            for (i, wxi) in wx.iter().enumerate() {
+                let c = e.matched(p, 0, x0 - 1 + i as i32, y0 - 1 + j as i32);
+                for k in 0..4 {
+                    row[k] += wxi * c[k];
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
+                }
+            }
+            for k in 0..4 {
+                acc[k] += wyj * row[k];
+            }
+        }
+        std::array::from_fn(|k| acc[k].clamp(lo[k], hi[k]))
     }
 
     /// Plane-weighted mean of the three level-`c` exemplar colours at `t`
@@ -586,10 +675,11 @@ impl<'a> SolidSynthesizer<'a> {
         if let Some(&p) = self.options.level_passes.get(c) {
             p
         } else if self.init.is_some() {
-            // The integrated start is corrected on the finest level only: on the coarse
-            // levels the stack has blurred thin layers away and corrections break the
-            // warp's phase (docs/solid.md, session 18).
-            if c == 0 { self.options.passes } else { 0 }
+            // The integrated start is not corrected: on the coarse levels the stack has
+            // blurred thin layers away and corrections break the warp's phase (session
+            // 18); on the finest they replace warp voxels by whole-pixel table triples,
+            // which breaks the sub-pixel warp (session 19, docs/solid.md).
+            0
         } else if c + 1 == self.cache.len() {
             self.options.coarse_passes
         } else {

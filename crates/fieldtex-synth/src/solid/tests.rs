@@ -425,3 +425,46 @@ fn integrated_start_follows_a_bent_field() {
     eprintln!("coherent steps: default {plain:.3}, integrated {integrated:.3}");
     assert!(integrated > plain + 0.1, "default {plain:.3}, integrated {integrated:.3}");
 }
+
+/// The uncorrected integrated start reads its colours at the warp's sub-pixel position:
+/// on a constant frame that is every triple's own pixels (the warp's constant is
+/// rounded away), on a bent field the colours step less between neighbours than the
+/// whole-pixel colours of the same triples (the staircase of a rounded warp is gone).
+#[test]
+fn integrated_colours_follow_the_warp_below_a_pixel() {
+    let img = exemplar();
+    let (ao, so) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let n = 24;
+    let slice: Vec<[i32; 3]> = (0..n * n).map(|i| [i % n, i / n, 5]).collect();
+    let o = SolidSynthesisOptions { integrated_init: true, ..so };
+    let run = |frames: &dyn FrameSource| {
+        let mut s = SolidSynthesizer::new(&ex, lattice, frames, o.clone())
+            .unwrap()
+            .with_extent([n as usize, n as usize, 12]);
+        let (colours, stats) = s.colors(&slice, &NoProgress);
+        assert!(stats.iter().all(|l| l.corrections == 0), "the integrated start was corrected");
+        let whole: Vec<[f32; 3]> =
+            s.triples(&slice, &NoProgress).0.iter().map(|t| s.triple_color(0, t)).collect();
+        (colours, whole)
+    };
+    let (colours, whole) = run(&ConstantFrame([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]));
+    assert_eq!(colours, whole, "a constant frame reads whole pixels");
+    let (colours, whole) = run(&Bent);
+    let moved = colours.iter().zip(&whole).filter(|(a, b)| a != b).count();
+    assert!(moved * 2 > colours.len(), "{moved} of {} colours read between pixels", colours.len());
+    let step = |c: &[[f32; 3]]| {
+        let mut sum = 0.0f64;
+        for y in 0..n {
+            for x in 0..n - 1 {
+                let (a, b) = (c[(y * n + x) as usize], c[(y * n + x + 1) as usize]);
+                sum += (0..3).map(|k| (a[k] - b[k]).abs() as f64).sum::<f64>();
+            }
+        }
+        sum / (n * (n - 1)) as f64
+    };
+    let (sub, px) = (step(&colours), step(&whole));
+    eprintln!("mean neighbour step: sub-pixel {sub:.4}, whole pixels {px:.4}");
+    assert!(sub < 0.95 * px, "sub-pixel {sub:.4}, whole pixels {px:.4}");
+}

@@ -533,7 +533,11 @@ fn notes(options: &SolidOptions) -> Vec<String> {
             options.analysis.neighbourhood, options.analysis.pca_dims
         ),
         "the coarsest level uses the same block (dual-grid) scheme as the others, with more passes, so that every level is lazy; the paper corrects the whole coarsest level without barriers".to_string(),
-        "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple".to_string(),
+        if options.synthesis.integrated_init {
+            "--integrated-init (a substitute start, not paper E's): the exemplar planes are carried along the least-squares integral of the frames and, unless --level-passes asks for corrections, left uncorrected; a voxel's colour is then the plane-weighted mean of the exemplar colours read by cubic convolution at its coordinate triple moved by the warp's sub-pixel part (with corrections, at the whole-pixel triple)".to_string()
+        } else {
+            "a voxel's colour is the plane-weighted mean of the exemplar colours at its coordinate triple".to_string()
+        },
         if options.feature_mask.is_some() {
             "--feature-mask: the mask (grey value, stacked like the colours, times --feature-weight) is matched as a fourth channel in the PCA neighbourhoods, the crossbar sticks of the triple search and the correction's voxel neighbourhoods, and never shown (paper E §4); the same mask serves every plane, transposed for yz with one --exemplar; a detected mask is not implemented (give it)".to_string()
         } else {
