@@ -442,15 +442,14 @@ impl<'a> SolidSynthesizer<'a> {
     }
 
     /// The sub-pixel part of the integrated warp at finest voxel `v` (exemplar pixels per
-    /// axis, each in `[−½, ½]`): every triple of a coherent region is `round(2^g U) +` a
-    /// constant, so adding it gives the continuous warp `2^g U +` that constant. `None`
-    /// without the integrated start, off its grid, or where it is zero.
+    /// axis, each in `[−½, ½]`): every triple of the uncorrected warp is `round(2^g U − φ)
+    /// +` a constant, so adding it gives the continuous warp. `None` unless the
+    /// integrated start is left uncorrected ([`Self::subpixel`]), and off its grid.
     fn warp_residual(&self, v: [i32; 3]) -> Option<[f32; 3]> {
         if !self.subpixel {
             return None;
         }
-        let r = self.init.as_ref()?.residual(v)?.map(|x| x as f32);
-        (r != [0.0; 3]).then_some(r)
+        Some(self.init.as_ref()?.residual(v)?.map(|x| x as f32))
     }
 
     /// The finest matched values ([`Self::triple_matched`]) of voxel `v` holding triple
