@@ -277,6 +277,24 @@ fn eval_known_answers_and_bad_field() {
 /// `orient` with a preset: all outputs, a field of the right shape, the designed
 /// singularities in the report, byte-identical outputs for 1 and 2 threads, and a
 /// clear exit 2 for an unknown preset.
+/// The default phase-defect count looks for the stripes at the exemplar's period scaled
+/// to the output (a pattern twice as large, twice the period, exactly), close to the
+/// period estimated on the output itself (`--exact-metrics`).
+#[test]
+fn orient_phase_defects_use_the_exemplars_period() {
+    let limit = Duration::from_secs(300);
+    let period = |extra: &[&str], name: &str| {
+        let dir = tmp(name);
+        common::orient_small(&dir, "arch", extra, limit);
+        let r = common::read_json(&dir.join("report.json"));
+        r["metrics"]["texture"]["phase_defects"]["period_px"].as_f64().unwrap()
+    };
+    let (one, two) = (period(&[], "orient-period-1"), period(&["--scale", "2"], "orient-period-2"));
+    assert!((two - 2.0 * one).abs() < 1e-9, "scale 1: {one} px, scale 2: {two} px");
+    let own = period(&["--exact-metrics"], "orient-period-exact");
+    assert!((one / own - 1.0).abs() < 0.1, "from the exemplar {one} px, on the output {own} px");
+}
+
 #[test]
 fn orient_preset_outputs_and_determinism() {
     let ex = shared().join("exemplars/stripes_Fabric071.png");

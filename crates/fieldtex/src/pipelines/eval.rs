@@ -90,6 +90,10 @@ pub(crate) struct SourceCoordinates<'a> {
     pub coords: &'a [f32],
     /// Also the search-based completeness.
     pub search_too: bool,
+    /// Exemplar pixels per output pixel of the synthesis: the default (approximate)
+    /// phase-defect count then looks for the stripes at the exemplar's own period
+    /// scaled by it, instead of estimating the period on the output.
+    pub per_pixel: f64,
 }
 
 pub(crate) fn bad(e: ev::EvalError, what: &Path) -> Error {
@@ -174,7 +178,7 @@ pub(crate) fn image_metrics(
                         progress,
                     )
                 },
-                || phase_metric(&o, exact, progress),
+                || phase_metric(&o, &e, sources.as_ref().map(|s| s.per_pixel), exact, progress),
             )
         },
     );
@@ -347,12 +351,26 @@ fn colour_and_orientation(
 /// Phase defects of `o` (default: counted on the image reduced 2× where the stripes are
 /// long enough; the gap to full resolution is pinned by fieldtex-eval's
 /// tests/approximate_metrics.rs).
+/// Phase defects of `o`: exact, or on the image reduced 2×. With `per_pixel` (the
+/// synthesis's exemplar pixels per output pixel) the reduced count looks for the
+/// stripes at the period the synthesis was asked to make, the exemplar `e`'s own
+/// ([`ev::estimate_stripe_period`], on the small exemplar) divided by `per_pixel` and
+/// clamped as the output's own estimate would be, instead of estimating it on the
+/// output (most of the count's cost; docs/first-hour.md).
 fn phase_metric(
     o: &ev::ImageView,
+    e: &ev::ImageView,
+    per_pixel: Option<f64>,
     exact: bool,
     progress: &dyn Progress,
 ) -> std::result::Result<ev::PhaseDefectReport, ev::EvalError> {
-    let pdo = ev::PhaseDefectOptions::default();
+    let mut pdo = ev::PhaseDefectOptions::default();
+    if !exact && let Some(step) = per_pixel.filter(|s| s.is_finite() && *s > 0.0) {
+        let t_max = (o.width.min(o.height) as f64 / 3.0).clamp(3.0, 64.0);
+        if let Ok(t) = ev::estimate_stripe_period(e) {
+            pdo.period_px = Some((t / step).clamp(3.0, t_max));
+        }
+    }
     let pd = if exact { ev::phase_defects(o, &pdo) } else { ev::coarse_phase_defects(o, &pdo) };
     progress.advance(1);
     pd

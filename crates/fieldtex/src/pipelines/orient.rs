@@ -388,18 +388,25 @@ fn orient_metrics(
     progress: &dyn Progress,
 ) -> Result<()> {
     let pts: Vec<[f64; 2]> = designed.iter().map(|s| [s.x, s.y]).collect();
-    let (mut metrics, _) = texture_metrics(
-        report,
-        &result.colors,
-        exemplar,
-        flat,
-        Some(coords),
-        &pts,
-        options,
-        progress,
-    )?;
-    let seam = seam_metric(coords, flat, &result.flips, options.size, exemplar, per_pixel)?;
-    metrics.rosy_seam = Some(seam);
+    // The seam measure (a serial scan of every neighbour pair) runs beside the image
+    // metrics, whose join tree leaves a core idle part of the time.
+    let (texture, seam) = rayon::join(
+        || {
+            texture_metrics(
+                report,
+                &result.colors,
+                exemplar,
+                flat,
+                Some((coords, per_pixel)),
+                &pts,
+                options,
+                progress,
+            )
+        },
+        || seam_metric(coords, flat, &result.flips, options.size, exemplar, per_pixel),
+    );
+    let (mut metrics, _) = texture?;
+    metrics.rosy_seam = Some(seam?);
     report.metric("texture", &metrics);
     Ok(())
 }
@@ -436,8 +443,10 @@ fn seam_metric(
 /// `exemplar_orientation` (as `align` measures on surfaces; 0 when the exemplar has no
 /// measurable orientation), plus the phase defects within 3 exemplar periods of the
 /// designed singularities `points`. With the synthesis's exemplar coordinates `coords`
-/// (`H×W×2`, pixels of `exemplar`), completeness is their source coverage (no search)
-/// unless `options` asks for the search too. Returns the metrics and that direction in
+/// (`H×W×2`, pixels of `exemplar`, and the exemplar pixels per output pixel),
+/// completeness is their source coverage (no search) unless `options` asks for the
+/// search too, and phase defects are looked for at the exemplar's period scaled to the
+/// output. Returns the metrics and that direction in
 /// degrees.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn texture_metrics(
@@ -445,7 +454,7 @@ pub(crate) fn texture_metrics(
     texture: &Image,
     exemplar: &Image,
     flat: &[f32],
-    coords: Option<&[f32]>,
+    coords: Option<(&[f32], f64)>,
     points: &[[f64; 2]],
     options: &OrientOptions,
     progress: &dyn Progress,
@@ -458,9 +467,10 @@ pub(crate) fn texture_metrics(
     }
     let metrics = report
         .stage(progress, "metrics", || {
-            let sources = coords.map(|coords| super::eval::SourceCoordinates {
+            let sources = coords.map(|(coords, per_pixel)| super::eval::SourceCoordinates {
                 coords,
                 search_too: exact || options.search_completeness,
+                per_pixel,
             });
             image_metrics(
                 texture,
