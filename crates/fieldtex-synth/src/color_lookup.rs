@@ -42,7 +42,7 @@ pub enum ColorFilter {
 /// Keys (1981) cubic convolution weights (`a = −½`) of the four taps at offsets
 /// −1, 0, 1, 2 from the pixel left of a sample at fraction `t ∈ [0, 1)`.
 #[inline]
-pub(crate) fn keys_weights(t: f32) -> [f32; 4] {
+fn keys_weights(t: f32) -> [f32; 4] {
     let (t2, t3) = (t * t, t * t * t);
     [
         -0.5 * t3 + t2 - 0.5 * t,
@@ -63,9 +63,6 @@ pub fn color_lookup(analysis: &ExemplarAnalysis, u: [f32; 2], filter: ColorFilte
 fn cubic(analysis: &ExemplarAnalysis, u: [f32; 2]) -> [f32; 4] {
     let (w, h) = (analysis.width() as i64, analysis.height() as i64);
     let colors = analysis.colors();
-    let (x, y) = (u[0] as f64 - 0.5, u[1] as f64 - 0.5);
-    let (x0, y0) = (x.floor(), y.floor());
-    let (wx, wy) = (keys_weights((x - x0) as f32), keys_weights((y - y0) as f32));
     // Synthesised coordinates are wrapped, so the taps need at most one wrap each; the
     // Euclidean remainder covers any other input.
     let wrap = |v: i64, n: i64| {
@@ -77,23 +74,41 @@ fn cubic(analysis: &ExemplarAnalysis, u: [f32; 2]) -> [f32; 4] {
             v
         }
     };
+    // Pixel centres at half-integers: pixel i is centred at i + ½.
+    keys_cubic(u[0] as f64 - 0.5, u[1] as f64 - 0.5, |x, y| {
+        colors[wrap(y, h) as usize * w as usize + wrap(x, w) as usize]
+    })
+}
+
+/// Keys (1981) cubic convolution (`a = −½`) at position `(x, y)` in pixel units (pixel
+/// `(i, j)` centred at `(i, j)`) over the 4 × 4 pixels around it, read by `tap` (which
+/// wraps or reflects as its image needs), each channel clamped to the range of its 16
+/// taps so no new extremes appear. Exact at pixel centres. Rows are summed first, in tap
+/// order. The one home of the kernel: the 2-D colour lookup here and the solid's
+/// sub-pixel reads of its warp.
+#[inline]
+pub(crate) fn keys_cubic<const C: usize>(
+    x: f64,
+    y: f64,
+    tap: impl Fn(i64, i64) -> [f32; C],
+) -> [f32; C] {
+    let (x0, y0) = (x.floor(), y.floor());
+    let (wx, wy) = (keys_weights((x - x0) as f32), keys_weights((y - y0) as f32));
     let (x0, y0) = (x0 as i64, y0 as i64);
-    let xs: [usize; 4] = std::array::from_fn(|i| wrap(x0 - 1 + i as i64, w) as usize);
-    let mut acc = [0.0f32; 4];
-    let mut lo = [f32::INFINITY; 4];
-    let mut hi = [f32::NEG_INFINITY; 4];
+    let mut acc = [0.0f32; C];
+    let mut lo = [f32::INFINITY; C];
+    let mut hi = [f32::NEG_INFINITY; C];
     for (j, wyj) in wy.iter().enumerate() {
-        let row = &colors[wrap(y0 - 1 + j as i64, h) as usize * w as usize..];
-        let mut racc = [0.0f32; 4];
-        for (&xi, wxi) in xs.iter().zip(&wx) {
-            let p = row[xi];
-            for c in 0..4 {
+        let mut racc = [0.0f32; C];
+        for (i, wxi) in wx.iter().enumerate() {
+            let p = tap(x0 - 1 + i as i64, y0 - 1 + j as i64);
+            for c in 0..C {
                 racc[c] += wxi * p[c];
                 lo[c] = lo[c].min(p[c]);
                 hi[c] = hi[c].max(p[c]);
             }
         }
-        for c in 0..4 {
+        for c in 0..C {
             acc[c] += wyj * racc[c];
         }
     }

@@ -59,7 +59,7 @@ use std::time::Instant;
 
 mod block_regions;
 use super::integrated_init::IntegratedInit;
-use crate::color_lookup::keys_weights;
+use crate::color_lookup::keys_cubic;
 
 /// Largest grid of the integrated initialisation's solve
 /// ([`SolidSynthesisOptions::integrated_init`]).
@@ -485,28 +485,8 @@ impl<'a> SolidSynthesizer<'a> {
     /// channel clamped to the range of its taps (as `orient`'s colour lookup,
     /// [`crate::color_lookup`]): exact at `d = 0`, sharper than bilinear between pixels.
     fn cubic_matched(&self, p: usize, xy: [i32; 2], d: [f32; 2]) -> [f32; 4] {
-        let (fx, fy) = (d[0].floor(), d[1].floor());
-        let (x0, y0) = (xy[0] + fx as i32, xy[1] + fy as i32);
-        let (wx, wy) = (keys_weights(d[0] - fx), keys_weights(d[1] - fy));
-        let e = &self.exemplar;
-        let mut acc = [0.0f32; 4];
-        let mut lo = [f32::INFINITY; 4];
-        let mut hi = [f32::NEG_INFINITY; 4];
-        for (j, wyj) in wy.iter().enumerate() {
-            let mut row = [0.0f32; 4];
-            for (i, wxi) in wx.iter().enumerate() {
-                let c = e.matched(p, 0, x0 - 1 + i as i32, y0 - 1 + j as i32);
-                for k in 0..4 {
-                    row[k] += wxi * c[k];
-                    lo[k] = lo[k].min(c[k]);
-                    hi[k] = hi[k].max(c[k]);
-                }
-            }
-            for k in 0..4 {
-                acc[k] += wyj * row[k];
-            }
-        }
-        std::array::from_fn(|k| acc[k].clamp(lo[k], hi[k]))
+        let (x, y) = (xy[0] as f64 + d[0] as f64, xy[1] as f64 + d[1] as f64);
+        keys_cubic(x, y, |x, y| self.exemplar.matched(p, 0, x as i32, y as i32))
     }
 
     /// Plane-weighted mean of the three level-`c` exemplar colours at `t`

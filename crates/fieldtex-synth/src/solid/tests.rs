@@ -34,6 +34,19 @@ fn options() -> (SolidAnalysisOptions, SolidSynthesisOptions) {
     (a, s)
 }
 
+/// The test exemplar on all three planes, the default test options and a unit lattice.
+fn stripes_setup() -> (SolidExemplar, SolidSynthesisOptions, VoxelLattice) {
+    let img = exemplar();
+    let (ao, so) = options();
+    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
+    (ex, so, VoxelLattice { origin: [0.0; 3], spacing: 1.0 })
+}
+
+/// The `n × n` voxels of the slice z = 5, x fastest.
+fn slice_z5(n: i32) -> Vec<[i32; 3]> {
+    (0..n * n).map(|i| [i % n, i / n, 5]).collect()
+}
+
 fn all_voxels(n: i32) -> Vec<[i32; 3]> {
     let mut v = Vec::new();
     for z in 0..n {
@@ -48,10 +61,7 @@ fn all_voxels(n: i32) -> Vec<[i32; 3]> {
 
 #[test]
 fn voxels_are_identical_alone_in_subsets_and_in_the_full_volume() {
-    let img = exemplar();
-    let (ao, so) = options();
-    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
-    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let (ex, so, lattice) = stripes_setup();
     let full_set = all_voxels(14);
     let mut full = SolidSynthesizer::new(&ex, lattice, &Bent, so.clone()).unwrap();
     let (full_t, stats) = full.triples(&full_set, &NoProgress);
@@ -85,10 +95,7 @@ fn voxels_are_identical_alone_in_subsets_and_in_the_full_volume() {
 /// voxels of the full volume.
 #[test]
 fn per_level_passes_keep_the_on_demand_equality() {
-    let img = exemplar();
-    let (ao, so) = options();
-    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
-    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let (ex, so, lattice) = stripes_setup();
     let voxels = all_voxels(10);
     let run = |level_passes: Vec<usize>, voxels: &[[i32; 3]]| {
         let o = SolidSynthesisOptions { level_passes, ..so.clone() };
@@ -118,10 +125,7 @@ impl FrameSource for Axes {
 /// differ), and keep the on-demand equality.
 #[test]
 fn projected_predictions_change_only_turned_frames() {
-    let img = exemplar();
-    let (ao, so) = options();
-    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
-    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let (ex, so, lattice) = stripes_setup();
     let voxels = all_voxels(10);
     let run = |projected: bool, frames: &dyn FrameSource, voxels: &[[i32; 3]]| {
         let o = SolidSynthesisOptions { projected_predictions: projected, ..so.clone() };
@@ -370,10 +374,7 @@ fn feature_masks_are_all_or_none_and_exemplar_sized() {
 /// the grid the coordinates were integrated over).
 #[test]
 fn integrated_initialisation_keeps_the_on_demand_equality() {
-    let img = exemplar();
-    let (ao, so) = options();
-    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
-    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let (ex, so, lattice) = stripes_setup();
     let voxels = all_voxels(10);
     let run = |integrated_init: bool, voxels: &[[i32; 3]]| {
         let o = SolidSynthesisOptions { integrated_init, ..so.clone() };
@@ -395,12 +396,9 @@ fn integrated_initialisation_keeps_the_on_demand_equality() {
 /// field's step (one warp) far more often than from the default slabs.
 #[test]
 fn integrated_start_follows_a_bent_field() {
-    let img = exemplar();
-    let (ao, so) = options();
-    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
-    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let (ex, so, lattice) = stripes_setup();
     let n = 24;
-    let slice: Vec<[i32; 3]> = (0..n * n).map(|i| [i % n, i / n, 5]).collect();
+    let slice = slice_z5(n);
     let share = |integrated_init: bool| {
         let o = SolidSynthesisOptions { integrated_init, ..so.clone() };
         let t = SolidSynthesizer::new(&ex, lattice, &Bent, o)
@@ -432,12 +430,9 @@ fn integrated_start_follows_a_bent_field() {
 /// whole-pixel colours of the same triples (the staircase of a rounded warp is gone).
 #[test]
 fn integrated_colours_follow_the_warp_below_a_pixel() {
-    let img = exemplar();
-    let (ao, so) = options();
-    let ex = SolidExemplar::new([&img, &img, &img], &ao, &NoProgress).unwrap();
-    let lattice = VoxelLattice { origin: [0.0; 3], spacing: 1.0 };
+    let (ex, so, lattice) = stripes_setup();
     let n = 24;
-    let slice: Vec<[i32; 3]> = (0..n * n).map(|i| [i % n, i / n, 5]).collect();
+    let slice = slice_z5(n);
     let o = SolidSynthesisOptions { integrated_init: true, ..so };
     let run = |frames: &dyn FrameSource| {
         let mut s = SolidSynthesizer::new(&ex, lattice, frames, o.clone())
