@@ -111,8 +111,9 @@ pub struct SolidSynthesisOptions {
     /// and colours are read by cubic convolution at each triple moved by the warp's
     /// sub-pixel part ([`SolidSynthesizer::colors`]): a smooth warp of the exemplar,
     /// not a synthesis (with corrections, whole pixels). For layered exemplars
-    /// (stripes, wood rings) whose layers should follow the sketch without breaks. Takes effect once the grid is known
-    /// ([`SolidSynthesizer::with_extent`]; voxels off the grid keep the default path).
+    /// (stripes, wood rings) whose layers should follow the sketch without breaks.
+    /// Takes effect once the grid is known ([`SolidSynthesizer::with_extent`]; voxels
+    /// off the grid keep the default path).
     /// Default false.
     pub integrated_init: bool,
     pub seed: u64,
@@ -420,10 +421,11 @@ impl<'a> SolidSynthesizer<'a> {
     }
 
     /// Colours (RGB, sRGB-encoded as the exemplars) of `voxels`: the mean of the three
-    /// finest exemplar colours at each final triple. With the integrated start
-    /// ([`SolidSynthesisOptions::integrated_init`]) each plane is read bilinearly at the
-    /// triple moved by the warp's sub-pixel part ([`Self::warp_residual`]), so coherent
-    /// regions sample the continuous warp instead of its whole-pixel steps.
+    /// finest exemplar colours at each final triple. With the uncorrected integrated
+    /// start ([`SolidSynthesisOptions::integrated_init`]) each plane is read by cubic
+    /// convolution at the triple moved by the warp's sub-pixel part
+    /// ([`Self::warp_residual`]), so the output samples the continuous warp instead of
+    /// its whole-pixel steps.
     pub fn colors(
         &mut self,
         voxels: &[[i32; 3]],
