@@ -88,8 +88,8 @@ pub struct SolidArgs {
     /// falls: layers such as stripes or wood rings then follow the sketch smoothly and
     /// without breaks (a substitute for the synthesis, not paper E's method;
     /// --level-passes adds corrections, read at whole pixels). The default synthesis
-    /// suits irregular exemplars (stone, marble) better and hides a non-tiling
-    /// exemplar's wrap seam, which this start shows.
+    /// suits irregular exemplars (stone, marble) better: this start repeats the
+    /// exemplar along the warp and shows a cropped exemplar's borders.
     #[arg(long)]
     integrated_init: bool,
     /// Synthesis levels.
