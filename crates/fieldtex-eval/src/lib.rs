@@ -71,7 +71,7 @@ pub use orientation::{
 };
 pub use phase_defects::{
     PhaseDefect, PhaseDefectOptions, PhaseDefectReport, count_defects_near, estimate_stripe_period,
-    phase_defects,
+    max_stripe_period, phase_defects,
 };
 pub use rosy_seam::{
     RosySeamOptions, RosySeamReport, SeamSubset, rosy_seam_coherence,

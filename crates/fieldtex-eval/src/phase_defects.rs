@@ -174,6 +174,13 @@ fn mean_gabor_amplitude(l0: &[f32], w: usize, h: usize, normal: &[f32], t: f64) 
     amps.iter().sum::<f64>() / amps.len().max(1) as f64
 }
 
+/// The longest stripe period [`estimate_stripe_period`] reports for a `width × height`
+/// image (its estimates lie in `[3, this]`): a third of the short side, within
+/// `[3, 64]` pixels.
+pub fn max_stripe_period(width: usize, height: usize) -> f64 {
+    (width.min(height) as f64 / 3.0).clamp(3.0, 64.0)
+}
+
 /// Dominant stripe period of an image in pixels: a first guess from the ratio of
 /// gradient energy to signal energy (`k² = Σ|∇f|² / Σf²` for a sinusoid), refined by
 /// picking, among periods from half to twice the guess, the one whose oriented Gabor
@@ -183,7 +190,7 @@ pub fn estimate_stripe_period(image: &ImageView) -> Result<f64, EvalError> {
     check_image(image, 16)?;
     let (w, h) = (image.width, image.height);
     let luma = image.luminance();
-    let t_max = (w.min(h) as f64 / 3.0).clamp(3.0, 64.0);
+    let t_max = max_stripe_period(w, h);
     let ratio_period = |sigma: f64| -> f64 {
         let l0 = detrend(&luma, w, h, sigma);
         let (gx, gy) = gradient(&l0, w, h);

@@ -365,11 +365,11 @@ fn phase_metric(
     progress: &dyn Progress,
 ) -> std::result::Result<ev::PhaseDefectReport, ev::EvalError> {
     let mut pdo = ev::PhaseDefectOptions::default();
-    if !exact && let Some(step) = per_pixel.filter(|s| s.is_finite() && *s > 0.0) {
-        let t_max = (o.width.min(o.height) as f64 / 3.0).clamp(3.0, 64.0);
-        if let Ok(t) = ev::estimate_stripe_period(e) {
-            pdo.period_px = Some((t / step).clamp(3.0, t_max));
-        }
+    if !exact
+        && let Some(step) = per_pixel.filter(|s| s.is_finite() && *s > 0.0)
+        && let Ok(t) = ev::estimate_stripe_period(e)
+    {
+        pdo.period_px = Some((t / step).clamp(3.0, ev::max_stripe_period(o.width, o.height)));
     }
     let pd = if exact { ev::phase_defects(o, &pdo) } else { ev::coarse_phase_defects(o, &pdo) };
     progress.advance(1);
